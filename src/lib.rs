@@ -1,0 +1,7 @@
+//! texgeo: geometry algorithms of the GPGPU texture era on raw Vulkan.
+//!
+//! `gpu` owns every Vulkan object; `mesh` is the polygon mesh and its formats;
+//! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top.
+
+pub mod gpu;
+pub mod mesh;

@@ -1,0 +1,79 @@
+//! Mesh file formats. Readers never panic and never return a half-read mesh: a file is
+//! either read whole and checked, or rejected with an error naming file, line (or byte
+//! offset) and the problem. No allocation is sized from a count the file claims before
+//! the data behind it has been seen.
+
+use std::path::Path;
+
+use super::{Mesh, MeshError, Result, error::Location};
+
+pub mod off;
+pub(crate) mod text;
+
+/// A file format texgeo reads and writes, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Obj,
+    Off,
+    Ply,
+    Stl,
+}
+
+impl Format {
+    /// The format of `path`, from its extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Format> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => Ok(Format::Obj),
+            Some("off") => Ok(Format::Off),
+            Some("ply") => Ok(Format::Ply),
+            Some("stl") => Ok(Format::Stl),
+            other => Err(MeshError::parse(
+                path,
+                Location::File,
+                match other {
+                    Some(e) => format!("unknown mesh format '.{e}' (expected .obj, .off, .ply or .stl)"),
+                    None => "no file extension; expected .obj, .off, .ply or .stl".to_string(),
+                },
+            )),
+        }
+    }
+}
+
+/// Reads a mesh, choosing the format from the file extension.
+pub fn read(path: impl AsRef<Path>) -> Result<Mesh> {
+    let path = path.as_ref();
+    let format = Format::from_path(path)?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.into(), source })?;
+    if bytes.is_empty() {
+        return Err(MeshError::parse(path, Location::File, "the file is empty"));
+    }
+    read_bytes(&bytes, format, path)
+}
+
+/// Reads a mesh from memory; `path` is only used to name the source in errors.
+pub fn read_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
+    match format {
+        Format::Off => off::read(bytes, path),
+        other => {
+            Err(MeshError::parse(path, Location::File, format!("{other:?} reading is not available yet")))
+        }
+    }
+}
+
+/// Writes a mesh, choosing the format from the file extension.
+pub fn write(path: impl AsRef<Path>, mesh: &Mesh) -> Result<()> {
+    let path = path.as_ref();
+    let format = Format::from_path(path)?;
+    let mut out = Vec::new();
+    write_to(&mut out, mesh, format).map_err(|source| MeshError::Io { path: path.into(), source })?;
+    std::fs::write(path, out).map_err(|source| MeshError::Io { path: path.into(), source })
+}
+
+/// Writes a mesh in `format` to any writer.
+pub fn write_to(out: &mut impl std::io::Write, mesh: &Mesh, format: Format) -> std::io::Result<()> {
+    match format {
+        Format::Off => off::write(out, mesh),
+        other => Err(std::io::Error::other(format!("{other:?} writing is not available yet"))),
+    }
+}

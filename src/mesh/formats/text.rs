@@ -1,0 +1,53 @@
+//! Line-oriented reading shared by the text formats (OFF, OBJ checks, ASCII PLY/STL).
+
+use std::path::Path;
+
+use crate::mesh::{MeshError, error::Location};
+
+/// The non-empty, comment-stripped lines of a text file, with 1-based line numbers.
+pub(crate) struct Lines<'a> {
+    path: &'a Path,
+    inner: std::iter::Enumerate<std::str::Lines<'a>>,
+    /// Line number of the last line handed out (for "file ends" errors).
+    pub last_line: usize,
+}
+
+impl<'a> Lines<'a> {
+    /// Fails on bytes that are not UTF-8, naming the byte offset.
+    pub fn new(bytes: &'a [u8], path: &'a Path) -> Result<Lines<'a>, MeshError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            MeshError::parse(path, Location::Byte(e.valid_up_to() as u64), "not a text file (invalid UTF-8)")
+        })?;
+        Ok(Lines { path, inner: text.lines().enumerate(), last_line: 0 })
+    }
+
+    /// The next line holding something other than whitespace and a `#` comment.
+    pub fn next_content(&mut self) -> Option<(usize, &'a str)> {
+        for (i, line) in self.inner.by_ref() {
+            self.last_line = i + 1;
+            let line = line.split('#').next().unwrap_or("").trim();
+            if !line.is_empty() {
+                return Some((i + 1, line));
+            }
+        }
+        None
+    }
+
+    pub fn error(&self, line: usize, message: impl Into<String>) -> MeshError {
+        MeshError::parse(self.path, Location::Line(line), message)
+    }
+}
+
+/// Parses a finite f64, or explains why not.
+pub(crate) fn parse_coord(token: &str) -> Result<f64, String> {
+    match token.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("coordinate '{token}' is not finite")),
+        Err(_) => Err(format!("'{token}' is not a number")),
+    }
+}
+
+/// Parses a count or index.
+pub(crate) fn parse_index(token: &str, what: &str) -> Result<u64, String> {
+    token.parse::<u64>().map_err(|_| format!("{what} '{token}' is not a non-negative integer"))
+}
