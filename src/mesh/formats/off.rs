@@ -4,12 +4,13 @@
 //! colours or normals are ignored), with the counts on the header line or the next one.
 //! One vertex per line, one face per line (`n i0 … in-1`, trailing colour values ignored).
 
+use std::io::Write;
 use std::path::Path;
 
 use glam::DVec3;
 
 use super::text::{Lines, parse_coord, parse_index};
-use crate::mesh::{Mesh, MeshError, Result};
+use crate::mesh::{Mesh, Result};
 
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let mut lines = Lines::new(bytes, path)?;
@@ -84,7 +85,7 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
 }
 
 /// Writes OFF with shortest round-trip decimal coordinates (reading it back is exact).
-pub fn write(out: &mut impl std::io::Write, mesh: &Mesh) -> std::io::Result<()> {
+pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     writeln!(w, "OFF")?;
     writeln!(w, "{} {} 0", mesh.num_vertices(), mesh.num_faces())?;
