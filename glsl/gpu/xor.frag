@@ -1,0 +1,8 @@
+#version 450
+// Every covered texel receives `value`; the logic op XOR flips those bits, so a texel
+// covered an even number of times ends where it started.
+#include "xor_params.glsl"
+layout(location = 0) out uint bits;
+void main() {
+    bits = pc.value;
+}

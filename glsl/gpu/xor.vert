@@ -1,0 +1,8 @@
+#version 450
+// Triangles given in texel units, rasterized with Vulkan's top-left rule.
+#include "texel.glsl"
+#include "xor_params.glsl"
+layout(location = 0) in vec2 position;
+void main() {
+    gl_Position = pixel_to_clip(position, pc.size);
+}

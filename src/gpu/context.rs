@@ -1,0 +1,516 @@
+//! Instance, device choice, queue, allocator and one-shot submission.
+//!
+//! `Context` is a cheap handle (an `Arc`) to the device; every resource keeps one, so
+//! the device outlives whatever was made from it and destruction order is written once,
+//! in `Device::drop`.
+
+use std::ffi::CStr;
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+use super::error::{GpuError, Result, VkContext};
+use super::pass::Recorder;
+use super::validation;
+
+/// Which physical device to use.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum DeviceChoice {
+    /// The first discrete GPU, else integrated, else virtual, else a CPU device (lavapipe).
+    #[default]
+    Auto,
+    /// Index in the order `texgeo info --all` lists devices.
+    Index(usize),
+    /// Case-insensitive part of the device or driver name; `lavapipe` also matches llvmpipe.
+    Name(String),
+}
+
+impl DeviceChoice {
+    /// `NAME|INDEX`, as given to `--device` or `TEXGEO_DEVICE`.
+    pub fn parse(s: &str) -> DeviceChoice {
+        match s.trim() {
+            "" | "auto" => DeviceChoice::Auto,
+            t => t.parse().map(DeviceChoice::Index).unwrap_or_else(|_| DeviceChoice::Name(t.to_string())),
+        }
+    }
+
+    /// `explicit` if given, else `TEXGEO_DEVICE`, else `Auto`.
+    pub fn from_env_or(explicit: Option<&str>) -> DeviceChoice {
+        match explicit {
+            Some(s) => DeviceChoice::parse(s),
+            None => std::env::var("TEXGEO_DEVICE").map(|s| DeviceChoice::parse(&s)).unwrap_or_default(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    pub device: DeviceChoice,
+    /// `None`: follow `TEXGEO_VALIDATION`.
+    pub validation: Option<bool>,
+}
+
+/// What `texgeo info` prints and benchmark reports quote.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub index: usize,
+    pub name: String,
+    pub kind: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub api_version: String,
+    pub max_image_2d: u32,
+    pub max_image_3d: u32,
+    pub max_array_layers: u32,
+    pub max_color_attachments: u32,
+    pub max_push_constants: u32,
+    pub max_vertex_attributes: u32,
+    pub logic_op: bool,
+    pub float64: bool,
+    pub timestamps: bool,
+    pub timestamp_period_ns: f32,
+    pub push_descriptor: bool,
+    pub vulkan13: bool,
+}
+
+impl DeviceInfo {
+    /// "llvmpipe (LLVM 15.0.6, 256 bits) [llvmpipe, Mesa 22.3.6]".
+    pub fn label(&self) -> String {
+        format!("{} [{} {}]", self.name, self.driver, self.driver_info)
+    }
+}
+
+pub(crate) struct Device {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    log: Option<Box<validation::Log>>,
+    pub physical: vk::PhysicalDevice,
+    pub raw: ash::Device,
+    pub push_descriptor: ash::khr::push_descriptor::Device,
+    pub queue: Mutex<vk::Queue>,
+    pub command_pool: Mutex<vk::CommandPool>,
+    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    /// NEAREST, clamp-to-edge: the texture era reads texels with `texelFetch` only.
+    pub sampler: vk::Sampler,
+    pub info: DeviceInfo,
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // SAFETY: every resource holds an Arc<Device>, so none is alive here; wait for
+        // the queue, then destroy in reverse creation order (allocator before device).
+        unsafe {
+            let _ = self.raw.device_wait_idle();
+            self.raw.destroy_sampler(self.sampler, None);
+            if let Ok(pool) = self.command_pool.get_mut() {
+                self.raw.destroy_command_pool(*pool, None);
+            }
+            ManuallyDrop::drop(&mut self.allocator);
+            self.raw.destroy_device(None);
+            if let Some((loader, messenger)) = self.debug.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+        if let Some(log) = &self.log {
+            let errors = log.take();
+            if !errors.is_empty() {
+                eprintln!("Vulkan validation errors at teardown:\n{}", errors.join("\n"));
+                if !std::thread::panicking() {
+                    panic!("{} Vulkan validation error(s) were never reported", errors.len());
+                }
+            }
+        }
+    }
+}
+
+impl Device {
+    /// Validation errors since the last check, as an error.
+    pub fn check_validation(&self) -> Result<()> {
+        match &self.log {
+            Some(log) => {
+                let errors = log.take();
+                if errors.is_empty() { Ok(()) } else { Err(GpuError::Validation(errors)) }
+            }
+            None => Ok(()),
+        }
+    }
+}
+
+/// A Vulkan device ready for texture-era GPGPU work.
+#[derive(Clone)]
+pub struct Context {
+    pub(crate) dev: Arc<Device>,
+}
+
+struct Instance {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    log: Option<Box<validation::Log>>,
+}
+
+impl Instance {
+    fn new(validate: bool) -> Result<Instance> {
+        // SAFETY: loading libvulkan; failure is reported, not assumed.
+        let entry = unsafe { ash::Entry::load()? };
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"texgeo")
+            .engine_name(c"texgeo")
+            .api_version(vk::API_VERSION_1_3);
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if validate {
+            // SAFETY: plain enumeration.
+            let available = unsafe { entry.enumerate_instance_layer_properties() }
+                .vk("vkEnumerateInstanceLayerProperties")?;
+            let found =
+                available.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == validation::LAYER));
+            if !found {
+                return Err(GpuError::Unsupported(
+                    "TEXGEO_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed; run tools/setup"
+                        .into(),
+                ));
+            }
+            layers.push(validation::LAYER.as_ptr());
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+            extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        if validate {
+            info = info.push_next(&mut features);
+        }
+        // SAFETY: all pointers in `info` outlive the call.
+        let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
+        let mut this = Instance { entry, instance, debug: None, log: None };
+        if validate {
+            let log = Box::new(validation::Log::default());
+            let loader = ash::ext::debug_utils::Instance::new(&this.entry, &this.instance);
+            let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(validation::callback))
+                .user_data(&*log as *const validation::Log as *mut std::ffi::c_void);
+            // SAFETY: the boxed log outlives the messenger (destroyed first in Device::drop).
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }
+                .vk("vkCreateDebugUtilsMessengerEXT")?;
+            this.debug = Some((loader, messenger));
+            this.log = Some(log);
+        }
+        Ok(this)
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        // Only reached when device creation failed; on success the parts move into Device.
+        // SAFETY: nothing else was created from this instance.
+        unsafe {
+            if let Some((loader, messenger)) = self.debug.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice) -> DeviceInfo {
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    // SAFETY: valid physical device from this instance; the chains live on the stack.
+    let (exts, props, features) = unsafe {
+        instance.get_physical_device_properties2(physical, &mut props2);
+        instance.get_physical_device_features2(physical, &mut features2);
+        (
+            instance.enumerate_device_extension_properties(physical).unwrap_or_default(),
+            props2.properties,
+            features2.features,
+        )
+    };
+    let cstr = |s: &[std::ffi::c_char]| {
+        // SAFETY: Vulkan fills these fixed arrays with NUL-terminated strings.
+        unsafe { CStr::from_ptr(s.as_ptr()) }.to_string_lossy().into_owned()
+    };
+    let has_ext = |name: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name));
+    let v = props.api_version;
+    let limits = props.limits;
+    DeviceInfo {
+        index,
+        name: cstr(&props.device_name),
+        kind: format!("{:?}", props.device_type).to_lowercase().replace('_', " "),
+        driver: cstr(&driver.driver_name),
+        driver_info: cstr(&driver.driver_info),
+        api_version: format!(
+            "{}.{}.{}",
+            vk::api_version_major(v),
+            vk::api_version_minor(v),
+            vk::api_version_patch(v)
+        ),
+        max_image_2d: limits.max_image_dimension2_d,
+        max_image_3d: limits.max_image_dimension3_d,
+        max_array_layers: limits.max_image_array_layers,
+        max_color_attachments: limits.max_color_attachments,
+        max_push_constants: limits.max_push_constants_size,
+        max_vertex_attributes: limits.max_vertex_input_attributes,
+        logic_op: features.logic_op == vk::TRUE,
+        float64: features.shader_float64 == vk::TRUE,
+        timestamps: limits.timestamp_compute_and_graphics == vk::TRUE,
+        timestamp_period_ns: limits.timestamp_period,
+        push_descriptor: has_ext(ash::khr::push_descriptor::NAME),
+        vulkan13: vk::api_version_minor(v) >= 3
+            && f13.dynamic_rendering == vk::TRUE
+            && f13.synchronization2 == vk::TRUE,
+    }
+}
+
+fn is_lavapipe(info: &DeviceInfo) -> bool {
+    info.name.to_lowercase().contains("llvmpipe") || info.driver.to_lowercase().contains("llvmpipe")
+}
+
+/// Every Vulkan device the loader sees, in index order.
+pub fn list_devices() -> Result<Vec<DeviceInfo>> {
+    let inst = Instance::new(false)?;
+    // SAFETY: plain enumeration on a live instance.
+    let physicals = unsafe { inst.instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    Ok(physicals.iter().enumerate().map(|(i, &p)| describe(&inst.instance, i, p)).collect())
+}
+
+fn choose(instance: &ash::Instance, choice: &DeviceChoice) -> Result<(vk::PhysicalDevice, DeviceInfo)> {
+    // SAFETY: plain enumeration on a live instance.
+    let physicals = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    let all: Vec<_> = physicals.iter().enumerate().map(|(i, &p)| (p, describe(instance, i, p))).collect();
+    if all.is_empty() {
+        return Err(GpuError::NoDevice(
+            "the Vulkan loader found no device; run tools/setup (installs lavapipe)".into(),
+        ));
+    }
+    let names = || all.iter().map(|(_, d)| format!("{}: {}", d.index, d.name)).collect::<Vec<_>>().join(", ");
+    let picked = match choice {
+        DeviceChoice::Index(i) => all
+            .get(*i)
+            .ok_or_else(|| GpuError::NoDevice(format!("no device with index {i} (devices: {})", names())))?,
+        DeviceChoice::Name(n) => {
+            let n = n.to_lowercase();
+            all.iter()
+                .find(|(_, d)| {
+                    (n == "lavapipe" && is_lavapipe(d))
+                        || d.name.to_lowercase().contains(&n)
+                        || d.driver.to_lowercase().contains(&n)
+                })
+                .ok_or_else(|| {
+                    GpuError::NoDevice(format!("no device matches '{n}' (devices: {})", names()))
+                })?
+        }
+        DeviceChoice::Auto => {
+            let rank = |d: &DeviceInfo| match d.kind.as_str() {
+                "discrete gpu" => 0,
+                "integrated gpu" => 1,
+                "virtual gpu" => 2,
+                "cpu" => 3,
+                _ => 4,
+            };
+            all.iter()
+                .filter(|(_, d)| d.vulkan13 && d.push_descriptor)
+                .min_by_key(|(_, d)| rank(d))
+                .unwrap_or(&all[0])
+        }
+    };
+    let (p, info) = picked.clone();
+    if !info.vulkan13 {
+        return Err(GpuError::Unsupported(format!(
+            "device '{}' lacks Vulkan 1.3 dynamic rendering / synchronization2 (API {})",
+            info.name, info.api_version
+        )));
+    }
+    if !info.push_descriptor {
+        return Err(GpuError::Unsupported(format!("device '{}' lacks VK_KHR_push_descriptor", info.name)));
+    }
+    Ok((p, info))
+}
+
+impl Context {
+    /// Opens the device `options` ask for (defaults: `TEXGEO_DEVICE`, `TEXGEO_VALIDATION`).
+    pub fn new(options: &ContextOptions) -> Result<Context> {
+        let validate = options.validation.unwrap_or_else(validation::requested);
+        let inst = Instance::new(validate)?;
+        let (physical, info) = choose(&inst.instance, &options.device)?;
+
+        // SAFETY: valid physical device.
+        let families = unsafe { inst.instance.get_physical_device_queue_family_properties(physical) };
+        let queue_family = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
+            .ok_or_else(|| GpuError::NoDevice(format!("device '{}' has no graphics queue", info.name)))?
+            as u32;
+        let priorities = [1.0];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let features = vk::PhysicalDeviceFeatures::default()
+            .logic_op(info.logic_op)
+            .shader_float64(info.float64)
+            .independent_blend(true);
+        let mut f13 =
+            vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let extensions = [ash::khr::push_descriptor::NAME.as_ptr()];
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_extension_names(&extensions)
+            .enabled_features(&features)
+            .push_next(&mut f13);
+        // SAFETY: all pointers in device_info outlive the call.
+        let raw =
+            unsafe { inst.instance.create_device(physical, &device_info, None) }.vk("vkCreateDevice")?;
+        // SAFETY: the queue family and index exist (created above).
+        let queue = unsafe { raw.get_device_queue(queue_family, 0) };
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT | vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::NEAREST)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: inst.instance.clone(),
+            device: raw.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        });
+        // SAFETY: valid device; on any failure below everything created so far is destroyed.
+        let (command_pool, sampler, allocator) = unsafe {
+            let pool = raw.create_command_pool(&pool_info, None);
+            let sampler = raw.create_sampler(&sampler_info, None);
+            match (pool, sampler, allocator) {
+                (Ok(p), Ok(s), Ok(a)) => (p, s, a),
+                (p, s, a) => {
+                    drop(a);
+                    if let Ok(p) = p {
+                        raw.destroy_command_pool(p, None);
+                    }
+                    if let Ok(s) = s {
+                        raw.destroy_sampler(s, None);
+                    }
+                    raw.destroy_device(None);
+                    return Err(GpuError::Unsupported(
+                        "cannot create command pool, sampler or allocator".into(),
+                    ));
+                }
+            }
+        };
+        let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.instance, &raw);
+        // Move the instance parts into the device, which now owns their destruction.
+        let inst = ManuallyDrop::new(inst);
+        // SAFETY: each field is read exactly once out of a ManuallyDrop that is never dropped.
+        let (entry, instance, debug, log) = unsafe {
+            (
+                std::ptr::read(&inst.entry),
+                std::ptr::read(&inst.instance),
+                std::ptr::read(&inst.debug),
+                std::ptr::read(&inst.log),
+            )
+        };
+        let dev = Device {
+            _entry: entry,
+            instance,
+            debug,
+            log,
+            physical,
+            raw,
+            push_descriptor,
+            queue: Mutex::new(queue),
+            command_pool: Mutex::new(command_pool),
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            sampler,
+            info,
+        };
+        dev.check_validation()?;
+        Ok(Context { dev: Arc::new(dev) })
+    }
+
+    /// Default options: device from `TEXGEO_DEVICE`, validation from `TEXGEO_VALIDATION`.
+    pub fn from_env() -> Result<Context> {
+        Context::new(&ContextOptions::default())
+    }
+
+    pub fn info(&self) -> &DeviceInfo {
+        &self.dev.info
+    }
+
+    /// Whether the validation layer is on for this context.
+    pub fn validating(&self) -> bool {
+        self.dev.log.is_some()
+    }
+
+    /// Records commands with `record`, submits them, waits, and reports validation errors.
+    /// The one-shot style of the texture era: upload, draw, read back, done.
+    pub fn submit<T>(&self, record: impl FnOnce(&mut Recorder) -> Result<T>) -> Result<T> {
+        let dev = &self.dev;
+        let pool =
+            dev.command_pool.lock().map_err(|_| GpuError::Usage("command pool lock poisoned".into()))?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(*pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: the pool is locked for the whole recording and submission.
+        let cmd = unsafe { dev.raw.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
+        let result = (|| {
+            let begin =
+                vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            // SAFETY: fresh command buffer.
+            unsafe { dev.raw.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
+            let mut recorder = Recorder::new(dev, cmd);
+            let value = record(&mut recorder)?;
+            // SAFETY: recording started above.
+            unsafe { dev.raw.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
+            let fence_info = vk::FenceCreateInfo::default();
+            // SAFETY: valid device.
+            let fence = unsafe { dev.raw.create_fence(&fence_info, None) }.vk("vkCreateFence")?;
+            let cmds = [cmd];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            let waited = (|| {
+                let queue = dev.queue.lock().map_err(|_| GpuError::Usage("queue lock poisoned".into()))?;
+                // SAFETY: the command buffer is complete; the fence is unsignalled.
+                unsafe { dev.raw.queue_submit(*queue, &submit, fence) }.vk("vkQueueSubmit")?;
+                drop(queue);
+                // SAFETY: waiting on our own fence.
+                unsafe { dev.raw.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")
+            })();
+            // SAFETY: the fence is signalled or was never submitted.
+            unsafe { dev.raw.destroy_fence(fence, None) };
+            waited?;
+            Ok(value)
+        })();
+        // SAFETY: the command buffer is no longer executing (fence waited) or never ran.
+        unsafe { dev.raw.free_command_buffers(*pool, &[cmd]) };
+        drop(pool);
+        dev.check_validation()?;
+        result
+    }
+
+    /// Returns `GpuError::Validation` if the layer logged errors since the last check.
+    pub fn check_validation(&self) -> Result<()> {
+        self.dev.check_validation()
+    }
+}

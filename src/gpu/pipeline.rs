@@ -1,0 +1,429 @@
+//! Graphics pipelines built from reflected SPIR-V: the descriptor set layout, the push
+//! constant range and the vertex input layout all come from the shaders themselves
+//! (rspirv-reflect), never from hand-written tables that could drift from the GLSL.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use ash::vk;
+use rspirv_reflect::rspirv::dr::{Instruction, Operand};
+use rspirv_reflect::rspirv::spirv::{Decoration, Op, StorageClass};
+use rspirv_reflect::{BindingCount, DescriptorType, Reflection};
+
+use super::context::{Context, Device};
+use super::error::{GpuError, Result, VkContext};
+use super::texture::TexFormat;
+use super::{Shader, shaders};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Topology {
+    /// One point per datum (`gl_PointSize = 1`), each placed on its own texel.
+    Points,
+    Triangles,
+}
+
+/// What the fixed-function output stage does with a fragment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Overwrite.
+    Replace,
+    /// Logic op XOR (integer targets only): parity accumulation.
+    Xor,
+    /// Additive blending (float targets): sum accumulation.
+    Add,
+}
+
+/// How to build a pipeline. Vertex attributes are packed in location order into binding 0
+/// (per vertex), except the locations listed in `per_instance`, packed into binding 1.
+pub struct PipelineDesc<'a> {
+    pub vertex: &'a Shader,
+    pub fragment: &'a Shader,
+    pub topology: Topology,
+    pub targets: &'a [TexFormat],
+    pub blend: Blend,
+    pub per_instance: &'a [u32],
+}
+
+/// A descriptor binding the pipeline expects (set 0, pushed per draw).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BindingKind {
+    Texture,
+    Uniform,
+}
+
+pub struct Pipeline {
+    dev: Arc<Device>,
+    pub(crate) raw: vk::Pipeline,
+    pub(crate) layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    pub(crate) bindings: BTreeMap<u32, BindingKind>,
+    pub(crate) push: Option<(vk::ShaderStageFlags, u32, u32)>,
+    pub(crate) targets: Vec<TexFormat>,
+    /// Byte strides of binding 0 (per vertex) and binding 1 (per instance).
+    pub(crate) strides: [u32; 2],
+    pub(crate) name: String,
+}
+
+struct Reflected {
+    sets: BTreeMap<u32, BTreeMap<u32, rspirv_reflect::DescriptorInfo>>,
+    push: Option<(u32, u32)>,
+}
+
+fn reflect(shader: &Shader) -> Result<(Reflection, Reflected)> {
+    let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
+    let r = Reflection::new_from_spirv(shader.spirv).map_err(|e| err(format!("cannot parse SPIR-V: {e}")))?;
+    let sets = r.get_descriptor_sets().map_err(|e| err(format!("reflection: {e}")))?;
+    let push =
+        r.get_push_constant_range().map_err(|e| err(format!("reflection: {e}")))?.map(|p| (p.offset, p.size));
+    Ok((r, Reflected { sets, push }))
+}
+
+/// A vertex shader input: location and Vulkan format.
+#[derive(Clone, Copy, Debug)]
+struct VertexInput {
+    location: u32,
+    format: vk::Format,
+    bytes: u32,
+}
+
+/// The vertex shader's `in` variables (builtins excluded), from the SPIR-V module.
+fn vertex_inputs(shader: &Shader, r: &Reflection) -> Result<Vec<VertexInput>> {
+    let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
+    let m = &r.0;
+    let by_id: BTreeMap<u32, &Instruction> =
+        m.types_global_values.iter().filter_map(|i| Some((i.result_id?, i))).collect();
+    let mut locations = BTreeMap::new();
+    for a in &m.annotations {
+        if a.class.opcode != Op::Decorate {
+            continue;
+        }
+        if let [
+            Operand::IdRef(target),
+            Operand::Decoration(Decoration::Location),
+            Operand::LiteralBit32(loc),
+            ..,
+        ] = a.operands.as_slice()
+        {
+            locations.insert(*target, *loc);
+        }
+    }
+    let mut inputs = Vec::new();
+    for v in m.types_global_values.iter().filter(|i| i.class.opcode == Op::Variable) {
+        if !matches!(v.operands.first(), Some(Operand::StorageClass(StorageClass::Input))) {
+            continue;
+        }
+        let (Some(id), Some(ptr)) = (v.result_id, v.result_type) else { continue };
+        let Some(&location) = locations.get(&id) else { continue }; // builtins have no location
+        let pointee = match by_id.get(&ptr).map(|p| p.operands.as_slice()) {
+            Some([Operand::StorageClass(_), Operand::IdRef(t)]) => *t,
+            _ => return Err(err(format!("input at location {location} is not a pointer variable"))),
+        };
+        let (scalar, count) = match by_id.get(&pointee) {
+            Some(t) if t.class.opcode == Op::TypeVector => match t.operands.as_slice() {
+                [Operand::IdRef(c), Operand::LiteralBit32(n)] => (*c, *n),
+                _ => return Err(err(format!("malformed vector type at location {location}"))),
+            },
+            Some(_) => (pointee, 1),
+            None => return Err(err(format!("unknown type at location {location}"))),
+        };
+        let kind = match by_id.get(&scalar).map(|t| (t.class.opcode, t.operands.as_slice())) {
+            Some((Op::TypeFloat, [Operand::LiteralBit32(32), ..])) => 'f',
+            Some((Op::TypeInt, [Operand::LiteralBit32(32), Operand::LiteralBit32(0)])) => 'u',
+            Some((Op::TypeInt, [Operand::LiteralBit32(32), Operand::LiteralBit32(1)])) => 'i',
+            _ => return Err(err(format!("input at location {location} is not a 32-bit scalar or vector"))),
+        };
+        use vk::Format as F;
+        let format = match (kind, count) {
+            ('f', 1) => F::R32_SFLOAT,
+            ('f', 2) => F::R32G32_SFLOAT,
+            ('f', 3) => F::R32G32B32_SFLOAT,
+            ('f', 4) => F::R32G32B32A32_SFLOAT,
+            ('u', 1) => F::R32_UINT,
+            ('u', 2) => F::R32G32_UINT,
+            ('u', 3) => F::R32G32B32_UINT,
+            ('u', 4) => F::R32G32B32A32_UINT,
+            ('i', 1) => F::R32_SINT,
+            ('i', 2) => F::R32G32_SINT,
+            ('i', 3) => F::R32G32B32_SINT,
+            ('i', 4) => F::R32G32B32A32_SINT,
+            _ => return Err(err(format!("unsupported input type at location {location}"))),
+        };
+        inputs.push(VertexInput { location, format, bytes: 4 * count });
+    }
+    inputs.sort_by_key(|i| i.location);
+    Ok(inputs)
+}
+
+impl Pipeline {
+    pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<Pipeline> {
+        let dev = ctx.dev.clone();
+        let name = format!("{} + {}", desc.vertex.path, desc.fragment.path);
+        if desc.blend == Blend::Xor {
+            if !dev.info.logic_op {
+                return Err(GpuError::Unsupported(format!(
+                    "device '{}' has no logicOp feature",
+                    dev.info.name
+                )));
+            }
+            if let Some(f) = desc.targets.iter().find(|f| !f.is_integer()) {
+                return Err(GpuError::Usage(format!(
+                    "{name}: logic op XOR needs integer targets, not {f:?}"
+                )));
+            }
+        }
+        if desc.targets.is_empty() || desc.targets.len() > dev.info.max_color_attachments as usize {
+            return Err(GpuError::Usage(format!(
+                "{name}: {} targets (the device allows 1..={})",
+                desc.targets.len(),
+                dev.info.max_color_attachments
+            )));
+        }
+
+        let (vr, v) = reflect(desc.vertex)?;
+        let (_, f) = reflect(desc.fragment)?;
+
+        // Descriptors: set 0 only, pushed per draw; textures and uniform blocks only —
+        // storage resources would break the texture-era model (SPEC §0).
+        let mut bindings: BTreeMap<u32, (BindingKind, vk::ShaderStageFlags)> = BTreeMap::new();
+        for (stage, refl, shader) in [
+            (vk::ShaderStageFlags::VERTEX, &v, desc.vertex),
+            (vk::ShaderStageFlags::FRAGMENT, &f, desc.fragment),
+        ] {
+            for (&set, set_bindings) in &refl.sets {
+                let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
+                if set != 0 {
+                    return Err(err(format!("uses descriptor set {set}; texgeo shaders use set 0 only")));
+                }
+                for (&b, info) in set_bindings {
+                    let kind = match info.ty {
+                        DescriptorType::COMBINED_IMAGE_SAMPLER => BindingKind::Texture,
+                        DescriptorType::UNIFORM_BUFFER => BindingKind::Uniform,
+                        other => {
+                            return Err(err(format!(
+                                "binding {b} is {other:?}; only sampled textures and uniform blocks are allowed"
+                            )));
+                        }
+                    };
+                    if info.binding_count != BindingCount::One {
+                        return Err(err(format!("binding {b} is an array; bind textures one by one")));
+                    }
+                    let entry = bindings.entry(b).or_insert((kind, vk::ShaderStageFlags::empty()));
+                    if entry.0 != kind {
+                        return Err(err(format!("binding {b} has different types in the two stages")));
+                    }
+                    entry.1 |= stage;
+                }
+            }
+        }
+        let push = match (v.push, f.push) {
+            (None, None) => None,
+            (a, b) => {
+                let mut stages = vk::ShaderStageFlags::empty();
+                let (mut lo, mut hi) = (u32::MAX, 0);
+                for (s, r) in [(vk::ShaderStageFlags::VERTEX, a), (vk::ShaderStageFlags::FRAGMENT, b)] {
+                    if let Some((off, size)) = r {
+                        stages |= s;
+                        lo = lo.min(off);
+                        hi = hi.max(off + size);
+                    }
+                }
+                Some((stages, lo, hi - lo))
+            }
+        };
+
+        let inputs = vertex_inputs(desc.vertex, &vr)?;
+        let mut strides = [0u32; 2];
+        let mut attributes = Vec::new();
+        for i in &inputs {
+            let binding = u32::from(desc.per_instance.contains(&i.location));
+            attributes.push(
+                vk::VertexInputAttributeDescription::default()
+                    .location(i.location)
+                    .binding(binding)
+                    .format(i.format)
+                    .offset(strides[binding as usize]),
+            );
+            strides[binding as usize] += i.bytes;
+        }
+        let mut vbindings = Vec::new();
+        for (b, rate) in [vk::VertexInputRate::VERTEX, vk::VertexInputRate::INSTANCE].into_iter().enumerate()
+        {
+            if strides[b] > 0 {
+                vbindings.push(
+                    vk::VertexInputBindingDescription::default()
+                        .binding(b as u32)
+                        .stride(strides[b])
+                        .input_rate(rate),
+                );
+            }
+        }
+
+        let layout_bindings: Vec<_> = bindings
+            .iter()
+            .map(|(&b, &(kind, stages))| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(match kind {
+                        BindingKind::Texture => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                        BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+                    })
+                    .descriptor_count(1)
+                    .stage_flags(stages)
+            })
+            .collect();
+        let mut pipeline = Pipeline {
+            dev: dev.clone(),
+            raw: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            bindings: bindings.iter().map(|(&b, &(k, _))| (b, k)).collect(),
+            push,
+            targets: desc.targets.to_vec(),
+            strides,
+            name,
+        };
+        // From here on, Drop of `pipeline` destroys whatever was created if a step fails.
+        let set_info = vk::DescriptorSetLayoutCreateInfo::default()
+            .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
+            .bindings(&layout_bindings);
+        // SAFETY: valid device and create infos; handles are owned by `pipeline`.
+        pipeline.set_layout = unsafe { dev.raw.create_descriptor_set_layout(&set_info, None) }
+            .vk("vkCreateDescriptorSetLayout")?;
+        let ranges: Vec<_> = push
+            .iter()
+            .map(|&(stages, offset, size)| vk::PushConstantRange { stage_flags: stages, offset, size })
+            .collect();
+        let set_layouts = [pipeline.set_layout];
+        let layout_info =
+            vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges);
+        // SAFETY: as above.
+        pipeline.layout =
+            unsafe { dev.raw.create_pipeline_layout(&layout_info, None) }.vk("vkCreatePipelineLayout")?;
+
+        let vmod = ShaderModule::new(&dev, desc.vertex)?;
+        let fmod = ShaderModule::new(&dev, desc.fragment)?;
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vmod.raw)
+                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fmod.raw)
+                .name(c"main"),
+        ];
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vbindings)
+            .vertex_attribute_descriptions(&attributes);
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(match desc.topology {
+            Topology::Points => vk::PrimitiveTopology::POINT_LIST,
+            Topology::Triangles => vk::PrimitiveTopology::TRIANGLE_LIST,
+        });
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::NONE)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let attachments: Vec<_> = desc
+            .targets
+            .iter()
+            .map(|_| {
+                let a = vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA);
+                match desc.blend {
+                    Blend::Add => a
+                        .blend_enable(true)
+                        .src_color_blend_factor(vk::BlendFactor::ONE)
+                        .dst_color_blend_factor(vk::BlendFactor::ONE)
+                        .color_blend_op(vk::BlendOp::ADD)
+                        .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                        .alpha_blend_op(vk::BlendOp::ADD),
+                    Blend::Replace | Blend::Xor => a,
+                }
+            })
+            .collect();
+        let blend = vk::PipelineColorBlendStateCreateInfo::default()
+            .logic_op_enable(desc.blend == Blend::Xor)
+            .logic_op(vk::LogicOp::XOR)
+            .attachments(&attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let formats: Vec<_> = desc.targets.iter().map(|f| f.vk()).collect();
+        let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(pipeline.layout)
+            .push_next(&mut rendering);
+        // SAFETY: every pointer in `info` outlives the call; modules are alive until after it.
+        let created = unsafe { dev.raw.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+        pipeline.raw =
+            created.map_err(|(_, e)| GpuError::Vk { call: "vkCreateGraphicsPipelines", result: e })?[0];
+        Ok(pipeline)
+    }
+
+    /// A full-target quad pass: the built-in quad vertex shader and `fragment`, which runs
+    /// once per output texel (`gl_FragCoord.xy` is the texel centre).
+    pub fn quad(ctx: &Context, fragment: &Shader, targets: &[TexFormat], blend: Blend) -> Result<Pipeline> {
+        Pipeline::new(
+            ctx,
+            &PipelineDesc {
+                vertex: &shaders::gpu::QUAD_VERT,
+                fragment,
+                topology: Topology::Triangles,
+                targets,
+                blend,
+                per_instance: &[],
+            },
+        )
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+impl Drop for Pipeline {
+    fn drop(&mut self) {
+        // SAFETY: submissions wait for completion; null handles are ignored by Vulkan.
+        unsafe {
+            self.dev.raw.destroy_pipeline(self.raw, None);
+            self.dev.raw.destroy_pipeline_layout(self.layout, None);
+            self.dev.raw.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A shader module that lives only while a pipeline is created.
+struct ShaderModule<'a> {
+    dev: &'a Device,
+    raw: vk::ShaderModule,
+}
+
+impl<'a> ShaderModule<'a> {
+    fn new(dev: &'a Device, shader: &Shader) -> Result<ShaderModule<'a>> {
+        let words = ash::util::read_spv(&mut std::io::Cursor::new(shader.spirv))
+            .map_err(|e| GpuError::Shader { shader: shader.path.to_string(), message: e.to_string() })?;
+        let info = vk::ShaderModuleCreateInfo::default().code(&words);
+        // SAFETY: valid SPIR-V produced by build.rs.
+        let raw = unsafe { dev.raw.create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
+        Ok(ShaderModule { dev, raw })
+    }
+}
+
+impl Drop for ShaderModule<'_> {
+    fn drop(&mut self) {
+        // SAFETY: only used during pipeline creation, which has returned.
+        unsafe { self.dev.raw.destroy_shader_module(self.raw, None) };
+    }
+}

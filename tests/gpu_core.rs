@@ -1,0 +1,125 @@
+//! The GPU core: context, reduction and XOR rasterization on the default device
+//! (lavapipe in `tools/test`), with validation on when `TEXGEO_VALIDATION=1`.
+
+use texgeo::gpu::{Context, TexFormat, Texture, XorRaster, reduce_sum};
+use texgeo::random::Rng;
+
+fn ctx() -> Context {
+    Context::from_env().expect("a Vulkan device (run tools/setup)")
+}
+
+/// Random integers in [-range, range], as RGBA texels.
+fn random_texels(rng: &mut Rng, n: usize, range: i64) -> Vec<[f32; 4]> {
+    (0..n).map(|_| std::array::from_fn(|_| (rng.below(2 * range as u64 + 1) as i64 - range) as f32)).collect()
+}
+
+fn cpu_sum(data: &[[f32; 4]]) -> [f32; 4] {
+    let mut s = [0i64; 4];
+    for t in data {
+        for c in 0..4 {
+            s[c] += t[c] as i64;
+        }
+    }
+    s.map(|v| v as f32)
+}
+
+#[test]
+fn reduce_sum_is_exact_on_integer_data() {
+    let ctx = ctx();
+    let mut rng = Rng::new(42);
+    for (w, h) in [(1, 1), (2, 2), (4, 4), (64, 64), (512, 512), (1024, 1024)] {
+        let data = random_texels(&mut rng, w * h, 2);
+        let gpu = reduce_sum(&ctx, &data, w as u32, h as u32).unwrap();
+        assert_eq!(gpu, cpu_sum(&data), "{w}x{h}");
+    }
+}
+
+#[test]
+fn reduce_sum_pads_other_sizes() {
+    let ctx = ctx();
+    let mut rng = Rng::new(7);
+    for (w, h) in [(3, 1), (1, 5), (37, 19), (100, 3), (129, 257)] {
+        let data = random_texels(&mut rng, w * h, 100);
+        let gpu = reduce_sum(&ctx, &data, w as u32, h as u32).unwrap();
+        assert_eq!(gpu, cpu_sum(&data), "{w}x{h}");
+    }
+}
+
+#[test]
+fn reduce_sum_rejects_wrong_sizes() {
+    let ctx = ctx();
+    assert!(reduce_sum(&ctx, &[[1.0; 4]; 3], 2, 2).is_err());
+}
+
+#[test]
+fn xor_overlaps_cancel() {
+    let ctx = ctx();
+    for format in [TexFormat::R32Ui, TexFormat::R8Ui] {
+        let xor = XorRaster::new(&ctx, format).unwrap();
+        // The same triangle twice cancels; a third, disjoint one stays.
+        let t = [[1.0, 1.0], [9.0, 1.0], [1.0, 9.0]];
+        let u = [[10.0, 10.0], [15.0, 10.0], [15.0, 15.0]];
+        let out = xor.rasterize(&ctx, 16, 16, &[t, t, u], 1).unwrap();
+        let single = xor.rasterize(&ctx, 16, 16, &[u], 1).unwrap();
+        assert_eq!(out, single, "{format:?}");
+        assert!(single.contains(&1));
+        // A texel covered by two different overlapping triangles is cleared.
+        let a = [[0.0, 0.0], [16.0, 0.0], [0.0, 16.0]];
+        let b = [[0.0, 0.0], [16.0, 0.0], [16.0, 16.0]];
+        let both = xor.rasterize(&ctx, 16, 16, &[a, b], 1).unwrap();
+        let only_a = xor.rasterize(&ctx, 16, 16, &[a], 1).unwrap();
+        let only_b = xor.rasterize(&ctx, 16, 16, &[b], 1).unwrap();
+        for i in 0..256 {
+            assert_eq!(both[i], only_a[i] ^ only_b[i], "texel {i}");
+        }
+    }
+}
+
+#[test]
+fn shared_edge_centre_flips_exactly_once() {
+    let ctx = ctx();
+    let xor = XorRaster::new(&ctx, TexFormat::R32Ui).unwrap();
+    // Two triangles forming a square split by a diagonal through texel centres
+    // (0.5,0.5), (1.5,1.5), …: every centre on the diagonal is covered exactly once.
+    let n = 8.0;
+    let lower = [[0.5, 0.5], [n - 0.5, n - 0.5], [n - 0.5, 0.5]];
+    let upper = [[0.5, 0.5], [0.5, n - 0.5], [n - 0.5, n - 0.5]];
+    let out = xor.rasterize(&ctx, 8, 8, &[lower, upper], 1).unwrap();
+    // Interior and diagonal centres: exactly one flip. (The outer boundary follows the
+    // top-left rule: centres on the left/top edges are in, right/bottom out.)
+    for j in 0..8 {
+        for i in 0..8 {
+            let v = out[j * 8 + i];
+            assert!(v <= 1, "texel ({i},{j}) flipped {v} times");
+            if i == j && i < 7 && i > 0 {
+                assert_eq!(v, 1, "diagonal texel ({i},{j})");
+            }
+        }
+    }
+    // A vertical shared edge exactly through centres x = 3.5.
+    let left = [[0.0, 0.0], [3.5, 0.0], [3.5, 8.0]];
+    let left2 = [[0.0, 0.0], [3.5, 8.0], [0.0, 8.0]];
+    let right = [[3.5, 0.0], [8.0, 0.0], [8.0, 8.0]];
+    let right2 = [[3.5, 0.0], [8.0, 8.0], [3.5, 8.0]];
+    let out = xor.rasterize(&ctx, 8, 8, &[left, left2, right, right2], 1).unwrap();
+    assert!(out.iter().all(|&v| v == 1), "{out:?}");
+}
+
+#[test]
+fn texture_round_trip_all_formats() {
+    let ctx = ctx();
+    let t = Texture::new_layered(&ctx, TexFormat::R32Ui, 5, 3, 2, "rt").unwrap();
+    let l0: Vec<u32> = (0..15).collect();
+    let l1: Vec<u32> = (100..115).collect();
+    let out = ctx
+        .submit(|rec| {
+            rec.upload(&t, 0, &l0)?;
+            rec.upload(&t, 1, &l1)?;
+            rec.readback(&t)
+        })
+        .unwrap()
+        .to_vec::<u32>()
+        .unwrap();
+    assert_eq!(&out[..15], &l0[..]);
+    assert_eq!(&out[15..], &l1[..]);
+}
