@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
 // Triangles given in texel units, rasterized with Vulkan's top-left rule.
 #include "texel.glsl"
 #include "xor_params.glsl"

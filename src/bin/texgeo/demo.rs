@@ -1,0 +1,63 @@
+//! `texgeo demo`: a short run of each algorithm on built-in data, for a first look.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use texgeo::gpu::{TexFormat, XorRaster, reduce_sum};
+use texgeo::random::Rng;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Folder for pictures and outputs.
+    #[arg(long, short, default_value = "out/demo")]
+    out: PathBuf,
+}
+
+pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    let ctx = crate::open_context(device)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    println!("device: {}", ctx.info().label());
+
+    // 1. Reduction: sum a 512×512 texture of random integers on the GPU and on the CPU.
+    let n = 512u32;
+    let mut rng = Rng::new(1);
+    let data: Vec<[f32; 4]> =
+        (0..n * n).map(|_| std::array::from_fn(|_| rng.below(5) as f32 - 2.0)).collect();
+    let t = std::time::Instant::now();
+    let gpu = reduce_sum(&ctx, &data, n, n)?;
+    let gpu_ms = t.elapsed().as_secs_f64() * 1e3;
+    let cpu = texgeo::report::bench::reduce::cpu_sum(&data);
+    println!(
+        "reduce_sum {n}x{n} RGBA32F: GPU {gpu:?} ({gpu_ms:.1} ms incl. upload), CPU {cpu:?}: {}",
+        if gpu == cpu { "equal" } else { "DIFFERENT" }
+    );
+    anyhow::ensure!(gpu == cpu, "GPU and CPU sums differ");
+
+    // 2. XOR raster: a fan of overlapping triangles; parity leaves a star pattern.
+    let size = 256u32;
+    let c = size as f32 / 2.0;
+    let k = 7;
+    let tris: Vec<[[f32; 2]; 3]> = (0..k)
+        .map(|i| {
+            let a = |j: usize| {
+                let t = std::f32::consts::TAU * ((i * 3 + j) % k) as f32 / k as f32;
+                [c + 0.45 * size as f32 * t.cos(), c + 0.45 * size as f32 * t.sin()]
+            };
+            [a(0), a(1), a(2)]
+        })
+        .collect();
+    let xor = XorRaster::new(&ctx, TexFormat::R8Ui)?;
+    let bits = xor.rasterize(&ctx, size, size, &tris, 1)?;
+    let pixels: Vec<u8> = bits.iter().map(|&b| if b & 1 == 1 { 255 } else { 0 }).collect();
+    let png = args.out.join("xor-star.png");
+    image::GrayImage::from_raw(size, size, pixels)
+        .context("image size")?
+        .save(&png)
+        .with_context(|| format!("writing {}", png.display()))?;
+    let set = bits.iter().filter(|&&b| b & 1 == 1).count();
+    println!(
+        "XOR raster: {k} overlapping triangles -> {set} texels of odd parity, picture {}",
+        png.display()
+    );
+    Ok(())
+}

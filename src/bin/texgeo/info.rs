@@ -1,0 +1,56 @@
+//! `texgeo info`: the device, its driver and the limits texture-era algorithms hit.
+
+use texgeo::gpu::{DeviceInfo, list_devices};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// List every Vulkan device, not only the one texgeo would use.
+    #[arg(long)]
+    all: bool,
+}
+
+fn yes(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
+fn print(d: &DeviceInfo) {
+    println!("device: {} (index {}, {})", d.name, d.index, d.kind);
+    println!("driver: {} {}", d.driver, d.driver_info);
+    println!("Vulkan API: {}", d.api_version);
+    println!("logicOp: {}", yes(d.logic_op));
+    println!(
+        "max texture size: {0}x{0} (2D), {1} layers, {2}^3 (3D)",
+        d.max_image_2d, d.max_array_layers, d.max_image_3d
+    );
+    println!("color attachments: {}", d.max_color_attachments);
+    println!(
+        "push constants: {} bytes; vertex attributes: {}",
+        d.max_push_constants, d.max_vertex_attributes
+    );
+    println!("shaderFloat64: {}", yes(d.float64));
+    println!("timestamps: {} ({} ns per tick)", yes(d.timestamps), d.timestamp_period_ns);
+    println!(
+        "dynamic rendering + synchronization2: {}; push descriptors: {}",
+        yes(d.vulkan13),
+        yes(d.push_descriptor)
+    );
+}
+
+pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    if args.all {
+        for (i, d) in list_devices()?.iter().enumerate() {
+            if i > 0 {
+                println!();
+            }
+            print(d);
+        }
+        return Ok(());
+    }
+    let ctx = crate::open_context(device)?;
+    print(ctx.info());
+    println!(
+        "validation layer: {}",
+        if ctx.validating() { "on" } else { "off (TEXGEO_VALIDATION=1 turns it on)" }
+    );
+    Ok(())
+}

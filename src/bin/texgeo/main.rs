@@ -1,0 +1,59 @@
+//! The `texgeo` command line. Errors print one message and exit with status 2.
+
+mod bench;
+mod demo;
+mod info;
+mod mesh;
+
+use clap::{Parser, Subcommand};
+use texgeo::gpu::{Context, ContextOptions, DeviceChoice};
+
+#[derive(Parser)]
+#[command(
+    name = "texgeo",
+    version,
+    about = "GPGPU-texture-era geometry on raw Vulkan: point-in-solid, voxelization, Catmull-Clark"
+)]
+struct Cli {
+    /// Vulkan device: a name part (e.g. `lavapipe`) or an index from `texgeo info --all`.
+    /// Default: TEXGEO_DEVICE, else the first GPU, else lavapipe.
+    #[arg(long, global = true, value_name = "NAME|INDEX")]
+    device: Option<String>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Show the Vulkan device texgeo would use: driver, limits, logicOp, texture sizes.
+    Info(info::Args),
+    /// Inspect and convert meshes (OBJ, OFF, PLY, STL).
+    #[command(subcommand)]
+    Mesh(mesh::Command),
+    /// Run a benchmark and write Markdown + CSV tables.
+    #[command(subcommand)]
+    Bench(bench::Command),
+    /// A short tour on built-in data: reduction, XOR raster, model statistics.
+    Demo(demo::Args),
+}
+
+/// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
+pub fn open_context(device: Option<&str>) -> anyhow::Result<Context> {
+    let options = ContextOptions { device: DeviceChoice::from_env_or(device), validation: None };
+    Ok(Context::new(&options)?)
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let device = cli.device.as_deref();
+    let result = match cli.command {
+        Command::Info(a) => info::run(device, a),
+        Command::Mesh(c) => mesh::run(c),
+        Command::Bench(c) => bench::run(device, c),
+        Command::Demo(a) => demo::run(device, a),
+    };
+    if let Err(e) = result {
+        eprintln!("texgeo: error: {e:#}");
+        std::process::exit(2);
+    }
+}

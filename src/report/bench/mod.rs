@@ -1,0 +1,3 @@
+//! Benchmark suites behind `texgeo bench …` and `cargo bench`.
+
+pub mod reduce;

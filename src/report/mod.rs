@@ -1,0 +1,54 @@
+//! Benchmarks and reproduction reports: timing with medians, tables written as Markdown
+//! and CSV, and the description of the machine and device that produced them.
+
+pub mod bench;
+mod table;
+mod timing;
+
+pub use table::{Report, Table};
+pub use timing::{Samples, time_runs, timed};
+
+/// Where and on what a measurement was made; printed at the top of every report.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    pub device: String,
+    pub cpu: String,
+    pub cores: usize,
+    pub date: String,
+    pub version: &'static str,
+}
+
+impl Environment {
+    pub fn new(device: String) -> Environment {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+            })
+            .unwrap_or_else(|| "unknown CPU".to_string());
+        let date = std::process::Command::new("date")
+            .arg("-u")
+            .arg("+%Y-%m-%d %H:%M UTC")
+            .output()
+            .ok()
+            .and_then(|o| String::from_utf8(o.stdout).ok())
+            .map(|s| s.trim().to_string())
+            .unwrap_or_default();
+        Environment {
+            device,
+            cpu,
+            cores: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+            date,
+            version: env!("CARGO_PKG_VERSION"),
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        format!(
+            "texgeo {} on {}; CPU: {} ({} cores); {}",
+            self.version, self.device, self.cpu, self.cores, self.date
+        )
+    }
+}

@@ -1,0 +1,109 @@
+//! Result tables: Markdown for people, CSV for plotting.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::Environment;
+
+#[derive(Clone, Debug, Default)]
+pub struct Table {
+    pub title: String,
+    pub columns: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+    /// Lines printed under the table (what was measured, how, caveats).
+    pub notes: Vec<String>,
+}
+
+impl Table {
+    pub fn new(title: impl Into<String>, columns: &[&str]) -> Table {
+        Table {
+            title: title.into(),
+            columns: columns.iter().map(|c| c.to_string()).collect(),
+            ..Default::default()
+        }
+    }
+
+    pub fn row(&mut self, cells: Vec<String>) {
+        self.rows.push(cells);
+    }
+
+    pub fn note(&mut self, note: impl Into<String>) {
+        self.notes.push(note.into());
+    }
+
+    pub fn to_markdown(&self) -> String {
+        let mut s = format!("### {}\n\n| {} |\n|", self.title, self.columns.join(" | "));
+        for _ in &self.columns {
+            s.push_str("---|");
+        }
+        s.push('\n');
+        for r in &self.rows {
+            let _ = writeln!(s, "| {} |", r.join(" | "));
+        }
+        for n in &self.notes {
+            let _ = write!(s, "\n{n}\n");
+        }
+        s
+    }
+
+    pub fn to_csv(&self) -> String {
+        let esc = |c: &str| {
+            if c.contains([',', '"', '\n']) {
+                format!("\"{}\"", c.replace('"', "\"\""))
+            } else {
+                c.to_string()
+            }
+        };
+        let mut s = String::new();
+        let _ = writeln!(s, "{}", self.columns.iter().map(|c| esc(c)).collect::<Vec<_>>().join(","));
+        for r in &self.rows {
+            let _ = writeln!(s, "{}", r.iter().map(|c| esc(c)).collect::<Vec<_>>().join(","));
+        }
+        s
+    }
+}
+
+/// A set of tables from one run, with the environment that produced them.
+pub struct Report {
+    pub name: String,
+    pub environment: Environment,
+    pub tables: Vec<Table>,
+}
+
+impl Report {
+    pub fn to_markdown(&self) -> String {
+        let mut s = format!("# texgeo bench {}\n\n{}\n\n", self.name, self.environment.describe());
+        for t in &self.tables {
+            s.push_str(&t.to_markdown());
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Writes `NAME.md` and one `NAME-<k>.csv` per table (or `NAME.csv` for one table)
+    /// into `dir`; returns the files written.
+    pub fn write(&self, dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir)?;
+        let mut written = Vec::new();
+        let md = dir.join(format!("{}.md", self.name));
+        std::fs::write(&md, self.to_markdown())?;
+        written.push(md);
+        for (k, t) in self.tables.iter().enumerate() {
+            let name = if self.tables.len() == 1 {
+                format!("{}.csv", self.name)
+            } else {
+                let slug: String = t
+                    .title
+                    .chars()
+                    .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+                    .collect();
+                let slug = slug.split('-').filter(|p| !p.is_empty()).take(4).collect::<Vec<_>>().join("-");
+                format!("{}-{}-{slug}.csv", self.name, k + 1)
+            };
+            let path = dir.join(name);
+            std::fs::write(&path, t.to_csv())?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+}

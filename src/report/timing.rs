@@ -1,0 +1,49 @@
+//! Repeated timing with medians: single runs on a shared 2-core machine are noisy.
+
+use std::time::{Duration, Instant};
+
+/// Durations of repeated runs of one measurement.
+#[derive(Clone, Debug, Default)]
+pub struct Samples(pub Vec<Duration>);
+
+impl Samples {
+    pub fn push(&mut self, d: Duration) {
+        self.0.push(d);
+    }
+
+    pub fn median(&self) -> Duration {
+        let mut v = self.0.clone();
+        v.sort();
+        match v.len() {
+            0 => Duration::ZERO,
+            n if n % 2 == 1 => v[n / 2],
+            n => (v[n / 2 - 1] + v[n / 2]) / 2,
+        }
+    }
+
+    pub fn min(&self) -> Duration {
+        self.0.iter().copied().min().unwrap_or_default()
+    }
+
+    pub fn median_ms(&self) -> f64 {
+        self.median().as_secs_f64() * 1e3
+    }
+}
+
+/// Runs `f` `runs` times (after one warm-up run) and returns the durations it reports.
+/// `f` measures itself, so set-up outside its timed section is not counted.
+pub fn time_runs<E>(runs: usize, mut f: impl FnMut() -> Result<Duration, E>) -> Result<Samples, E> {
+    f()?;
+    let mut s = Samples::default();
+    for _ in 0..runs.max(1) {
+        s.push(f()?);
+    }
+    Ok(s)
+}
+
+/// Times a closure.
+pub fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
+    let t = Instant::now();
+    let v = f();
+    (v, t.elapsed())
+}
