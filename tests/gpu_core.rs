@@ -123,3 +123,45 @@ fn texture_round_trip_all_formats() {
     assert_eq!(&out[..15], &l0[..]);
     assert_eq!(&out[15..], &l1[..]);
 }
+
+#[test]
+fn tiles_and_layers_reduce_independently() {
+    use texgeo::gpu::Reducer;
+    let ctx = ctx();
+    let mut rng = Rng::new(99);
+    // 3 layers of a 64×32 texture cut into 16×8 tiles: 4×4 sums per layer.
+    let (w, h, layers, tw, th) = (64u32, 32u32, 3u32, 16u32, 8u32);
+    let tex = Texture::new_layered(&ctx, TexFormat::Rgba32F, w, h, layers, "tiles").unwrap();
+    let data: Vec<Vec<[f32; 4]>> =
+        (0..layers).map(|_| random_texels(&mut rng, (w * h) as usize, 3)).collect();
+    let mut reducer = Reducer::new(&ctx, w, h, layers).unwrap();
+    let (tx, ty) = (w / tw, h / th);
+    let out = ctx
+        .submit(|rec| {
+            for (l, d) in data.iter().enumerate() {
+                rec.upload(&tex, l as u32, d)?;
+            }
+            let r = reducer.record_tiles(rec, &tex, [w, h], [tw, th])?;
+            rec.readback_region(r, 0..layers, [0, 0, tx, ty])
+        })
+        .unwrap()
+        .to_vec::<[f32; 4]>()
+        .unwrap();
+    for l in 0..layers as usize {
+        for j in 0..ty as usize {
+            for i in 0..tx as usize {
+                let tile: Vec<[f32; 4]> = (0..th as usize)
+                    .flat_map(|y| {
+                        let row = (j * th as usize + y) * w as usize + i * tw as usize;
+                        data[l][row..row + tw as usize].to_vec()
+                    })
+                    .collect();
+                let got = out[l * (tx * ty) as usize + j * tx as usize + i];
+                assert_eq!(got, cpu_sum(&tile), "layer {l} tile ({i},{j})");
+            }
+        }
+    }
+    // Tiles that are not powers of two are refused.
+    let refused = ctx.submit(|rec| reducer.record_tiles(rec, &tex, [w, h], [12, 8]).map(|_| ()));
+    assert!(refused.is_err());
+}

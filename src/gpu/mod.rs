@@ -21,7 +21,7 @@ pub use memory::Buffer;
 pub use memory::{Pod, as_bytes, from_bytes};
 pub use pass::{Attachment, Load, PingPong, Recorder, Rect, RenderScope};
 pub use pipeline::{Blend, Pipeline, PipelineDesc, Topology};
-pub use reduce::{Reducer, reduce_sum};
+pub use reduce::{MAX_LAYERS, Reducer, reduce_sum};
 pub use texture::{TexFormat, Texture};
 pub use timer::Timestamps;
 pub use xor::XorRaster;

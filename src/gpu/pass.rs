@@ -397,9 +397,9 @@ impl<'p> RenderScope<'_, 'p> {
         let p = self.bound()?;
         let mut infos = Vec::with_capacity(bindings.len());
         for &(b, tex) in bindings {
-            if p.bindings.get(&b) != Some(&BindingKind::Texture) {
+            let Some(&BindingKind::Texture { arrayed }) = p.bindings.get(&b) else {
                 return Err(GpuError::Usage(format!("binding {b} is not a texture in the bound pipeline")));
-            }
+            };
             if !self.reads.iter().any(|r| std::ptr::eq(*r, tex)) {
                 return Err(GpuError::Usage(format!(
                     "texture for binding {b} was not listed in the pass's reads"
@@ -407,7 +407,7 @@ impl<'p> RenderScope<'_, 'p> {
             }
             infos.push([vk::DescriptorImageInfo {
                 sampler: self.dev.sampler,
-                image_view: tex.view,
+                image_view: if arrayed { tex.array_view } else { tex.view },
                 image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             }]);
         }
@@ -541,10 +541,22 @@ impl PingPong {
         height: u32,
         name: &str,
     ) -> Result<PingPong> {
+        PingPong::new_layered(ctx, format, width, height, 1, name)
+    }
+
+    /// A pair of `layers`-layer targets.
+    pub fn new_layered(
+        ctx: &super::Context,
+        format: TexFormat,
+        width: u32,
+        height: u32,
+        layers: u32,
+        name: &str,
+    ) -> Result<PingPong> {
         Ok(PingPong {
             pair: [
-                Texture::new(ctx, format, width, height, &format!("{name} ping"))?,
-                Texture::new(ctx, format, width, height, &format!("{name} pong"))?,
+                Texture::new_layered(ctx, format, width, height, layers, &format!("{name} ping"))?,
+                Texture::new_layered(ctx, format, width, height, layers, &format!("{name} pong"))?,
             ],
             current: 0,
         })

@@ -47,7 +47,10 @@ pub struct PipelineDesc<'a> {
 /// A descriptor binding the pipeline expects (set 0, pushed per draw).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum BindingKind {
-    Texture,
+    /// A sampled texture; `arrayed` for `sampler2DArray` (bound through the array view).
+    Texture {
+        arrayed: bool,
+    },
     Uniform,
 }
 
@@ -76,6 +79,44 @@ fn reflect(shader: &Shader) -> Result<(Reflection, Reflected)> {
     let push =
         r.get_push_constant_range().map_err(|e| err(format!("reflection: {e}")))?.map(|p| (p.offset, p.size));
     Ok((r, Reflected { sets, push }))
+}
+
+fn refl_module<'a>(mods: &[&'a Reflection; 2], stage: vk::ShaderStageFlags) -> &'a Reflection {
+    if stage == vk::ShaderStageFlags::VERTEX { mods[0] } else { mods[1] }
+}
+
+/// Whether the sampler at set 0, `binding` is an array image (`sampler2DArray`).
+fn texture_is_arrayed(shader: &Shader, r: &Reflection, binding: u32) -> Result<bool> {
+    let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
+    let m = &r.0;
+    let by_id: BTreeMap<u32, &Instruction> =
+        m.types_global_values.iter().filter_map(|i| Some((i.result_id?, i))).collect();
+    let target = m.annotations.iter().find_map(|a| match a.operands.as_slice() {
+        [Operand::IdRef(t), Operand::Decoration(Decoration::Binding), Operand::LiteralBit32(b)]
+            if a.class.opcode == Op::Decorate && *b == binding =>
+        {
+            Some(*t)
+        }
+        _ => None,
+    });
+    let ty =
+        target.and_then(|t| by_id.get(&t)).and_then(|v| v.result_type).and_then(|p| by_id.get(&p)).and_then(
+            |p| match p.operands.as_slice() {
+                [Operand::StorageClass(_), Operand::IdRef(t)] => by_id.get(t),
+                _ => None,
+            },
+        );
+    let image = match ty {
+        Some(t) if t.class.opcode == Op::TypeSampledImage => match t.operands.as_slice() {
+            [Operand::IdRef(i)] => by_id.get(i),
+            _ => None,
+        },
+        _ => None,
+    };
+    match image.map(|i| i.operands.as_slice()) {
+        Some([_, Operand::Dim(_), _, Operand::LiteralBit32(arrayed), ..]) => Ok(*arrayed == 1),
+        _ => Err(err(format!("binding {binding}: cannot find its sampled image type"))),
+    }
 }
 
 /// A vertex shader input: location and Vulkan format.
@@ -180,7 +221,8 @@ impl Pipeline {
         }
 
         let (vr, v) = reflect(desc.vertex)?;
-        let (_, f) = reflect(desc.fragment)?;
+        let (fr, f) = reflect(desc.fragment)?;
+        let refl_mods = [&vr, &fr];
 
         // Descriptors: set 0 only, pushed per draw; textures and uniform blocks only —
         // storage resources would break the texture-era model (SPEC §0).
@@ -196,7 +238,9 @@ impl Pipeline {
                 }
                 for (&b, info) in set_bindings {
                     let kind = match info.ty {
-                        DescriptorType::COMBINED_IMAGE_SAMPLER => BindingKind::Texture,
+                        DescriptorType::COMBINED_IMAGE_SAMPLER => BindingKind::Texture {
+                            arrayed: texture_is_arrayed(shader, refl_module(&refl_mods, stage), b)?,
+                        },
                         DescriptorType::UNIFORM_BUFFER => BindingKind::Uniform,
                         other => {
                             return Err(err(format!(
@@ -264,7 +308,7 @@ impl Pipeline {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
                     .descriptor_type(match kind {
-                        BindingKind::Texture => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                        BindingKind::Texture { .. } => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                         BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
                     })
                     .descriptor_count(1)

@@ -1,7 +1,12 @@
 //! `reduce_sum`: the texture era's parallel reduction (Alg. 4-3). Each pass renders a
 //! full-target quad over a quarter of the previous size, every texel summing a 2×2
 //! block, ping-ponging between two targets until one texel holds the sum.
-//! Integer-valued data is summed exactly while every partial sum stays below 2²⁴.
+//!
+//! Two generalizations keep the pass structure but batch more work per pass: a texture
+//! may be cut into equal power-of-two *tiles*, each reduced to its own texel (many
+//! independent sums at once), and up to 8 layers are reduced together, one colour
+//! attachment per layer. Integer-valued data is summed exactly while every partial sum
+//! stays below 2²⁴.
 
 use super::context::Context;
 use super::error::{GpuError, Result};
@@ -10,23 +15,34 @@ use super::pipeline::{Blend, Pipeline};
 use super::shaders;
 use super::texture::{TexFormat, Texture};
 
-/// The reduction pipeline and its ping-pong targets, sized once for inputs up to
-/// `max_width`×`max_height` and reused.
+/// Most layers reduced in one pass (one attachment each; the `reduce.frag` outputs).
+pub const MAX_LAYERS: u32 = 8;
+
+/// The reduction pipeline and its ping-pong targets, sized once and reused.
 pub struct Reducer {
     pipeline: Pipeline,
     pair: PingPong,
+    layers: u32,
 }
 
 impl Reducer {
-    pub fn new(ctx: &Context, max_width: u32, max_height: u32) -> Result<Reducer> {
-        let pipeline =
-            Pipeline::quad(ctx, &shaders::gpu::REDUCE_FRAG, &[TexFormat::Rgba32F], Blend::Replace)?;
+    /// A reducer for RGBA32F inputs up to `max_width`×`max_height` with `layers` layers.
+    pub fn new(ctx: &Context, max_width: u32, max_height: u32, layers: u32) -> Result<Reducer> {
+        if layers == 0 || layers > MAX_LAYERS {
+            return Err(GpuError::Usage(format!(
+                "the reducer handles 1..={MAX_LAYERS} layers, not {layers}"
+            )));
+        }
+        let targets = vec![TexFormat::Rgba32F; layers as usize];
+        let pipeline = Pipeline::quad(ctx, &shaders::gpu::REDUCE_FRAG, &targets, Blend::Replace)?;
         let (w, h) = (max_width.div_ceil(2).max(1), max_height.div_ceil(2).max(1));
-        Ok(Reducer { pipeline, pair: PingPong::new(ctx, TexFormat::Rgba32F, w, h, "reduce")? })
+        let pair = PingPong::new_layered(ctx, TexFormat::Rgba32F, w, h, layers, "reduce")?;
+        Ok(Reducer { pipeline, pair, layers })
     }
 
-    /// Records the passes that sum the `width`×`height` corner of `src` (RGBA32F) into
-    /// one texel; returns the texture whose texel (0, 0) holds the four channel sums.
+    /// Records the passes that sum the `width`×`height` corner of `src` into one texel
+    /// (per layer); returns the texture whose texel (0, 0) holds the four channel sums.
+    /// Any size works (missing texels count as zero).
     pub fn record<'a>(
         &'a mut self,
         rec: &mut Recorder,
@@ -34,58 +50,92 @@ impl Reducer {
         width: u32,
         height: u32,
     ) -> Result<&'a Texture> {
-        if src.format() != TexFormat::Rgba32F {
+        self.record_tiles(rec, src, [width, height], [width, height])
+    }
+
+    /// Records the passes that sum each `tile[0]`×`tile[1]` tile of the `size` corner of
+    /// `src` into one texel: tile (i, j) ends at texel (i, j) of the returned texture.
+    /// With more than one tile along an axis, the tile side must be a power of two
+    /// dividing the size, so 2×2 blocks never straddle two tiles.
+    pub fn record_tiles<'a>(
+        &'a mut self,
+        rec: &mut Recorder,
+        src: &'a Texture,
+        size: [u32; 2],
+        tile: [u32; 2],
+    ) -> Result<&'a Texture> {
+        if src.format() != TexFormat::Rgba32F || src.layers() != self.layers {
             return Err(GpuError::Usage(format!(
-                "reduce_sum needs an RGBA32F texture, not {:?}",
-                src.format()
+                "this reducer takes RGBA32F textures with {} layers, not {:?} with {}",
+                self.layers,
+                src.format(),
+                src.layers()
             )));
         }
-        if width == 0 || height == 0 || width > src.width() || height > src.height() {
+        let [w, h] = size;
+        if w == 0 || h == 0 || w > src.width() || h > src.height() {
             return Err(GpuError::Usage(format!(
-                "cannot reduce {width}×{height} texels of a {}×{} texture",
+                "cannot reduce {w}×{h} texels of a {}×{} texture",
                 src.width(),
                 src.height()
             )));
         }
-        if width.div_ceil(2) > self.pair.width() || height.div_ceil(2) > self.pair.height() {
+        for axis in 0..2 {
+            let (n, t) = (size[axis], tile[axis]);
+            if t == 0 || (t != n && (!t.is_power_of_two() || n % t != 0)) {
+                return Err(GpuError::Usage(format!(
+                    "tile side {t} must be the whole side {n} or a power of two dividing it"
+                )));
+            }
+        }
+        if w.div_ceil(2) > self.pair.width() || h.div_ceil(2) > self.pair.height() {
             return Err(GpuError::Usage(format!(
-                "reducer sized for {}×{} inputs, asked for {width}×{height}",
+                "reducer sized for {}×{} inputs, asked for {w}×{h}",
                 self.pair.width() * 2,
                 self.pair.height() * 2
             )));
         }
-        let (mut w, mut h) = (width, height);
+        let (mut cur, mut t) = (size, tile);
         let mut first = true;
-        while w > 1 || h > 1 {
-            let (ow, oh) = (w.div_ceil(2), h.div_ceil(2));
+        while t[0] > 1 || t[1] > 1 {
+            let step = [if t[0] > 1 { 2 } else { 1 }, if t[1] > 1 { 2 } else { 1 }];
+            let out = [cur[0].div_ceil(step[0]), cur[1].div_ceil(step[1])];
             let input = if first { src } else { self.pair.src() };
+            let dst = self.pair.dst();
+            let attachments: Vec<Attachment> = (0..self.layers)
+                .map(|l| {
+                    if self.layers == 1 {
+                        Attachment::new(dst, Load::Discard)
+                    } else {
+                        Attachment::layer(dst, l, Load::Discard)
+                    }
+                })
+                .collect();
             let reads = [input];
-            let size = [w as i32, h as i32];
-            rec.render(
-                &[Attachment::new(self.pair.dst(), Load::Discard)],
-                Some([0, 0, ow, oh]),
-                &reads,
-                |pass| {
-                    pass.bind(&self.pipeline)?;
-                    pass.textures(&[(0, input)])?;
-                    pass.push(&size)?;
-                    pass.quad()
-                },
-            )?;
+            let params = [cur[0] as i32, cur[1] as i32, step[0] as i32, step[1] as i32, self.layers as i32];
+            rec.render(&attachments, Some([0, 0, out[0], out[1]]), &reads, |pass| {
+                pass.bind(&self.pipeline)?;
+                pass.textures(&[(0, input)])?;
+                pass.push(&params)?;
+                pass.quad()
+            })?;
             self.pair.swap();
-            (w, h, first) = (ow, oh, false);
+            cur = out;
+            t = [t[0].div_ceil(step[0]), t[1].div_ceil(step[1])];
+            first = false;
         }
         Ok(if first { src } else { self.pair.src() })
     }
 
-    /// Sums the `width`×`height` corner of `src` and reads the result back.
-    pub fn sum(&mut self, ctx: &Context, src: &Texture, width: u32, height: u32) -> Result<[f32; 4]> {
+    /// Sums the `width`×`height` corner of `src` and reads the result back (one RGBA
+    /// sum per layer).
+    pub fn sum(&mut self, ctx: &Context, src: &Texture, width: u32, height: u32) -> Result<Vec<[f32; 4]>> {
+        let layers = self.layers;
         let buffer = ctx.submit(|rec| {
             let out = self.record(rec, src, width, height)?;
-            rec.readback_region(out, 0..1, [0, 0, 1, 1])
+            rec.readback_region(out, 0..layers, [0, 0, 1, 1])
         })?;
-        let v = buffer.to_vec::<[f32; 4]>()?;
-        v.first().copied().ok_or_else(|| GpuError::Usage("empty readback".into()))
+        buffer.to_vec::<[f32; 4]>()
     }
 }
 
@@ -96,7 +146,8 @@ pub fn reduce_sum(ctx: &Context, data: &[[f32; 4]], width: u32, height: u32) -> 
         return Err(GpuError::Usage(format!("{} texels given for a {width}×{height} texture", data.len())));
     }
     let tex = Texture::new(ctx, TexFormat::Rgba32F, width, height, "reduce input")?;
-    let mut reducer = Reducer::new(ctx, width, height)?;
+    let mut reducer = Reducer::new(ctx, width, height, 1)?;
     ctx.submit(|rec| rec.upload(&tex, 0, data))?;
-    reducer.sum(ctx, &tex, width, height)
+    let sums = reducer.sum(ctx, &tex, width, height)?;
+    sums.first().copied().ok_or_else(|| GpuError::Usage("empty readback".into()))
 }

@@ -102,6 +102,8 @@ pub struct Texture {
     pub(crate) image: vk::Image,
     /// View over all layers (2D, or 2D array when layered): what shaders sample.
     pub(crate) view: vk::ImageView,
+    /// View over all layers as a 2D array, for `sampler2DArray` (equals `view` when layered).
+    pub(crate) array_view: vk::ImageView,
     /// One 2D view per layer, for rendering into a single layer.
     pub(crate) layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
@@ -176,6 +178,7 @@ impl Texture {
             dev,
             image,
             view: vk::ImageView::null(),
+            array_view: vk::ImageView::null(),
             layer_views: Vec::new(),
             allocation: None,
             format,
@@ -207,10 +210,13 @@ impl Texture {
             if layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
         tex.view = tex.make_view(view_type, 0, layers)?;
         if layers > 1 {
+            tex.array_view = tex.view;
             for layer in 0..layers {
                 let v = tex.make_view(vk::ImageViewType::TYPE_2D, layer, 1)?;
                 tex.layer_views.push(v);
             }
+        } else {
+            tex.array_view = tex.make_view(vk::ImageViewType::TYPE_2D_ARRAY, 0, 1)?;
         }
         Ok(tex)
     }
@@ -272,9 +278,10 @@ impl Drop for Texture {
             for &v in &self.layer_views {
                 self.dev.raw.destroy_image_view(v, None);
             }
-            if self.view != vk::ImageView::null() {
-                self.dev.raw.destroy_image_view(self.view, None);
+            if self.array_view != self.view {
+                self.dev.raw.destroy_image_view(self.array_view, None);
             }
+            self.dev.raw.destroy_image_view(self.view, None);
             self.dev.raw.destroy_image(self.image, None);
         }
         if let Some(a) = self.allocation.take() {

@@ -29,7 +29,7 @@ pub fn run(ctx: &Context, sides: &[u32], runs: usize) -> Result<Report> {
         let data: Vec<[f32; 4]> =
             (0..texels).map(|_| std::array::from_fn(|_| rng.below(3) as f32 - 1.0)).collect();
         let tex = Texture::new(ctx, TexFormat::Rgba32F, n, n, "bench input")?;
-        let mut reducer = Reducer::new(ctx, n, n)?;
+        let mut reducer = Reducer::new(ctx, n, n, 1)?;
         let timer = Timestamps::new(ctx, 2)?;
 
         let upload = time_runs(runs, || {
