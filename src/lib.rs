@@ -6,3 +6,4 @@
 pub mod gpu;
 pub mod mesh;
 pub mod random;
+pub mod subdiv;
