@@ -203,3 +203,24 @@ fn missing_helper_error_says_to_run_setup() {
     let e = SubdivError::HelperMissing { path: "target/tools/osd-refine".into() };
     assert!(e.to_string().contains("run tools/setup"), "{e}");
 }
+
+/// SPEC requirement: on a 6400-triangle closed mesh to level 5 (4.9 M quads) the CPU
+/// reference is no slower than OpenSubdiv's refine + interpolate (one thread, minimum of
+/// two runs each). Only asserted in optimized builds.
+#[test]
+fn cpu_is_not_slower_than_opensubdiv_at_level_5() {
+    let knot = shapes::torus_knot(400, 8);
+    assert_eq!(knot.num_faces(), 6400);
+    let mut cpu_seconds = f64::INFINITY;
+    for _ in 0..2 {
+        let start = std::time::Instant::now();
+        let refined = cpu::refine(&knot, 5).unwrap();
+        cpu_seconds = cpu_seconds.min(start.elapsed().as_secs_f64());
+        assert_eq!(refined.num_faces(), 6400 * 3 * 256);
+    }
+    let osd_seconds = osd::time(&knot, 5, 2).unwrap_or_else(|e| panic!("{e}"));
+    println!("level 5 of 6400 triangles: CPU reference {cpu_seconds:.3} s, OpenSubdiv {osd_seconds:.3} s");
+    if !cfg!(debug_assertions) {
+        assert!(cpu_seconds <= osd_seconds, "CPU {cpu_seconds:.3} s > OpenSubdiv {osd_seconds:.3} s");
+    }
+}

@@ -23,7 +23,7 @@ pub enum SubdivError {
     #[error("non-manifold vertex {vertex}: its {faces} faces do not form a single fan")]
     NonManifoldVertex { vertex: u32, faces: usize },
     /// The mesh has more elements than 32-bit indices can address at the requested level.
-    #[error("level {level} would need {vertices} vertices, more than 32-bit indices address")]
+    #[error("level {level} would be too large for 32-bit indices ({vertices} vertices)")]
     TooLarge { level: u32, vertices: u64 },
     /// A refined mesh could not be assembled or a mesh file could not be read or written.
     #[error(transparent)]

@@ -49,8 +49,9 @@ impl Topology {
     pub fn new(mesh: &Mesh) -> Result<Topology> {
         let (offsets, origin) = mesh.face_parts();
         let n = origin.len();
-        if n >= NONE as usize || mesh.num_vertices() >= NONE as usize {
-            return Err(SubdivError::TooLarge { level: 0, vertices: n as u64 });
+        // Edge numbers carry a flag bit during refinement, hence 2^31.
+        if n >= 1 << 31 || mesh.num_vertices() >= NONE as usize {
+            return Err(SubdivError::TooLarge { level: 0, vertices: mesh.num_vertices() as u64 });
         }
         check_degenerate_faces(mesh)?;
 
