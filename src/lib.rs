@@ -7,3 +7,4 @@ pub mod gpu;
 pub mod mesh;
 pub mod random;
 pub mod report;
+pub mod subdiv;

@@ -1,0 +1,141 @@
+//! OpenSubdiv as the independent reference: runs the helper `tools/osd-refine.cpp`
+//! (built by `tools/setup` into `target/tools/osd-refine`) on a mesh written to a
+//! temporary OFF file and reads its output back.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::mesh::{Mesh, formats};
+
+use super::{Result, SubdivError};
+
+/// Environment variable naming the helper binary, overriding the default location.
+pub const HELPER_ENV: &str = "TEXGEO_OSD_REFINE";
+
+/// The helper binary: `$TEXGEO_OSD_REFINE`, else `target/tools/osd-refine` of this
+/// checkout, else `tools/osd-refine` next to the running executable's `target` folder.
+/// Fails with [`SubdivError::HelperMissing`] (saying to run `tools/setup`) when absent.
+pub fn helper_path() -> Result<PathBuf> {
+    if let Some(path) = std::env::var_os(HELPER_ENV) {
+        let path = PathBuf::from(path);
+        return if path.is_file() { Ok(path) } else { Err(SubdivError::HelperMissing { path }) };
+    }
+    let default = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tools/osd-refine");
+    if default.is_file() {
+        return Ok(default);
+    }
+    let beside_exe = std::env::current_exe().ok().and_then(|exe| {
+        exe.ancestors().map(|dir| dir.join("tools/osd-refine")).find(|candidate| candidate.is_file())
+    });
+    beside_exe.ok_or(SubdivError::HelperMissing { path: default })
+}
+
+/// How to run the helper.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Time topology creation + refinement + interpolation this many times (minimum kept).
+    pub repeat: Option<u32>,
+    /// Skip full topology in the last level (OpenSubdiv's faster drawing-only setting).
+    pub sparse: bool,
+    /// Do not write (nor read back) the refined mesh: for timing only.
+    pub no_output: bool,
+}
+
+/// What the helper produced.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The last level, in OpenSubdiv's vertex order (absent with `no_output`).
+    pub mesh: Option<Mesh>,
+    /// Minimum time of refine + interpolate over the repeats, in seconds.
+    pub min_seconds: Option<f64>,
+}
+
+/// OpenSubdiv's Catmull-Clark refinement of `mesh` to `level`.
+pub fn refine(mesh: &Mesh, level: u32) -> Result<Mesh> {
+    let run = run(mesh, level, &Options::default())?;
+    run.mesh.ok_or_else(|| helper_error(Path::new("osd-refine"), "no mesh was produced"))
+}
+
+/// Seconds OpenSubdiv takes to refine `mesh` to `level` (minimum of `repeat` runs).
+pub fn time(mesh: &Mesh, level: u32, repeat: u32) -> Result<f64> {
+    let options = Options { repeat: Some(repeat.max(1)), no_output: true, ..Options::default() };
+    let run = run(mesh, level, &options)?;
+    run.min_seconds.ok_or_else(|| helper_error(Path::new("osd-refine"), "no timing was printed"))
+}
+
+/// Runs the helper on `mesh` with `options`.
+pub fn run(mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+    let helper = helper_path()?;
+    let dir = TempDir::new()?;
+    let input = dir.path.join("in.off");
+    let output = dir.path.join("out.off");
+    formats::write(&input, mesh)?;
+
+    let mut command = Command::new(&helper);
+    command.arg(&input).arg(level.to_string());
+    if !options.no_output {
+        command.arg(&output);
+    }
+    if let Some(n) = options.repeat {
+        command.arg("--repeat").arg(n.to_string());
+    }
+    if options.sparse {
+        command.arg("--sparse");
+    }
+    let result = command.output().map_err(|source| SubdivError::Io { path: helper.clone(), source })?;
+    if !result.status.success() {
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        return Err(helper_error(&helper, format!("{}: {}", result.status, stderr.trim())));
+    }
+    let min_seconds = match options.repeat {
+        Some(_) => Some(
+            parse_seconds(&String::from_utf8_lossy(&result.stdout))
+                .ok_or_else(|| helper_error(&helper, "expected 'min_seconds=S' on stdout".to_string()))?,
+        ),
+        None => None,
+    };
+    let mesh = if options.no_output { None } else { Some(formats::read(&output)?) };
+    Ok(Run { mesh, min_seconds })
+}
+
+fn helper_error(path: &Path, message: impl Into<String>) -> SubdivError {
+    SubdivError::Helper { path: path.to_path_buf(), message: message.into() }
+}
+
+/// The value of `min_seconds=` in the helper's timing line.
+fn parse_seconds(stdout: &str) -> Option<f64> {
+    stdout.split_whitespace().find_map(|t| t.strip_prefix("min_seconds="))?.parse().ok()
+}
+
+/// A private temporary folder, removed on drop.
+struct TempDir {
+    path: PathBuf,
+}
+
+impl TempDir {
+    fn new() -> Result<TempDir> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let path = std::env::temp_dir().join(format!("texgeo-osd-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&path).map_err(|source| SubdivError::Io { path: path.clone(), source })?;
+        Ok(TempDir { path })
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        // Best effort: a leftover folder in the temp dir is harmless.
+        let _ = std::fs::remove_dir_all(&self.path);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn parses_the_timing_line() {
+        let line = "osd-refine: level=5 vertices=10 faces=8 repeat=3 min_seconds=1.250000\n";
+        assert_eq!(super::parse_seconds(line), Some(1.25));
+        assert_eq!(super::parse_seconds("nothing"), None);
+    }
+}

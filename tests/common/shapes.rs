@@ -1,0 +1,186 @@
+//! The named test-shape set for subdivision (in the spirit of OpenSubdiv's
+//! `regression/shapes`): small meshes that each exercise one case of the masks —
+//! valence 3, triangles, all-regular, every valence 3…8 with an n-gon, boundaries and
+//! corners, and a thesis-sized torus knot. CPU, GPU and reference tests share them.
+
+#![allow(dead_code)]
+
+use std::f64::consts::TAU;
+
+use glam::DVec3;
+use texgeo::mesh::Mesh;
+
+/// A shape of the set: its name (used in file names and messages) and mesh.
+pub struct Shape {
+    pub name: &'static str,
+    pub mesh: Mesh,
+}
+
+fn mesh(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Mesh {
+    Mesh::new(positions, faces).expect("test shapes are valid meshes")
+}
+
+/// Cube [−1,1]³, six quads: every vertex has valence 3.
+pub fn cube() -> Mesh {
+    let positions = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            )
+        })
+        .collect();
+    let faces = vec![
+        vec![0, 2, 3, 1],
+        vec![4, 5, 7, 6],
+        vec![0, 1, 5, 4],
+        vec![1, 3, 7, 5],
+        vec![3, 2, 6, 7],
+        vec![2, 0, 4, 6],
+    ];
+    mesh(positions, faces)
+}
+
+/// Cube without its top face: an open mesh, boundary vertices of valence 3.
+pub fn open_cube() -> Mesh {
+    let cube = cube();
+    let faces = cube.faces().filter(|f| f != &[4, 5, 7, 6]).map(<[u32]>::to_vec).collect();
+    mesh(cube.positions().to_vec(), faces)
+}
+
+/// Regular tetrahedron: four triangles, valence 3.
+pub fn tetrahedron() -> Mesh {
+    let positions = vec![
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 1.0),
+    ];
+    mesh(positions, vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 1], vec![1, 3, 2]])
+}
+
+/// Square pyramid: four triangles and a quad, apex valence 4, base valence 3.
+pub fn pyramid() -> Mesh {
+    let positions = vec![
+        DVec3::new(-1.0, -1.0, 0.0),
+        DVec3::new(1.0, -1.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(-1.0, 1.0, 0.0),
+        DVec3::new(0.0, 0.0, 1.5),
+    ];
+    let faces = vec![vec![0, 3, 2, 1], vec![0, 1, 4], vec![1, 2, 4], vec![2, 3, 4], vec![3, 0, 4]];
+    mesh(positions, faces)
+}
+
+/// Torus of `nu × nv` quads (major radius 2, minor 0.6): every vertex regular (valence 4).
+pub fn torus(nu: u32, nv: u32) -> Mesh {
+    let mut positions = Vec::new();
+    for i in 0..nu {
+        let u = TAU * f64::from(i) / f64::from(nu);
+        for j in 0..nv {
+            let v = TAU * f64::from(j) / f64::from(nv);
+            let r = 2.0 + 0.6 * v.cos();
+            positions.push(DVec3::new(r * u.cos(), r * u.sin(), 0.6 * v.sin()));
+        }
+    }
+    let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
+    let faces = (0..nu)
+        .flat_map(|i| (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .collect();
+    mesh(positions, faces)
+}
+
+/// A closed mesh with vertices of every valence 3…8 and a heptagonal face: a heptagonal
+/// prism (bottom kept as one 7-gon, top fanned to an apex of valence 7) whose side
+/// strips are fanned to centres of valence 6 and 8, one side quad split by a diagonal.
+pub fn valences() -> Mesh {
+    let ring = |z: f64| {
+        (0..7).map(move |i| {
+            let a = TAU * f64::from(i) / 7.0;
+            DVec3::new(a.cos(), a.sin(), z)
+        })
+    };
+    let mut positions: Vec<DVec3> = ring(0.0).chain(ring(1.0)).collect(); // b_i = i, t_i = 7 + i
+    let (b, t) = (|i: u32| i % 7, |i: u32| 7 + i % 7);
+    let mut faces = vec![(0..7).rev().map(b).collect::<Vec<u32>>()]; // the 7-gon, seen from below
+    positions.push(DVec3::new(0.0, 0.0, 1.5)); // apex A = 14
+    faces.extend((0..7).map(|i| vec![t(i), t(i + 1), 14]));
+    // Fans over side strips: quads 0–1 around S (valence 6), quads 4–6 around S' (valence 8).
+    let fan = |cycle: Vec<u32>, positions: &mut Vec<DVec3>, faces: &mut Vec<Vec<u32>>| {
+        let centre = cycle.iter().map(|&v| positions[v as usize]).sum::<DVec3>() / cycle.len() as f64;
+        let centre = centre + DVec3::new(centre.x, centre.y, 0.0) * 0.3;
+        let c = positions.len() as u32;
+        positions.push(centre);
+        for k in 0..cycle.len() {
+            faces.push(vec![cycle[k], cycle[(k + 1) % cycle.len()], c]);
+        }
+    };
+    fan(vec![b(0), b(1), b(2), t(2), t(1), t(0)], &mut positions, &mut faces);
+    fan(vec![b(4), b(5), b(6), b(7), t(7), t(6), t(5), t(4)], &mut positions, &mut faces);
+    faces.push(vec![b(2), b(3), t(3)]);
+    faces.push(vec![b(2), t(3), t(2)]);
+    faces.push(vec![b(3), b(4), t(4), t(3)]);
+    mesh(positions, faces)
+}
+
+/// An `n × n` grid of quads in the plane: open, with corners of valence 2.
+pub fn grid(n: u32) -> Mesh {
+    let positions = (0..=n)
+        .flat_map(|j| {
+            (0..=n).map(move |i| DVec3::new(f64::from(i), f64::from(j), 0.1 * f64::from(i * j % 3)))
+        })
+        .collect();
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let faces = (0..n)
+        .flat_map(|j| (0..n).map(move |i| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .collect();
+    mesh(positions, faces)
+}
+
+/// A (2,3) torus knot tube of `2 · nu · nv` triangles (the thesis' "Torusknot" has 1200:
+/// `nu = 100, nv = 6`; CGAL's knot1.off-sized 6400: `nu = 400, nv = 8`).
+pub fn torus_knot(nu: u32, nv: u32) -> Mesh {
+    let curve = |s: f64| {
+        let r = 2.0 + (3.0 * s).cos();
+        DVec3::new(r * (2.0 * s).cos(), r * (2.0 * s).sin(), -(3.0 * s).sin())
+    };
+    let mut positions = Vec::new();
+    for i in 0..nu {
+        let s = TAU * f64::from(i) / f64::from(nu);
+        let c = curve(s);
+        let tangent = (curve(s + 1e-4) - curve(s - 1e-4)).normalize();
+        let normal = tangent.cross(c).normalize();
+        let binormal = tangent.cross(normal);
+        for j in 0..nv {
+            let a = TAU * f64::from(j) / f64::from(nv);
+            positions.push(c + 0.4 * (a.cos() * normal + a.sin() * binormal));
+        }
+    }
+    let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
+    let faces = (0..nu)
+        .flat_map(|i| {
+            (0..nv).flat_map(move |j| {
+                [
+                    vec![id(i, j), id(i, j + 1), id(i + 1, j + 1)],
+                    vec![id(i, j), id(i + 1, j + 1), id(i + 1, j)],
+                ]
+            })
+        })
+        .collect();
+    mesh(positions, faces)
+}
+
+/// The named set, small enough for every level the tests use.
+pub fn all() -> Vec<Shape> {
+    vec![
+        Shape { name: "cube", mesh: cube() },
+        Shape { name: "tetrahedron", mesh: tetrahedron() },
+        Shape { name: "pyramid", mesh: pyramid() },
+        Shape { name: "torus", mesh: torus(8, 6) },
+        Shape { name: "valences", mesh: valences() },
+        Shape { name: "grid", mesh: grid(3) },
+        Shape { name: "open_cube", mesh: open_cube() },
+        Shape { name: "torus_knot", mesh: torus_knot(100, 6) },
+    ]
+}

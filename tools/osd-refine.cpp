@@ -1,0 +1,304 @@
+// osd-refine: uniform Catmull-Clark refinement by OpenSubdiv, the independent reference
+// for texgeo's CPU and GPU subdivision (SPEC §5.1, STACK.md "OpenSubdiv facts").
+//
+//   osd-refine IN LEVEL [OUT] [--repeat N] [--sparse]
+//
+// IN is an OFF or OBJ file (OBJ: only `v` and `f` lines are used). The mesh is refined
+// LEVEL times with Sdc::SCHEME_CATMARK, VTX_BOUNDARY_EDGE_ONLY, FVAR_LINEAR_ALL,
+// CREASE_UNIFORM, TRI_SUB_CATMARK and full topology in the last level (--sparse drops
+// it, as an application that only draws would), positions interpolated in double
+// precision. The last level is written to OUT as OFF with %.17g coordinates, in
+// OpenSubdiv's default vertex order (vertex points, face points, edge points).
+//
+// With --repeat N, topology creation + refinement + interpolation is timed N times and
+// one line is printed on stdout:
+//   osd-refine: level=L vertices=V faces=F repeat=N min_seconds=S
+// Errors go to stderr as `file:line: message` and exit with status 1.
+//
+// Face indices are range-checked here: OpenSubdiv itself does not check them.
+
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace OpenSubdiv;
+
+namespace {
+
+struct Mesh {
+    std::vector<double> positions;  // xyz per vertex
+    std::vector<int> faceSizes;
+    std::vector<int> faceIndices;
+    int numVertices() const { return int(positions.size() / 3); }
+};
+
+// A primvar in double precision for PrimvarRefinerReal<double>.
+struct Point {
+    double p[3];
+    void Clear() { p[0] = p[1] = p[2] = 0.0; }
+    void AddWithWeight(Point const& src, double w) {
+        p[0] += w * src.p[0];
+        p[1] += w * src.p[1];
+        p[2] += w * src.p[2];
+    }
+};
+
+[[noreturn]] void fail(std::string const& where, std::string const& message) {
+    std::fprintf(stderr, "osd-refine: %s: %s\n", where.c_str(), message.c_str());
+    std::exit(1);
+}
+
+std::string at(std::string const& path, long line) { return path + ":" + std::to_string(line); }
+
+bool parseDouble(std::string const& tok, double& out) {
+    if (tok.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    out = std::strtod(tok.c_str(), &end);
+    return end == tok.c_str() + tok.size() && errno != ERANGE && std::isfinite(out);
+}
+
+bool parseLong(std::string const& tok, long& out) {
+    if (tok.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    out = std::strtol(tok.c_str(), &end, 10);
+    return end == tok.c_str() + tok.size() && errno != ERANGE;
+}
+
+// The non-blank lines of a file with `#` comments removed, with 1-based line numbers.
+struct Lines {
+    std::ifstream in;
+    std::string path;
+    long number = 0;
+    bool next(std::string& line) {
+        while (std::getline(in, line)) {
+            ++number;
+            auto hash = line.find('#');
+            if (hash != std::string::npos) line.erase(hash);
+            if (line.find_first_not_of(" \t\r") != std::string::npos) return true;
+        }
+        return false;
+    }
+};
+
+std::vector<std::string> tokens(std::string const& line) {
+    std::istringstream s(line);
+    std::vector<std::string> out;
+    std::string t;
+    while (s >> t) out.push_back(t);
+    return out;
+}
+
+void checkFace(Mesh const& mesh, std::string const& where, int first) {
+    int size = int(mesh.faceIndices.size()) - first;
+    if (size < 3) fail(where, "a face needs at least 3 vertices, this one has " + std::to_string(size));
+}
+
+Mesh readOff(std::string const& path) {
+    Lines lines{std::ifstream(path), path};
+    if (!lines.in) fail(path, std::strerror(errno));
+    Mesh mesh;
+    std::string line;
+    if (!lines.next(line)) fail(path, "empty file, expected an OFF header");
+    auto head = tokens(line);
+    if (head[0] != "OFF" && head[0] != "COFF" && head[0] != "NOFF" && head[0] != "CNOFF")
+        fail(at(path, lines.number), "expected an OFF header, found '" + head[0] + "'");
+    std::vector<std::string> counts(head.begin() + 1, head.end());
+    if (counts.empty()) {
+        if (!lines.next(line)) fail(at(path, lines.number), "the file ends before the counts");
+        counts = tokens(line);
+    }
+    long nv = 0, nf = 0;
+    if (counts.size() < 2 || !parseLong(counts[0], nv) || !parseLong(counts[1], nf) || nv < 0 || nf < 0 ||
+        nv > std::numeric_limits<int>::max() || nf > std::numeric_limits<int>::max())
+        fail(at(path, lines.number), "expected 'vertices faces [edges]' counts");
+    for (long i = 0; i < nv; ++i) {
+        if (!lines.next(line)) fail(at(path, lines.number), "the file ends after " + std::to_string(i) + " vertices");
+        auto t = tokens(line);
+        double x, y, z;
+        if (t.size() < 3 || !parseDouble(t[0], x) || !parseDouble(t[1], y) || !parseDouble(t[2], z))
+            fail(at(path, lines.number), "a vertex needs three finite coordinates");
+        mesh.positions.insert(mesh.positions.end(), {x, y, z});
+    }
+    for (long i = 0; i < nf; ++i) {
+        if (!lines.next(line)) fail(at(path, lines.number), "the file ends after " + std::to_string(i) + " faces");
+        auto t = tokens(line);
+        long n = 0;
+        if (!parseLong(t[0], n) || n < 3) fail(at(path, lines.number), "a face needs a size of at least 3");
+        if (long(t.size()) < n + 1) fail(at(path, lines.number), "the face lists fewer vertices than its size");
+        int first = int(mesh.faceIndices.size());
+        for (long j = 1; j <= n; ++j) {
+            long v = 0;
+            if (!parseLong(t[j], v) || v < 0 || v >= nv)
+                fail(at(path, lines.number), "vertex index '" + t[j] + "' is out of range (the file has " +
+                                                 std::to_string(nv) + " vertices)");
+            mesh.faceIndices.push_back(int(v));
+        }
+        mesh.faceSizes.push_back(int(n));
+        checkFace(mesh, at(path, lines.number), first);
+    }
+    return mesh;
+}
+
+// OBJ: `v x y z` and `f a b c …` (a, b, c may be `i`, `i/t`, `i//n`, `i/t/n`, negative = relative).
+Mesh readObj(std::string const& path) {
+    Lines lines{std::ifstream(path), path};
+    if (!lines.in) fail(path, std::strerror(errno));
+    Mesh mesh;
+    std::string line;
+    while (lines.next(line)) {
+        auto t = tokens(line);
+        if (t[0] == "v") {
+            double x, y, z;
+            if (t.size() < 4 || !parseDouble(t[1], x) || !parseDouble(t[2], y) || !parseDouble(t[3], z))
+                fail(at(path, lines.number), "a vertex needs three finite coordinates");
+            mesh.positions.insert(mesh.positions.end(), {x, y, z});
+        } else if (t[0] == "f") {
+            int first = int(mesh.faceIndices.size());
+            for (size_t j = 1; j < t.size(); ++j) {
+                std::string idx = t[j].substr(0, t[j].find('/'));
+                long v = 0;
+                if (!parseLong(idx, v) || v == 0) fail(at(path, lines.number), "bad vertex index '" + t[j] + "'");
+                long nv = mesh.numVertices();
+                long i = v > 0 ? v - 1 : nv + v;  // indices refer to the vertices read so far
+                if (i < 0 || i >= nv)
+                    fail(at(path, lines.number), "vertex index " + std::to_string(v) + " is out of range (" +
+                                                     std::to_string(nv) + " vertices so far)");
+                mesh.faceIndices.push_back(int(i));
+            }
+            checkFace(mesh, at(path, lines.number), first);
+            mesh.faceSizes.push_back(int(mesh.faceIndices.size()) - first);
+        }
+    }
+    return mesh;
+}
+
+bool endsWith(std::string const& s, std::string const& suffix) {
+    if (s.size() < suffix.size()) return false;
+    return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(),
+                      [](char a, char b) { return std::tolower(a) == std::tolower(b); });
+}
+
+struct Result {
+    std::unique_ptr<Far::TopologyRefiner> refiner;
+    std::vector<Point> points;  // every level, concatenated
+};
+
+// Topology creation, uniform refinement and interpolation of every level: what is timed.
+Result refine(Mesh const& mesh, int level, bool fullTopology) {
+    Sdc::Options sdc;
+    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    sdc.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
+    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+    sdc.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+
+    Far::TopologyDescriptor desc;
+    desc.numVertices = mesh.numVertices();
+    desc.numFaces = int(mesh.faceSizes.size());
+    desc.numVertsPerFace = mesh.faceSizes.data();
+    desc.vertIndicesPerFace = mesh.faceIndices.data();
+
+    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+    Result r;
+    r.refiner.reset(Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, sdc)));
+    if (!r.refiner) fail("OpenSubdiv", "TopologyRefinerFactory::Create failed");
+
+    Far::TopologyRefiner::UniformOptions uniform(level);
+    uniform.fullTopologyInLastLevel = fullTopology;
+    r.refiner->RefineUniform(uniform);
+
+    r.points.resize(r.refiner->GetNumVerticesTotal());
+    for (int v = 0; v < desc.numVertices; ++v)
+        for (int k = 0; k < 3; ++k) r.points[v].p[k] = mesh.positions[3 * v + k];
+    Far::PrimvarRefinerReal<double> primvar(*r.refiner);
+    Point* src = r.points.data();
+    for (int l = 1; l <= level; ++l) {
+        Point* dst = src + r.refiner->GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    return r;
+}
+
+void writeOff(std::string const& path, Result const& r) {
+    int level = r.refiner->GetMaxLevel();
+    Far::TopologyLevel const& last = r.refiner->GetLevel(level);
+    Point const* p = r.points.data() + (r.points.size() - last.GetNumVertices());
+    FILE* out = std::fopen(path.c_str(), "w");
+    if (!out) fail(path, std::strerror(errno));
+    std::fprintf(out, "OFF\n%d %d 0\n", last.GetNumVertices(), last.GetNumFaces());
+    for (int v = 0; v < last.GetNumVertices(); ++v)
+        std::fprintf(out, "%.17g %.17g %.17g\n", p[v].p[0], p[v].p[1], p[v].p[2]);
+    for (int f = 0; f < last.GetNumFaces(); ++f) {
+        Far::ConstIndexArray fv = last.GetFaceVertices(f);
+        std::fprintf(out, "%d", fv.size());
+        for (int j = 0; j < fv.size(); ++j) std::fprintf(out, " %d", fv[j]);
+        std::fputc('\n', out);
+    }
+    if (std::fclose(out) != 0) fail(path, std::strerror(errno));
+}
+
+[[noreturn]] void usage() {
+    std::fprintf(stderr, "usage: osd-refine IN.(off|obj) LEVEL [OUT.off] [--repeat N] [--sparse]\n");
+    std::exit(2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> positional;
+    long repeat = 0;
+    bool fullTopology = true;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        if (a == "--repeat") {
+            if (i + 1 >= argc || !parseLong(argv[i + 1], repeat) || repeat < 1) usage();
+            ++i;
+        } else if (a == "--sparse") {
+            fullTopology = false;
+        } else if (a.size() > 1 && a[0] == '-') {
+            usage();
+        } else {
+            positional.push_back(a);
+        }
+    }
+    long level = 0;
+    if (positional.size() < 2 || positional.size() > 3 || !parseLong(positional[1], level)) usage();
+    if (level < 1 || level > 10) fail("LEVEL", "must be in 1..=10, got " + positional[1]);
+
+    std::string const& in = positional[0];
+    Mesh mesh = endsWith(in, ".obj") ? readObj(in) : readOff(in);
+    if (mesh.faceSizes.empty()) fail(in, "the mesh has no faces");
+
+    Result r;
+    double best = std::numeric_limits<double>::infinity();
+    for (long k = 0; k < std::max(repeat, 1L); ++k) {
+        auto t0 = std::chrono::steady_clock::now();
+        r = refine(mesh, int(level), fullTopology);
+        auto t1 = std::chrono::steady_clock::now();
+        best = std::min(best, std::chrono::duration<double>(t1 - t0).count());
+    }
+    if (repeat > 0) {
+        Far::TopologyLevel const& last = r.refiner->GetLevel(int(level));
+        std::printf("osd-refine: level=%ld vertices=%d faces=%d repeat=%ld min_seconds=%.6f\n", level,
+                    last.GetNumVertices(), last.GetNumFaces(), repeat, best);
+    }
+    if (positional.size() == 3) writeOff(positional[2], r);
+    return 0;
+}
