@@ -8,3 +8,4 @@ pub mod mesh;
 pub mod random;
 pub mod report;
 pub mod subdiv;
+pub mod voxel;

@@ -67,6 +67,10 @@ pub struct DeviceInfo {
     pub max_color_attachments: u32,
     pub max_push_constants: u32,
     pub max_vertex_attributes: u32,
+    /// Fixed-point bits of sub-pixel precision of rasterized vertex positions.
+    pub sub_pixel_bits: u32,
+    /// Largest viewport width and height.
+    pub max_viewport: [u32; 2],
     pub logic_op: bool,
     pub float64: bool,
     pub timestamps: bool,
@@ -269,6 +273,8 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
         max_color_attachments: limits.max_color_attachments,
         max_push_constants: limits.max_push_constants_size,
         max_vertex_attributes: limits.max_vertex_input_attributes,
+        sub_pixel_bits: limits.sub_pixel_precision_bits,
+        max_viewport: limits.max_viewport_dimensions,
         logic_op: features.logic_op == vk::TRUE,
         float64: features.shader_float64 == vk::TRUE,
         timestamps: limits.timestamp_compute_and_graphics == vk::TRUE,
