@@ -273,11 +273,13 @@ mod tests {
         let mut rng = Rng::new(11);
         let big = 1i64 << 26; // products reach 2^80: beyond f64's 53 bits, fine for i128
         for _ in 0..20_000 {
-            let mut p = || -> [i64; 3] { std::array::from_fn(|_| rng.below(2 * big as u64) as i64 - big) };
-            let (a, b, c) = (p(), p(), p());
-            // Half the time, d is coplanar (a + b − c) or nudged off the plane by one unit.
+            let p = |rng: &mut Rng| -> [i64; 3] {
+                std::array::from_fn(|_| rng.below(2 * big as u64) as i64 - big)
+            };
+            let (a, b, c) = (p(&mut rng), p(&mut rng), p(&mut rng));
+            // A third of the time d is coplanar (a + b − c), a third one unit off the plane.
             let d = match rng.below(3) {
-                0 => p(),
+                0 => p(&mut rng),
                 1 => [a[0] + b[0] - c[0], a[1] + b[1] - c[1], a[2] + b[2] - c[2]],
                 _ => [a[0] + b[0] - c[0] + 1, a[1] + b[1] - c[1], a[2] + b[2] - c[2]],
             };
