@@ -4,6 +4,7 @@ mod bench;
 mod demo;
 mod info;
 mod mesh;
+mod voxelize;
 
 use clap::{Parser, Subcommand};
 use texgeo::gpu::{Context, ContextOptions, DeviceChoice};
@@ -35,6 +36,8 @@ enum Command {
     Bench(bench::Command),
     /// A short tour on built-in data: reduction, XOR raster, model statistics.
     Demo(demo::Args),
+    /// Solid voxelization by slicing tetrahedra with XOR; writes .binvox (+ PNG slices).
+    Voxelize(voxelize::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -51,6 +54,7 @@ fn main() {
         Command::Mesh(c) => mesh::run(c),
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
+        Command::Voxelize(a) => voxelize::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");
