@@ -212,6 +212,16 @@ fn degenerate_faces() {
 }
 
 #[test]
+fn huge_coordinates_do_not_overflow_the_area_test() {
+    let big = f64::MAX / 2.0;
+    let positions = vec![DVec3::new(-big, -big, 0.0), DVec3::new(big, -big, 0.0), DVec3::new(0.0, big, 0.0)];
+    let r = Mesh::new(positions.clone(), vec![vec![0, 1, 2]]).unwrap().report();
+    assert_eq!(r.degenerate_faces, 0);
+    let flat = vec![positions[0], positions[1], DVec3::new(0.0, -big, 0.0)];
+    assert_eq!(Mesh::new(flat, vec![vec![0, 1, 2]]).unwrap().report().degenerate_faces, 1);
+}
+
+#[test]
 fn two_tetrahedra_touching_at_a_vertex() {
     let t = procedural::tetrahedron();
     let mut positions = t.positions().to_vec();

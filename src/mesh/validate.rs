@@ -216,14 +216,27 @@ fn is_degenerate(face: &[u32], positions: &[glam::DVec3]) -> bool {
         return true;
     }
     let p0 = positions[face[0] as usize];
+    let (area, scale) = vector_area(face, positions, p0, 1.0);
+    if area.is_finite() && scale.is_finite() {
+        return area <= 1e-12 * scale;
+    }
+    // Coordinates near f64::MAX overflow: measure again in units of the face's size.
+    let size = face.iter().map(|&i| positions[i as usize].abs().max_element()).fold(0.0, f64::max);
+    let (area, scale) = vector_area(face, positions, p0, 1.0 / size);
+    area <= 1e-12 * scale
+}
+
+/// |Σ (pᵢ − p0) × (pᵢ₊₁ − p0)| and Σ |pᵢ₊₁ − pᵢ|², coordinates multiplied by `unit` first.
+fn vector_area(face: &[u32], positions: &[glam::DVec3], p0: glam::DVec3, unit: f64) -> (f64, f64) {
     let mut area = glam::DVec3::ZERO;
     let mut scale = 0.0;
     for (k, &a) in face.iter().enumerate() {
-        let (pa, pb) = (positions[a as usize], positions[face[(k + 1) % face.len()] as usize]);
-        area += (pa - p0).cross(pb - p0);
+        let pa = positions[a as usize] * unit - p0 * unit;
+        let pb = positions[face[(k + 1) % face.len()] as usize] * unit - p0 * unit;
+        area += pa.cross(pb);
         scale += pa.distance_squared(pb);
     }
-    area.length() <= 1e-12 * scale
+    (area.length(), scale)
 }
 
 /// Disjoint sets over 0..n with path halving and union by rank.

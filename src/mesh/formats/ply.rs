@@ -47,6 +47,20 @@ impl Scalar {
         })
     }
 
+    /// The PLY name.
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
     fn size(self) -> u64 {
         match self {
             Scalar::I8 | Scalar::U8 => 1,
@@ -387,7 +401,7 @@ impl Source for Ascii<'_> {
             let (lo, hi) = ty.range();
             match token.parse::<i64>() {
                 Ok(v) if (lo..=hi).contains(&v) => Ok(Value::Int(v)),
-                Ok(v) => Err(Fault::Bad(format!("{v} is out of range for {ty:?}"))),
+                Ok(v) => Err(Fault::Bad(format!("{v} is out of range for {}", ty.name()))),
                 Err(_) => Err(Fault::Bad(format!("'{token}' is not an integer"))),
             }
         } else {
