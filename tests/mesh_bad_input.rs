@@ -480,3 +480,57 @@ fn replace_bytes(bytes: Vec<u8>, marker: &str, with: &[u8]) -> Vec<u8> {
     let at = bytes.windows(m.len()).position(|w| w == m).unwrap();
     [&bytes[..at], with, &bytes[at + m.len()..]].concat()
 }
+
+// ---------------------------------------------------------------- mutations
+
+/// Random byte flips, cuts and insertions in valid files of every format: a reader may
+/// accept the result (then it is a valid mesh by construction) or reject it with a
+/// parse error, but never panic.
+#[test]
+fn mutated_files_never_panic() {
+    use texgeo::mesh::formats::Format;
+    use texgeo::random::Rng;
+    let mesh = procedural::pyramid();
+    let mut rng = Rng::new(2006);
+    let mut files: Vec<(Format, Vec<u8>)> = Vec::new();
+    for format in [Format::Obj, Format::Off, Format::Ply, Format::Stl] {
+        let mut bytes = Vec::new();
+        formats::write_to(&mut bytes, &mesh, format).unwrap();
+        files.push((format, bytes));
+    }
+    let mut ascii = Vec::new();
+    ply::write_ascii(&mut ascii, &mesh).unwrap();
+    files.push((Format::Ply, ascii));
+    let mut ascii = Vec::new();
+    stl::write_ascii(&mut ascii, &mesh).unwrap();
+    files.push((Format::Stl, ascii));
+    let path = std::path::Path::new("mutated");
+    let interesting = b"0123456789-+.eE \n#/nainf\xff\x00";
+    for (format, good) in &files {
+        let (mut accepted, mut rejected) = (0, 0);
+        for _ in 0..3000 {
+            let mut b = good.clone();
+            for _ in 0..1 + rng.below(3) {
+                let at = rng.below(b.len() as u64 + 1) as usize;
+                match rng.below(4) {
+                    0 if at < b.len() => b[at] = rng.below(256) as u8,
+                    1 if at < b.len() => b[at] = interesting[rng.below(interesting.len() as u64) as usize],
+                    2 => b.truncate(at),
+                    _ => b.insert(at, interesting[rng.below(interesting.len() as u64) as usize]),
+                }
+            }
+            match formats::read_bytes(&b, *format, path) {
+                Ok(m) => {
+                    accepted += 1;
+                    assert!(m.num_faces() > 0);
+                }
+                Err(MeshError::Parse { .. }) => rejected += 1,
+                Err(e) => panic!("{format:?}: not a parse error: {e}"),
+            }
+        }
+        assert!(
+            rejected > 100,
+            "{format:?}: only {rejected} of 3000 mutations rejected ({accepted} accepted)"
+        );
+    }
+}

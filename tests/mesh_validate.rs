@@ -267,3 +267,79 @@ fn empty_mesh() {
     assert_eq!((r.vertices, r.faces, r.edges, r.components, r.euler_characteristic), (0, 0, 0, 0, 0));
     assert!(r.is_closed());
 }
+
+/// The report of random small meshes (repeated indices, shared edges, stray vertices)
+/// against a slow, obvious recount.
+#[test]
+fn random_meshes_match_a_naive_recount() {
+    use std::collections::{BTreeMap, BTreeSet};
+    use texgeo::random::Rng;
+    let mut rng = Rng::new(42);
+    for _ in 0..300 {
+        let nv = 3 + rng.below(10) as usize;
+        let positions: Vec<DVec3> =
+            (0..nv).map(|_| DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64())).collect();
+        let faces: Vec<Vec<u32>> = (0..1 + rng.below(14))
+            .map(|_| (0..3 + rng.below(3)).map(|_| rng.below(nv as u64) as u32).collect())
+            .collect();
+        let r = Mesh::new(positions, faces.clone()).unwrap().report();
+
+        // Half-edge counts per undirected edge.
+        let mut half: BTreeMap<(u32, u32), [u32; 2]> = BTreeMap::new();
+        for f in &faces {
+            for k in 0..f.len() {
+                let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                if a != b {
+                    half.entry((a.min(b), a.max(b))).or_default()[usize::from(a > b)] += 1;
+                }
+            }
+        }
+        let boundary = half.values().filter(|c| c[0] + c[1] == 1).count();
+        let non_manifold = half.values().filter(|c| c[0] + c[1] > 2).count();
+        let misoriented = half.values().filter(|c| c[0] + c[1] >= 2 && c[0] != c[1]).count();
+        assert_eq!((r.edges, r.boundary_edges), (half.len(), boundary));
+        assert_eq!((r.non_manifold_edges, r.misoriented_edges), (non_manifold, misoriented));
+
+        // Fans: corners at v linked when they share a neighbour across an edge side.
+        let mut bad_vertices = 0;
+        for v in 0..nv as u32 {
+            let mut sides: Vec<BTreeSet<u32>> = Vec::new();
+            for f in &faces {
+                for k in 0..f.len() {
+                    if f[k] == v {
+                        let n = f.len();
+                        let set: BTreeSet<u32> =
+                            [f[(k + n - 1) % n], f[(k + 1) % n]].into_iter().filter(|&w| w != v).collect();
+                        sides.push(set);
+                    }
+                }
+            }
+            let mut group: Vec<usize> = (0..sides.len()).collect();
+            let mut changed = true;
+            while changed {
+                changed = false;
+                for i in 0..sides.len() {
+                    for j in 0..sides.len() {
+                        if group[i] < group[j] && !sides[i].is_disjoint(&sides[j]) {
+                            group[j] = group[i];
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            let fans = group.iter().collect::<BTreeSet<_>>().len();
+            let on_bad_edge = half.iter().any(|(&(a, b), c)| (a == v || b == v) && c[0] + c[1] > 2);
+            if fans > 1 || on_bad_edge {
+                bad_vertices += 1;
+            }
+        }
+        assert_eq!(r.non_manifold_vertices, bad_vertices, "{faces:?}");
+
+        let used: BTreeSet<u32> = faces.iter().flatten().copied().collect();
+        assert_eq!(r.unused_vertices, nv - used.len());
+        assert_eq!(r.euler_characteristic, used.len() as i64 - half.len() as i64 + faces.len() as i64);
+        assert_eq!(r.face_degrees.values().sum::<usize>(), faces.len());
+        let repeats = faces.iter().filter(|f| f.iter().collect::<BTreeSet<_>>().len() < f.len()).count();
+        assert!(r.degenerate_faces >= repeats);
+    }
+}

@@ -13,7 +13,9 @@
 //!    shared and a closed OBJ reads as a closed mesh.
 //!
 //! Vertices no face uses are dropped (`tobj` does not return them); the others keep their
-//! file order. Texture coordinates, normals and colours are checked but not kept.
+//! file order. Texture coordinates, normals and colours are checked but not kept. A face
+//! may only use vertices defined before it (positive or relative indices), as written
+//! by every exporter; a forward reference is reported as out of range.
 
 use std::io::Write;
 use std::path::Path;

@@ -110,7 +110,8 @@ struct Element {
 }
 
 impl Element {
-    /// The fewest bytes one binary entry can take (lists may be empty).
+    /// The fewest bytes one binary entry can take (lists may be empty). Never 0 for an
+    /// element with entries: the header parser refuses elements without properties.
     fn min_size(&self) -> u64 {
         self.props
             .iter()
@@ -202,6 +203,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 })?;
                 if let Some(prev) = elements.last()
                     && prev.props.is_empty()
+                    && prev.count > 0
                 {
                     return Err(err(prev.line, format!("element '{}' has no properties", prev.name)));
                 }
@@ -253,6 +255,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     };
     if let Some(last) = elements.last()
         && last.props.is_empty()
+        && last.count > 0
     {
         return Err(err(last.line, format!("element '{}' has no properties", last.name)));
     }

@@ -4,7 +4,9 @@
 //!
 //! A file is binary when its size is exactly 84 + 50·n bytes for the triangle count n
 //! stored at byte 80 (even if its header starts with `solid`, as some writers do); else
-//! ascii when it starts with `solid`; else it is rejected.
+//! ascii when it starts with `solid`; else it is rejected. ASCII keywords are matched
+//! case-insensitively, several `solid … endsolid` blocks are merged, and an
+//! `outer loop` of more than three vertices is read as one polygon face.
 
 use std::collections::HashMap;
 use std::io::Write;
