@@ -26,39 +26,11 @@ use super::text::{parse_coord, utf8};
 use crate::mesh::{Mesh, MeshError, Result, error::Location};
 
 /// Statements of the OBJ format that texgeo accepts but ignores.
+#[rustfmt::skip]
 const IGNORED: &[&str] = &[
-    "l",
-    "p",
-    "s",
-    "usemtl",
-    "mtllib",
-    "vp",
-    "cstype",
-    "deg",
-    "bmat",
-    "step",
-    "curv",
-    "curv2",
-    "surf",
-    "parm",
-    "trim",
-    "hole",
-    "scrv",
-    "sp",
-    "end",
-    "con",
-    "mg",
-    "bevel",
-    "c_interp",
-    "d_interp",
-    "lod",
-    "shadow_obj",
-    "trace_obj",
-    "ctech",
-    "stech",
-    "maplib",
-    "usemap",
-    "call",
+    "l", "p", "s", "usemtl", "mtllib", "vp", "cstype", "deg", "bmat", "step", "curv", "curv2",
+    "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg", "bevel", "c_interp",
+    "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap", "call",
     "csh",
 ];
 
@@ -94,7 +66,7 @@ fn assemble(models: &[tobj::Model], checked: &Checked, path: &Path) -> Result<Me
     let disagree = |what: &str| {
         MeshError::parse(path, Location::File, format!("tobj and texgeo's check disagree about {what}"))
     };
-    // New vertex numbers: the used file vertices, in file order.
+    // New vertex numbers: the used file vertices, in file order (first marked with 0).
     let mut renumber = vec![u32::MAX; checked.vertices];
     for &g in &checked.corners {
         if let Some(slot) = renumber.get_mut(g as usize) {
