@@ -54,7 +54,7 @@ impl Format {
 pub fn read(path: impl AsRef<Path>) -> Result<Mesh> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.into(), source })?;
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
     read_bytes(&bytes, format, path)
 }
 
@@ -83,8 +83,8 @@ pub fn write(path: impl AsRef<Path>, mesh: &Mesh) -> Result<()> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
     let mut out = Vec::new();
-    write_to(&mut out, mesh, format).map_err(|source| MeshError::Io { path: path.into(), source })?;
-    std::fs::write(path, out).map_err(|source| MeshError::Io { path: path.into(), source })
+    write_to(&mut out, mesh, format).map_err(|error| MeshError::Io { path: path.into(), error })?;
+    std::fs::write(path, out).map_err(|error| MeshError::Io { path: path.into(), error })
 }
 
 /// Writes a mesh in `format` to any writer.
