@@ -4,5 +4,6 @@
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top.
 
 pub mod gpu;
+pub mod inclusion;
 pub mod mesh;
 pub mod random;
