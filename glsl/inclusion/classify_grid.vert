@@ -7,10 +7,14 @@
 #include "classify_common.glsl"
 
 layout(set = 0, binding = 2) uniform usampler2D cell_lists;
-// x: first entry of the cell's list, y: list length, z: first point, w: point count.
-layout(location = 0) in uvec4 job;
+// Per job: x = first entry of the cell's list, y = list length, z = first point,
+// w = point count. Instance i of a draw runs job first_group + i.
+layout(set = 0, binding = 3) uniform Jobs {
+    uvec4 jobs[MAX_POINTS];
+} jobs;
 
 void main() {
+    uvec4 job = jobs.jobs[pc.first_group + uint(gl_InstanceIndex)];
     uint vertex = uint(gl_VertexIndex);
     uint first = vertex * pc.batch;
     if (first >= job.y) {

@@ -40,9 +40,12 @@ use crate::mesh::covering::UnbalancedEdge;
 
 pub mod bvh;
 pub mod cpu;
+pub mod gpu;
 pub mod jordan;
 pub mod octants;
 pub mod octree;
+pub mod points;
+pub mod solver;
 pub mod surface;
 pub mod tetra;
 pub mod tetragrid;
@@ -74,6 +77,14 @@ pub enum InclusionError {
     Resolution(usize),
     #[error("octree depth {0} is outside 1..=10")]
     OctreeDepth(u32),
+    #[error("GPU: {0}")]
+    Gpu(#[from] crate::gpu::GpuError),
+    #[error("too large for the GPU path: {0}")]
+    TooLarge(String),
+    #[error("invalid options: {0}")]
+    Options(String),
+    #[error("method '{0}' runs on the GPU: build it with inclusion::solver::Solver")]
+    NeedsGpu(Method),
 }
 
 impl From<UnbalancedEdge> for InclusionError {
@@ -121,10 +132,16 @@ pub enum Method {
     JordanOctree,
     /// Generalized winding number: the independent oracle.
     Winding,
+    /// Alg. 4-2 + 4-3 on the GPU: phase 1 draws, 2×2 reduction passes (§4.3.3).
+    Gpu,
+    /// Phase 1 on the GPU, phase 2 summed on the host (the thesis' CPU+GPU).
+    CpuGpu,
+    /// The GPU method over TetraGrid cells: each cell's points against its tetras.
+    GpuTetraGrid,
 }
 
 impl Method {
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 10] = [
         Method::Cpu,
         Method::Bvh,
         Method::Octants,
@@ -132,6 +149,9 @@ impl Method {
         Method::Jordan,
         Method::JordanOctree,
         Method::Winding,
+        Method::Gpu,
+        Method::CpuGpu,
+        Method::GpuTetraGrid,
     ];
 
     pub fn name(self) -> &'static str {
@@ -143,6 +163,9 @@ impl Method {
             Method::Jordan => "jordan",
             Method::JordanOctree => "jordan-octree",
             Method::Winding => "winding",
+            Method::Gpu => "gpu",
+            Method::CpuGpu => "cpu+gpu",
+            Method::GpuTetraGrid => "gpu+tetragrid",
         }
     }
 
@@ -150,9 +173,10 @@ impl Method {
         Method::ALL.iter().map(|m| m.name()).collect()
     }
 
-    /// True for methods that run on the CPU alone (all of them, for now).
+    /// True for methods that run on the CPU alone ([`build`] makes them; the GPU ones
+    /// are made by [`solver::Solver::new`]).
     pub fn is_cpu(self) -> bool {
-        true
+        !matches!(self, Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid)
     }
 }
 
@@ -200,6 +224,7 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
         Method::Jordan => Box::new(jordan::Jordan::new(mesh)?),
         Method::JordanOctree => Box::new(octree::JordanOctree::new(mesh, options.octree_depth)?),
         Method::Winding => Box::new(winding::WindingNumber::new(mesh)?),
+        Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => return Err(InclusionError::NeedsGpu(method)),
     })
 }
 
