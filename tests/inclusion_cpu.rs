@@ -108,24 +108,24 @@ fn cube_points_on_base_triangles_faces_and_edges_through_the_apex() {
     // On a base triangle (the +x face), on a cube edge, on a corner: OnBoundary.
     for p in [DVec3::new(1.0, 0.3, 0.2), DVec3::new(1.0, 1.0, 0.3), DVec3::ONE, DVec3::new(1.0, 0.0, 0.0)] {
         let t = ft.trace(p);
-        assert_eq!(t.class, Some(OnBoundary), "{p}: {t:?}");
+        assert_eq!(t.class, OnBoundary, "{p}: {t:?}");
         assert!(t.near_base >= 1 && t.reruns == 0, "{p}: {t:?}");
     }
 
     // (½, 0.2, 0.2) lies on the plane through O, the +x face's centroid (1,0,0) and its corner
     // (1,1,1): the face shared by two tetras, each adding s.
     let t = ft.trace(DVec3::new(0.5, 0.2, 0.2));
-    assert_eq!((t.class, t.acc, t.side, t.interior, t.reruns), (Some(Inside), 2, 2, 0, 0), "{t:?}");
+    assert_eq!((t.class, t.acc, t.side, t.interior, t.reruns), (Inside, 2, 2, 0, 0), "{t:?}");
 
     // Strictly inside one tetra.
     let t = ft.trace(DVec3::new(0.5, 0.1, 0.2));
-    assert_eq!((t.class, t.acc, t.side, t.interior), (Some(Inside), 2, 0, 1), "{t:?}");
+    assert_eq!((t.class, t.acc, t.side, t.interior), (Inside, 2, 0, 1), "{t:?}");
 
     // On apex edges O–(1,1,1) (a mesh vertex) and O–(1,0,0) (a face centroid), and O itself:
     // resolved by re-running with another apex.
     for p in [DVec3::splat(0.5), DVec3::new(0.5, 0.0, 0.0), DVec3::ZERO, DVec3::splat(0.1 * APEX_BALL)] {
         let t = ft.trace(p);
-        assert_eq!(t.class, Some(Inside), "{p}: {t:?}");
+        assert_eq!(t.class, Inside, "{p}: {t:?}");
         assert!(t.reruns >= 1 && !t.fallback, "{p}: {t:?}");
     }
     assert!(ft.trace(DVec3::splat(0.5)).apex_edges >= 6);
@@ -134,7 +134,7 @@ fn cube_points_on_base_triangles_faces_and_edges_through_the_apex() {
     let thesis = FeitoTorres::with_options(&cube, Some(DVec3::ZERO), EdgeRule::VertexSets).unwrap();
     for p in [DVec3::splat(0.5), DVec3::new(0.5, 0.0, 0.0)] {
         let t = thesis.trace(p);
-        assert_eq!((t.class, t.acc, t.reruns), (Some(Inside), 2, 0), "{p}: {t:?}");
+        assert_eq!((t.class, t.acc, t.reruns), (Inside, 2, 0), "{p}: {t:?}");
     }
 }
 
@@ -168,10 +168,10 @@ fn flat_tetras_send_points_to_a_rerun() {
     let apex = DVec3::new(1.0, 0.5, 0.25);
     let ft = FeitoTorres::with_apex(&l, apex).unwrap();
     let t = ft.trace(DVec3::new(1.0, 0.8, 0.375));
-    assert_eq!(t.class, Some(Inside), "{t:?}");
+    assert_eq!(t.class, Inside, "{t:?}");
     assert!(t.flat >= 1 && t.reruns >= 1, "{t:?}");
     let t = ft.trace(DVec3::new(1.0, 2.0, 0.375));
-    assert_eq!(t.class, Some(OnBoundary), "{t:?}");
+    assert_eq!(t.class, OnBoundary, "{t:?}");
     let options = Options { apex: Some(apex), ..Options::default() };
     expect_all(
         &l,
@@ -537,4 +537,12 @@ fn perf_tetragrid_against_cpu() {
     let grid = TetraGrid::new(FeitoTorres::new(&mesh).unwrap(), 32).unwrap();
     let (t_grid, _) = time(&grid);
     assert!(t_cpu.as_secs_f64() >= 50.0 * t_grid.as_secs_f64(), "cpu {t_cpu:?} grid {t_grid:?}");
+}
+
+#[test]
+fn an_empty_mesh_holds_nothing() {
+    let empty = Mesh::new(Vec::new(), Vec::new()).unwrap();
+    for c in all_methods(&empty, &Options::default()) {
+        assert_eq!(c.classify_all(&[DVec3::ZERO, DVec3::ONE]), vec![Outside, Outside], "{}", c.name());
+    }
 }

@@ -53,8 +53,8 @@ pub const MAX_RERUNS: usize = 8;
 /// Points closer than this (× bounding-box diagonal, max-norm) to the apex are re-run
 /// with another apex: near O the faces through O crowd within ε of each other.
 pub const APEX_BALL: f64 = 1e-4;
-/// Default apex: the bounding-box centre moved by this (× diagonal), so symmetric models
-/// do not put the apex on their symmetry planes, edges or vertices.
+/// Default apex: the bounding-box centre moved by this (× the box's extent per axis), so
+/// symmetric models do not put the apex on their symmetry planes, edges or vertices.
 pub const APEX_SHIFT: DVec3 = DVec3::new(0.013_7, -0.021_1, 0.017_3);
 const RERUN_SEED: u64 = 0x7e7a_a9e7;
 
@@ -70,7 +70,7 @@ pub enum EdgeRule {
 /// What happened while classifying one point (for tests, debugging and GPU fallbacks).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Trace {
-    pub class: Option<Class>,
+    pub class: Class,
     /// Sum of the last pass (2·winding number when decided).
     pub acc: i32,
     /// Tetras the point was strictly inside of, on one face through O of, on an apex edge of.
@@ -87,7 +87,8 @@ pub struct Trace {
     pub fallback: bool,
 }
 
-/// The exact Feito-Torres classifier with basic preprocessing (Table 4-1, optimizer 1).
+/// The exact Feito-Torres classifier (Alg. 4-1, §4.3.1) with basic preprocessing (Table
+/// 4-1, optimizer 1): every tetra's planes and sign computed once, every tetra tested.
 #[derive(Clone, Debug)]
 pub struct FeitoTorres {
     surface: Surface,
@@ -106,7 +107,7 @@ pub struct FeitoTorres {
 /// point works; a central one keeps the tetras and the determinants small).
 pub fn default_apex(surface: &Surface) -> DVec3 {
     let (lo, hi) = surface.bounds();
-    (lo + hi) * 0.5 + APEX_SHIFT * surface.scale()
+    (lo + hi) * 0.5 + APEX_SHIFT * (hi - lo)
 }
 
 enum Pass {
@@ -202,7 +203,7 @@ impl FeitoTorres {
     /// candidates hold every tetra whose grown box and octant mask hold `p` (the others
     /// would answer `Outside` anyway), which is how the optimizers use it.
     pub fn classify_among(&self, p: DVec3, candidates: impl IntoIterator<Item = u32>) -> Class {
-        self.run(p, candidates, None).class.unwrap_or(Class::Outside)
+        self.run(p, candidates, None).class
     }
 
     /// [`Self::classify_among`] with every candidate first checked against its f32 planes
@@ -214,7 +215,7 @@ impl FeitoTorres {
         candidates: impl IntoIterator<Item = u32>,
         compact: &[CompactPlanes],
     ) -> Class {
-        self.run(p, candidates, Some(compact)).class.unwrap_or(Class::Outside)
+        self.run(p, candidates, Some(compact)).class
     }
 
     /// The f32 prefilter planes of every tetra, for [`Self::classify_among_compact`].
@@ -235,7 +236,6 @@ impl FeitoTorres {
     ) -> Trace {
         let mut tally = Tally::default();
         if !self.surface.in_bounds(p) {
-            tally.trace.class = Some(Class::Outside);
             return tally.trace;
         }
         let q = p - self.apex;
@@ -263,7 +263,7 @@ impl FeitoTorres {
             Pass::Decided(c) => c,
             Pass::Ambiguous => self.rerun(p, &mut tally),
         };
-        tally.trace.class = Some(class);
+        tally.trace.class = class;
         tally.trace
     }
 
@@ -309,7 +309,7 @@ impl FeitoTorres {
         sign_tie: &dyn Fn(u32) -> (i8, i8),
     ) -> Pass {
         for (t, v) in verdicts {
-            if v != Verdict::Outside && self.absorb(p, t, v, sign_tie, tally) {
+            if !matches!(v, Verdict::Outside) && self.absorb(p, t, v, sign_tie, tally) {
                 return Pass::Boundary;
             }
         }
