@@ -3,7 +3,8 @@
 //! For every covering tetra T = (O, Q1, Q2, Q3) with sign s, P adds 2s when strictly
 //! inside T, s when on exactly one face through O (that face's other tetra adds the other
 //! half), and nothing when outside; P within ε of a base triangle's face is OnBoundary.
-//! The sum is 2·w(P), w the winding number, so P is Inside iff the sum is non-zero.
+//! The sum is 2·w(P), w the winding number, so P is Inside iff the sum is non-zero (the
+//! thesis' `acc == 2` for every valid solid, where w ∈ {0, 1}).
 //!
 //! ## Points on an apex edge O–Qj: the thesis' vertex-set rule is not exact
 //!
@@ -12,8 +13,9 @@
 //! 2k, k the winding number of Qj's link (its neighbours' polygon) projected along O–Qj
 //! around that line. The rule assumes k = [some fan tetra positive] − [some negative]:
 //!
-//! - right when the fan has one sign and Qj is a manifold vertex (then k = ±1), or when
-//!   the fan is mixed and the link does not wind (k = 0), e.g. a dimple seen from the side;
+//! - right when the fan has one sign and Qj is a manifold vertex of an embedded surface
+//!   (its link is a simple loop, so k = ±1), or when the fan is mixed and the link does
+//!   not wind (k = 0), e.g. an L-prism's reflex corner or a dimple seen from the side;
 //! - **wrong** for a saddle vertex seen so that its link folds back but still winds once
 //!   (mixed signs, k = 1: the rule adds 0 instead of 2);
 //! - **wrong** at a non-manifold vertex, e.g. two cubes sharing an edge, O inside one cube
@@ -36,6 +38,19 @@
 //! broken by a degenerate neighbour), and points within `1e-4·D` of the apex go straight
 //! to a re-run. After [`MAX_RERUNS`] ambiguous re-runs (never seen in practice) the answer
 //! comes from the winding number, which is reliable off the boundary.
+//!
+//! Within ε of a base plane the point is first checked against the face itself
+//! (OnBoundary); if it is off the face, the side of the base is taken from the face's own
+//! plane when the face is a planar n-gon, so that a non-convex face's overlapping positive
+//! and negative triangles decide alike and cancel.
+//!
+//! ## Speed
+//!
+//! `classify` is the thesis' baseline: one pass over every tetra, four plane tests each,
+//! evaluated without early exits (which tetras a point misses follows no pattern a branch
+//! predictor learns). Tetras are stored along a Morton curve of their triangles, so the
+//! optimizers, which read scattered subsets, touch runs of neighbours; they also prefilter
+//! with f32 planes ([`CompactPlanes`]) that only reject what the f64 test rejects.
 
 use std::time::Instant;
 
