@@ -426,6 +426,63 @@ fn all_methods_agree_with_the_oracle_on_random_points() {
     }
 }
 
+/// Points on covering triangles, on their edges and at their corners, moved off by 0,
+/// ±ε/2, ±3ε or ±1000ε along the normal or a random direction: the tolerance zone where
+/// the methods' decisions are the hardest to keep consistent.
+fn near_surface_points(mesh: &Mesh, n: usize, seed: u64) -> Vec<DVec3> {
+    let surface = texgeo::inclusion::Surface::new(mesh).unwrap();
+    let (cov, eps) = (surface.covering(), surface.eps());
+    let mut rng = Rng::new(seed);
+    (0..n)
+        .map(|_| {
+            let [a, b, c] = cov.triangle(rng.below(cov.triangles.len() as u64) as usize);
+            let (mut u, mut v) = (rng.next_f64(), rng.next_f64());
+            match rng.below(4) {
+                0 => u = 0.0,
+                1 => (u, v) = (0.0, 0.0),
+                _ => {}
+            }
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let x = a + (b - a) * u + (c - a) * v;
+            let off = [0.0, 0.5, -0.5, 3.0, -3.0, 1e3, -1e3][rng.below(7) as usize] * eps;
+            let dir = if rng.below(2) == 0 {
+                (b - a).cross(c - a).normalize_or_zero()
+            } else {
+                rng.point_in_box(DVec3::NEG_ONE, DVec3::ONE).normalize_or_zero()
+            };
+            x + dir * off
+        })
+        .collect()
+}
+
+#[test]
+fn all_methods_agree_near_the_surface() {
+    let rot = glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+    let models = [
+        l_prism().map_positions(|p| rot * p).unwrap(),
+        procedural::two_cubes_sharing_edge(),
+        procedural::torus_knot(),
+        procedural::pyramid(),
+        monkey_saddle(0.3),
+    ];
+    for (i, mesh) in models.iter().enumerate() {
+        let points = near_surface_points(mesh, 1500, 50 + i as u64);
+        let oracle = WindingNumber::new(mesh).unwrap().classify_all(&points);
+        assert!(oracle.contains(&OnBoundary) && oracle.contains(&Inside) && oracle.contains(&Outside));
+        // The default apex, and the apex on a mesh vertex (many flat tetras).
+        for apex in [None, Some(mesh.positions()[0])] {
+            for c in all_methods(mesh, &Options { apex, ..Options::default() }) {
+                let got = c.classify_all(&points);
+                for (k, (g, w)) in got.iter().zip(&oracle).enumerate() {
+                    assert_eq!(g, w, "model {i}, apex {apex:?}: {} at {}", c.name(), points[k]);
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn agreement_with_the_apex_on_a_vertex_or_outside() {
     // The thesis' origin apex on a corner of the cube [0,1]³ (three faces' tetras flat), and

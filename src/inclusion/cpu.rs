@@ -36,8 +36,10 @@
 //! it concerns (faces through O), or sent to the fallback: a re-run with another apex when
 //! the pass saw an apex edge, the apex, a flat tetra, or ended with an odd sum (a pairing
 //! broken by a degenerate neighbour), and points within `1e-4·D` of the apex go straight
-//! to a re-run. After [`MAX_RERUNS`] ambiguous re-runs (never seen in practice) the answer
-//! comes from the winding number, which is reliable off the boundary.
+//! to a re-run. The winding number, reliable off the boundary, has the last word after
+//! [`MAX_RERUNS`] ambiguous re-runs, and at once for a point on an apex edge within
+//! [`NEAR_VERTEX`]·ε of its base vertex (a point off the boundary but that close to a mesh
+//! vertex or face centroid is within ε of every apex edge ending there, for any apex).
 //!
 //! Within ε of a base plane the point is first checked against the face itself
 //! (OnBoundary); if it is off the face, the side of the base is taken from the face's own
@@ -68,6 +70,9 @@ pub const MAX_RERUNS: usize = 8;
 /// Points closer than this (× bounding-box diagonal, max-norm) to the apex are re-run
 /// with another apex: near O the faces through O crowd within ε of each other.
 pub const APEX_BALL: f64 = 1e-4;
+/// A point this close (× ε) to a covering point, but off the boundary, is within ε of every
+/// apex edge ending there whatever the apex: re-runs cannot help, the winding number decides.
+pub const NEAR_VERTEX: f64 = 4.0;
 /// Default apex: the bounding-box centre moved by this (× the box's extent per axis), so
 /// symmetric models do not put the apex on their symmetry planes, edges or vertices.
 pub const APEX_SHIFT: DVec3 = DVec3::new(0.013_7, -0.021_1, 0.017_3);
@@ -135,6 +140,8 @@ enum Pass {
 struct Tally {
     acc: i32,
     ambiguous: bool,
+    /// P is on an apex edge within [`NEAR_VERTEX`]·ε of its base vertex: no apex helps.
+    near_vertex: bool,
     trace: Trace,
     /// The thesis' PosVert / NegVert (only filled with [`EdgeRule::VertexSets`]).
     pos: Vec<u32>,
@@ -276,6 +283,7 @@ impl FeitoTorres {
         let class = match pass {
             Pass::Boundary => Class::OnBoundary,
             Pass::Decided(c) => c,
+            Pass::Ambiguous if tally.near_vertex => self.fallback(p, &mut tally),
             Pass::Ambiguous => self.rerun(p, &mut tally),
         };
         tally.trace.class = class;
@@ -307,9 +315,17 @@ impl FeitoTorres {
             match self.fold(p, tally, verdicts, &sign_tie) {
                 Pass::Boundary => return Class::OnBoundary,
                 Pass::Decided(c) => return c,
+                Pass::Ambiguous if tally.near_vertex => break,
                 Pass::Ambiguous => {}
             }
         }
+        self.fallback(p, tally)
+    }
+
+    /// The last word: the winding number, reliable for points off the boundary (which
+    /// every pass has already checked).
+    #[cold]
+    fn fallback(&self, p: DVec3, tally: &mut Tally) -> Class {
         tally.trace.fallback = true;
         winding::classify(&self.surface, p)
     }
@@ -390,10 +406,12 @@ impl FeitoTorres {
             }
             Contact::ApexEdge(j) => {
                 tally.trace.apex_edges += 1;
+                let qj = covering.triangles[tri][j as usize];
+                let near = p.distance(covering.points[qj as usize]) <= NEAR_VERTEX * self.surface.eps();
+                tally.near_vertex |= near;
                 match self.rule {
                     EdgeRule::Rerun => tally.ambiguous = true,
                     EdgeRule::VertexSets => {
-                        let qj = covering.triangles[tri][j as usize];
                         let set = if s > 0 { &mut tally.pos } else { &mut tally.neg };
                         if !set.contains(&qj) {
                             set.push(qj);
