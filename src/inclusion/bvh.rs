@@ -9,6 +9,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use super::cpu::FeitoTorres;
+use super::tetra::CompactPlanes;
 use super::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Tetras per leaf.
@@ -42,6 +43,7 @@ pub struct Bvh {
     ft: FeitoTorres,
     nodes: Vec<Node>,
     order: Vec<u32>,
+    compact: Vec<CompactPlanes>,
     index_stats: BuildStats,
 }
 
@@ -85,9 +87,10 @@ impl Bvh {
             stack.push((left, a, mid));
             stack.push((left + 1, mid, b));
         }
-        let index_stats =
-            BuildStats { build_time: start.elapsed(), bytes: vec_bytes(&nodes) + vec_bytes(&order) };
-        Bvh { ft, nodes, order, index_stats }
+        let compact = ft.compact_planes();
+        let bytes = vec_bytes(&nodes) + vec_bytes(&order) + vec_bytes(&compact);
+        let index_stats = BuildStats { build_time: start.elapsed(), bytes };
+        Bvh { ft, nodes, order, compact, index_stats }
     }
 
     pub fn base(&self) -> &FeitoTorres {
@@ -154,7 +157,7 @@ impl Classifier for Bvh {
     }
 
     fn classify(&self, p: DVec3) -> Class {
-        self.ft.classify_among(p, self.candidates(p))
+        self.ft.classify_among_compact(p, self.candidates(p), &self.compact)
     }
 
     fn build_stats(&self) -> BuildStats {

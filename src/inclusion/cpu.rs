@@ -3,7 +3,8 @@
 //! For every covering tetra T = (O, Q1, Q2, Q3) with sign s, P adds 2s when strictly
 //! inside T, s when on exactly one face through O (that face's other tetra adds the other
 //! half), and nothing when outside; P within ε of a base triangle's face is OnBoundary.
-//! The sum is 2·w(P), w the winding number, so P is Inside iff the sum is non-zero.
+//! The sum is 2·w(P), w the winding number, so P is Inside iff the sum is non-zero (the
+//! thesis' `acc == 2` for every valid solid, where w ∈ {0, 1}).
 //!
 //! ## Points on an apex edge O–Qj: the thesis' vertex-set rule is not exact
 //!
@@ -12,8 +13,9 @@
 //! 2k, k the winding number of Qj's link (its neighbours' polygon) projected along O–Qj
 //! around that line. The rule assumes k = [some fan tetra positive] − [some negative]:
 //!
-//! - right when the fan has one sign and Qj is a manifold vertex (then k = ±1), or when
-//!   the fan is mixed and the link does not wind (k = 0), e.g. a dimple seen from the side;
+//! - right when the fan has one sign and Qj is a manifold vertex of an embedded surface
+//!   (its link is a simple loop, so k = ±1), or when the fan is mixed and the link does
+//!   not wind (k = 0), e.g. an L-prism's reflex corner or a dimple seen from the side;
 //! - **wrong** for a saddle vertex seen so that its link folds back but still winds once
 //!   (mixed signs, k = 1: the rule adds 0 instead of 2);
 //! - **wrong** at a non-manifold vertex, e.g. two cubes sharing an edge, O inside one cube
@@ -34,17 +36,33 @@
 //! it concerns (faces through O), or sent to the fallback: a re-run with another apex when
 //! the pass saw an apex edge, the apex, a flat tetra, or ended with an odd sum (a pairing
 //! broken by a degenerate neighbour), and points within `1e-4·D` of the apex go straight
-//! to a re-run. After [`MAX_RERUNS`] ambiguous re-runs (never seen in practice) the answer
-//! comes from the winding number, which is reliable off the boundary.
+//! to a re-run. The winding number, reliable off the boundary, has the last word after
+//! [`MAX_RERUNS`] ambiguous re-runs, and at once for a point on an apex edge within
+//! [`NEAR_VERTEX`]·ε of its base vertex (a point off the boundary but that close to a mesh
+//! vertex or face centroid is within ε of every apex edge ending there, for any apex).
+//!
+//! Within ε of a base plane the point is first checked against the face itself
+//! (OnBoundary); if it is off the face, the side of the base is taken from the face's own
+//! plane when the face is a planar n-gon, so that a non-convex face's overlapping positive
+//! and negative triangles decide alike and cancel.
+//!
+//! ## Speed
+//!
+//! `classify` is the thesis' baseline: one pass over every tetra, four plane tests each,
+//! evaluated without early exits (which tetras a point misses follows no pattern a branch
+//! predictor learns). Tetras are stored along a Morton curve of their triangles, so the
+//! optimizers, which read scattered subsets, touch runs of neighbours; they also prefilter
+//! with f32 planes ([`CompactPlanes`]) that only reject what the f64 test rejects.
 
 use std::time::Instant;
 
 use glam::DVec3;
 
 use super::surface::Surface;
-use super::tetra::{Contact, TetraPlanes, Verdict, octant_bit};
+use super::tetra::{CompactPlanes, CompactPoint, Contact, TetraPlanes, Verdict, octant_bit};
 use super::{BuildStats, Class, Classifier, Result, vec_bytes, winding};
 use crate::mesh::Mesh;
+use crate::mesh::covering::Covering;
 use crate::random::Rng;
 
 /// Re-runs with other apexes before giving up and using the winding number.
@@ -52,8 +70,11 @@ pub const MAX_RERUNS: usize = 8;
 /// Points closer than this (× bounding-box diagonal, max-norm) to the apex are re-run
 /// with another apex: near O the faces through O crowd within ε of each other.
 pub const APEX_BALL: f64 = 1e-4;
-/// Default apex: the bounding-box centre moved by this (× diagonal), so symmetric models
-/// do not put the apex on their symmetry planes, edges or vertices.
+/// A point this close (× ε) to a covering point, but off the boundary, is within ε of every
+/// apex edge ending there whatever the apex: re-runs cannot help, the winding number decides.
+pub const NEAR_VERTEX: f64 = 4.0;
+/// Default apex: the bounding-box centre moved by this (× the box's extent per axis), so
+/// symmetric models do not put the apex on their symmetry planes, edges or vertices.
 pub const APEX_SHIFT: DVec3 = DVec3::new(0.013_7, -0.021_1, 0.017_3);
 const RERUN_SEED: u64 = 0x7e7a_a9e7;
 
@@ -69,7 +90,7 @@ pub enum EdgeRule {
 /// What happened while classifying one point (for tests, debugging and GPU fallbacks).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Trace {
-    pub class: Option<Class>,
+    pub class: Class,
     /// Sum of the last pass (2·winding number when decided).
     pub acc: i32,
     /// Tetras the point was strictly inside of, on one face through O of, on an apex edge of.
@@ -86,12 +107,17 @@ pub struct Trace {
     pub fallback: bool,
 }
 
-/// The exact Feito-Torres classifier with basic preprocessing (Table 4-1, optimizer 1).
+/// The exact Feito-Torres classifier (Alg. 4-1, §4.3.1) with basic preprocessing (Table
+/// 4-1, optimizer 1): every tetra's planes and sign computed once, every tetra tested.
 #[derive(Clone, Debug)]
 pub struct FeitoTorres {
     surface: Surface,
     apex: DVec3,
     tetras: Vec<TetraPlanes>,
+    /// Covering triangle of each tetra: tetras follow a Morton curve through the triangles'
+    /// centroids, so tetras near in space are near in memory (cell lists of the TetraGrid,
+    /// BVH leaves and GPU groups read runs of neighbours).
+    order: Vec<u32>,
     rule: EdgeRule,
     apex_ball: f64,
     stats: BuildStats,
@@ -101,7 +127,7 @@ pub struct FeitoTorres {
 /// point works; a central one keeps the tetras and the determinants small).
 pub fn default_apex(surface: &Surface) -> DVec3 {
     let (lo, hi) = surface.bounds();
-    (lo + hi) * 0.5 + APEX_SHIFT * surface.scale()
+    (lo + hi) * 0.5 + APEX_SHIFT * (hi - lo)
 }
 
 enum Pass {
@@ -114,6 +140,8 @@ enum Pass {
 struct Tally {
     acc: i32,
     ambiguous: bool,
+    /// P is on an apex edge within [`NEAR_VERTEX`]·ε of its base vertex: no apex helps.
+    near_vertex: bool,
     trace: Trace,
     /// The thesis' PosVert / NegVert (only filled with [`EdgeRule::VertexSets`]).
     pos: Vec<u32>,
@@ -136,8 +164,10 @@ impl FeitoTorres {
         let start = Instant::now();
         let surface = Surface::new(mesh)?;
         let apex = apex.unwrap_or_else(|| default_apex(&surface));
-        let tetras = (0..surface.covering().triangles.len()).map(|t| tetra_at(&surface, apex, t)).collect();
+        let order = morton_order(surface.covering());
+        let tetras = order.iter().map(|&t| tetra_at(&surface, apex, t as usize)).collect();
         let mut ft = FeitoTorres {
+            order,
             apex_ball: APEX_BALL * surface.scale(),
             surface,
             apex,
@@ -145,8 +175,8 @@ impl FeitoTorres {
             rule,
             stats: BuildStats::default(),
         };
-        ft.stats =
-            BuildStats { build_time: start.elapsed(), bytes: ft.surface.bytes() + vec_bytes(&ft.tetras) };
+        let bytes = ft.surface.bytes() + vec_bytes(&ft.tetras) + vec_bytes(&ft.order);
+        ft.stats = BuildStats { build_time: start.elapsed(), bytes };
         Ok(ft)
     }
 
@@ -162,14 +192,20 @@ impl FeitoTorres {
         self.rule
     }
 
-    /// Per-tetra planes, in covering-triangle order (relative to [`Self::apex`]).
+    /// Per-tetra planes (relative to [`Self::apex`]), indexed by tetra id; tetra `t` is
+    /// built on covering triangle [`Self::tetra_triangle`]`(t)`.
     pub fn tetras(&self) -> &[TetraPlanes] {
         &self.tetras
     }
 
+    /// The covering triangle (index into `surface().covering().triangles`) of tetra `t`.
+    pub fn tetra_triangle(&self, t: usize) -> usize {
+        self.order[t] as usize
+    }
+
     /// Q1, Q2, Q3 of tetra `t` (absolute); the fourth vertex is the apex.
     pub fn tetra_vertices(&self, t: usize) -> [DVec3; 3] {
-        self.surface.covering().triangle(t)
+        self.surface.covering().triangle(self.tetra_triangle(t))
     }
 
     /// Flat upload arrays for a GPU pass: Q1, Q2, Q3 of every tetra relative to the apex
@@ -189,18 +225,39 @@ impl FeitoTorres {
     /// candidates hold every tetra whose grown box and octant mask hold `p` (the others
     /// would answer `Outside` anyway), which is how the optimizers use it.
     pub fn classify_among(&self, p: DVec3, candidates: impl IntoIterator<Item = u32>) -> Class {
-        self.run(p, candidates).class.unwrap_or(Class::Outside)
+        self.run(p, candidates, None).class
+    }
+
+    /// [`Self::classify_among`] with every candidate first checked against its f32 planes
+    /// (`compact[t]`, built by [`Self::compact_planes`]): same answers, fewer f64 tests and
+    /// cache lines for the optimizers, which visit tetras in scattered order.
+    pub fn classify_among_compact(
+        &self,
+        p: DVec3,
+        candidates: impl IntoIterator<Item = u32>,
+        compact: &[CompactPlanes],
+    ) -> Class {
+        self.run(p, candidates, Some(compact)).class
+    }
+
+    /// The f32 prefilter planes of every tetra, for [`Self::classify_among_compact`].
+    pub fn compact_planes(&self) -> Vec<CompactPlanes> {
+        self.tetras.iter().map(CompactPlanes::new).collect()
     }
 
     /// Classifies `p` and reports what the passes saw.
     pub fn trace(&self, p: DVec3) -> Trace {
-        self.run(p, 0..self.tetras.len() as u32)
+        self.run(p, 0..self.tetras.len() as u32, None)
     }
 
-    fn run(&self, p: DVec3, candidates: impl IntoIterator<Item = u32>) -> Trace {
+    fn run(
+        &self,
+        p: DVec3,
+        candidates: impl IntoIterator<Item = u32>,
+        compact: Option<&[CompactPlanes]>,
+    ) -> Trace {
         let mut tally = Tally::default();
         if !self.surface.in_bounds(p) {
-            tally.trace.class = Some(Class::Outside);
             return tally.trace;
         }
         let q = p - self.apex;
@@ -209,19 +266,27 @@ impl FeitoTorres {
         } else {
             let eps = self.surface.eps();
             let octant = octant_bit(q);
-            let verdicts =
-                candidates.into_iter().map(|t| (t, self.tetras[t as usize].verdict(q, octant, eps)));
-            self.fold(p, &mut tally, verdicts, &|t| {
+            let sign_tie = |t: u32| {
                 let tp = &self.tetras[t as usize];
                 (tp.sign, tp.tie)
-            })
+            };
+            let verdict = |t: u32| (t, self.tetras[t as usize].verdict(q, octant, eps));
+            match compact {
+                None => self.fold(p, &mut tally, candidates.into_iter().map(verdict), &sign_tie),
+                Some(compact) => {
+                    let cq = CompactPoint::new(q, eps);
+                    let kept = candidates.into_iter().filter(|&t| !compact[t as usize].rejects(&cq));
+                    self.fold(p, &mut tally, kept.map(verdict), &sign_tie)
+                }
+            }
         };
         let class = match pass {
             Pass::Boundary => Class::OnBoundary,
             Pass::Decided(c) => c,
+            Pass::Ambiguous if tally.near_vertex => self.fallback(p, &mut tally),
             Pass::Ambiguous => self.rerun(p, &mut tally),
         };
-        tally.trace.class = Some(class);
+        tally.trace.class = class;
         tally.trace
     }
 
@@ -240,19 +305,27 @@ impl FeitoTorres {
             }
             let octant = octant_bit(q);
             *tally = Tally { trace: tally.trace, ..Tally::default() };
-            let n = self.surface.covering().triangles.len() as u32;
-            let verdicts =
-                (0..n).map(|t| (t, tetra_at(&self.surface, o, t as usize).verdict(q, octant, eps)));
+            let n = self.tetras.len() as u32;
+            let at = |t: u32| tetra_at(&self.surface, o, self.order[t as usize] as usize);
+            let verdicts = (0..n).map(|t| (t, at(t).verdict(q, octant, eps)));
             let sign_tie = |t: u32| {
-                let tp = tetra_at(&self.surface, o, t as usize);
+                let tp = at(t);
                 (tp.sign, tp.tie)
             };
             match self.fold(p, tally, verdicts, &sign_tie) {
                 Pass::Boundary => return Class::OnBoundary,
                 Pass::Decided(c) => return c,
+                Pass::Ambiguous if tally.near_vertex => break,
                 Pass::Ambiguous => {}
             }
         }
+        self.fallback(p, tally)
+    }
+
+    /// The last word: the winding number, reliable for points off the boundary (which
+    /// every pass has already checked).
+    #[cold]
+    fn fallback(&self, p: DVec3, tally: &mut Tally) -> Class {
         tally.trace.fallback = true;
         winding::classify(&self.surface, p)
     }
@@ -267,7 +340,7 @@ impl FeitoTorres {
         sign_tie: &dyn Fn(u32) -> (i8, i8),
     ) -> Pass {
         for (t, v) in verdicts {
-            if v != Verdict::Outside && self.absorb(p, t, v, sign_tie, tally) {
+            if !matches!(v, Verdict::Outside) && self.absorb(p, t, v, sign_tie, tally) {
                 return Pass::Boundary;
             }
         }
@@ -290,7 +363,8 @@ impl FeitoTorres {
         tally: &mut Tally,
     ) -> bool {
         let covering = self.surface.covering();
-        let face = covering.face_of[t as usize] as usize;
+        let tri = self.order[t as usize] as usize;
+        let face = covering.face_of[tri] as usize;
         let contact = match v {
             Verdict::Outside => return false,
             Verdict::Contact(c) => c,
@@ -332,10 +406,12 @@ impl FeitoTorres {
             }
             Contact::ApexEdge(j) => {
                 tally.trace.apex_edges += 1;
+                let qj = covering.triangles[tri][j as usize];
+                let near = p.distance(covering.points[qj as usize]) <= NEAR_VERTEX * self.surface.eps();
+                tally.near_vertex |= near;
                 match self.rule {
                     EdgeRule::Rerun => tally.ambiguous = true,
                     EdgeRule::VertexSets => {
-                        let qj = covering.triangles[t as usize][j as usize];
                         let set = if s > 0 { &mut tally.pos } else { &mut tally.neg };
                         if !set.contains(&qj) {
                             set.push(qj);
@@ -348,6 +424,23 @@ impl FeitoTorres {
         }
         false
     }
+}
+
+/// Covering triangles sorted along a Z-order (Morton) curve of their centroids in the
+/// bounding box (10 bits per axis), ties by index.
+fn morton_order(covering: &Covering) -> Vec<u32> {
+    let (lo, hi) = covering.bounds();
+    let scale = 1023.0 / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
+    let spread = |v: u32| (0..10).fold(0u32, |k, b| k | ((v >> b) & 1) << (3 * b));
+    let mut keyed: Vec<(u32, u32)> = (0..covering.triangles.len())
+        .map(|t| {
+            let [a, b, c] = covering.triangle(t);
+            let q = (((a + b + c) / 3.0 - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1023.0)).as_uvec3();
+            (spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2, t as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, t)| t).collect()
 }
 
 /// The tetra of covering triangle `t` with apex `o`.

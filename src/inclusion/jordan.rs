@@ -9,7 +9,9 @@
 //!
 //! A ray that hits within 1e-9 (barycentric) of a triangle's edge or vertex, or grazes a
 //! triangle's plane (|cos| < 1e-7), is cast again in another direction from a fixed
-//! pseudo-random sequence. A point within ε of a face is OnBoundary before any ray is cast.
+//! pseudo-random sequence. A point within ε of a face is OnBoundary before any ray is cast;
+//! a point in the plane of a non-convex face, over its cancelled part, casts its rays from
+//! ε/2 off that plane ([`Surface::off_polygon_planes`]).
 
 use std::time::Instant;
 
@@ -170,9 +172,11 @@ impl Classifier for Jordan {
         if !surface.in_bounds(p) {
             return Class::Outside;
         }
-        if (0..surface.covering().triangles.len()).any(|t| surface.on_boundary_near(t, p)) {
+        let n = surface.covering().triangles.len();
+        if (0..n).any(|t| surface.on_boundary_near(t, p)) {
             return Class::OnBoundary;
         }
+        let p = surface.off_polygon_planes(p, 0..n);
         // Any ray from inside the box leaves it within two diagonals.
         let reach = 2.0 * surface.scale() + surface.eps();
         for d in directions().take(MAX_CASTS) {

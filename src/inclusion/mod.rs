@@ -13,21 +13,28 @@
 //! ## The tolerance rule (one rule, used everywhere)
 //!
 //! ε = [`surface::REL_TOL`] · D with `REL_TOL = 1e-9` and D the length of the mesh's
-//! bounding-box diagonal. All distances below are Euclidean, computed in f64 with unit
-//! normals:
+//! bounding-box diagonal. Distances are Euclidean, computed in f64 with unit normals:
 //!
-//! - *on the boundary*: distance from P to a face polygon ≤ ε (for an n-gon: to the part
-//!   of its covering its signed coverage does not cancel, or to one of its edges);
-//! - *on a tetra face* (Feito-Torres): distance from P to that face's plane ≤ ε; *on an
-//!   apex edge*: on two faces through the apex; a tetra is *flat* when its apex is within ε
-//!   of its base plane (or the apex is nearly collinear with a base edge, sin < 1e-6), and
-//!   *degenerate* when its base triangle's smallest height is ≤ ε;
+//! - *on the boundary*: distance from P to a face polygon ≤ ε. For an n-gon that means
+//!   within ε of one of its edges, or of a covering triangle at a point the polygon winds
+//!   around — the parts of the fan that a non-convex face's negative triangles cancel are
+//!   not boundary ([`surface::Surface::on_face`]). Every method calls this one predicate
+//!   for every face that may be within ε of P, so they agree on OnBoundary;
+//! - *on a tetra's face* (Feito-Torres): distance from P to that face's plane ≤ ε; *on an
+//!   apex edge*: on two faces through the apex; *at the apex*: on all three, or within
+//!   `1e-4·D` (max-norm) of it;
+//! - a tetra is *flat* when its apex is within ε of its base plane or nearly collinear with
+//!   a base edge (sine < 1e-6, [`tetra::SIN_MIN`]), and *degenerate* when its base
+//!   triangle's smallest height is ≤ ε;
 //! - points outside the mesh's bounding box grown by ε are Outside without further work.
 //!
-//! ε is far above f64 rounding for coordinates of size D (≈1e-16·D), so every decision
-//! taken with a margin larger than ε is geometrically right, and every decision within ε
-//! is either shared bit-for-bit by the two tetras it concerns or sends the point to an
-//! exact fallback (see [`cpu`]).
+//! ε is far above f64 rounding for coordinates of size D (≈1e-16·D), so a decision taken
+//! with a margin larger than ε is geometrically right; a decision within ε is either
+//! shared bit for bit by the two tetras it concerns or sends the point to an exact
+//! fallback (see [`cpu`]). Points at a distance of exactly ε (to within rounding) from a
+//! face may come out either way. The Jordan baselines add their own re-cast triggers
+//! (barycentric 1e-9, grazing 1e-7, [`jordan`]); they only choose when to cast another
+//! ray, never a class.
 
 use std::fmt;
 use std::str::FromStr;
@@ -56,8 +63,9 @@ pub use surface::Surface;
 
 /// Where a point lies relative to a solid. The numbers are what the CLI writes.
 #[repr(u8)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Class {
+    #[default]
     Outside = 0,
     Inside = 1,
     OnBoundary = 2,

@@ -13,7 +13,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use super::cpu::FeitoTorres;
-use super::tetra::octant_bit;
+use super::tetra::{CompactPlanes, octant_bit};
 use super::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Feito-Torres over the tetras of the point's octant.
@@ -23,6 +23,7 @@ pub struct Octants {
     /// Tetras of octant k are `ids[start[k]..start[k + 1]]`.
     start: [u32; 9],
     ids: Vec<u32>,
+    compact: Vec<CompactPlanes>,
     index_stats: BuildStats,
 }
 
@@ -41,9 +42,10 @@ impl Octants {
             );
             start[k + 1] = ids.len() as u32;
         }
-        let index_stats =
-            BuildStats { build_time: start_time.elapsed(), bytes: vec_bytes(&ids) + size_of_val(&start) };
-        Octants { ft, start, ids, index_stats }
+        let compact = ft.compact_planes();
+        let bytes = vec_bytes(&ids) + size_of_val(&start) + vec_bytes(&compact);
+        let index_stats = BuildStats { build_time: start_time.elapsed(), bytes };
+        Octants { ft, start, ids, compact, index_stats }
     }
 
     pub fn base(&self) -> &FeitoTorres {
@@ -67,7 +69,7 @@ impl Classifier for Octants {
 
     fn classify(&self, p: DVec3) -> Class {
         let k = octant_bit(p - self.ft.apex()).trailing_zeros() as usize;
-        self.ft.classify_among(p, self.octant_tetras(k).iter().copied())
+        self.ft.classify_among_compact(p, self.octant_tetras(k).iter().copied(), &self.compact)
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -195,11 +195,16 @@ impl Classifier for JordanOctree {
             return Class::Outside;
         }
         // Every triangle within ε of p has a grown box holding p, hence is in p's leaf.
-        if let Some(leaf) = self.leaf_of(p) {
-            if self.leaf_items(leaf).iter().any(|&t| surface.on_boundary_near(t as usize, p)) {
-                return Class::OnBoundary;
+        let p = match self.leaf_of(p) {
+            Some(leaf) => {
+                let items = self.leaf_items(leaf);
+                if items.iter().any(|&t| surface.on_boundary_near(t as usize, p)) {
+                    return Class::OnBoundary;
+                }
+                surface.off_polygon_planes(p, items.iter().map(|&t| t as usize))
             }
-        }
+            None => p,
+        };
         let reach = 2.0 * surface.scale() + surface.eps();
         for d in directions().take(MAX_CASTS) {
             if let Some(w) = self.crossings(p, d, reach) {

@@ -148,6 +148,31 @@ impl Surface {
         false
     }
 
+    /// `p`, or `p` moved ε/2 away from the plane of the first covering triangle of an n-gon
+    /// among `triangles` whose plane passes within ε of it (inside its grown box).
+    ///
+    /// For ray crossings and solid angles, a point lying in the plane of a non-convex
+    /// face, over its cancelled part, is ambiguous: the overlapping positive and negative
+    /// triangles each see it on a side decided by rounding. Off the boundary (> ε from every
+    /// face) nothing changes within ε/2, so classifying the moved point is exact and makes
+    /// those triangles agree. Triangle faces need no such care: within rounding of their
+    /// plane and over them, a point is on the boundary.
+    pub fn off_polygon_planes(&self, p: DVec3, triangles: impl IntoIterator<Item = usize>) -> DVec3 {
+        let c = &self.covering;
+        for t in triangles {
+            if c.face_triangles(c.face_of[t] as usize).len() < 2 || !self.near_triangle(t, p) {
+                continue;
+            }
+            let [a, b, cc] = c.triangle(t);
+            let Some(n) = (b - a).cross(cc - a).try_normalize() else { continue };
+            let d = n.dot(p - a);
+            if d.abs() <= self.eps {
+                return p + n * if d >= 0.0 { 0.5 * self.eps } else { -0.5 * self.eps };
+            }
+        }
+        p
+    }
+
     /// Heap bytes held.
     pub fn bytes(&self) -> usize {
         let c = &self.covering;

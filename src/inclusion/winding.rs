@@ -36,11 +36,14 @@ pub fn winding_number(surface: &Surface, p: DVec3) -> f64 {
     sum / (4.0 * PI)
 }
 
-/// OnBoundary within ε of a face, else Inside iff |w| ≥ 0.5.
+/// OnBoundary within ε of a face, else Inside iff |w| ≥ 0.5 (measured from a point moved
+/// off the plane of a non-convex face if `p` lies in one, see [`Surface::off_polygon_planes`]).
 pub fn classify(surface: &Surface, p: DVec3) -> Class {
-    if (0..surface.covering().triangles.len()).any(|t| surface.on_boundary_near(t, p)) {
+    let n = surface.covering().triangles.len();
+    if (0..n).any(|t| surface.on_boundary_near(t, p)) {
         return Class::OnBoundary;
     }
+    let p = surface.off_polygon_planes(p, 0..n);
     if winding_number(surface, p).abs() >= 0.5 { Class::Inside } else { Class::Outside }
 }
 
