@@ -143,7 +143,10 @@ fn flat_tetras_fall_back_to_the_cpu() {
     let mut gpu = GpuInclusion::new(&ctx, grid(), GpuOptions::default()).unwrap();
     assert_eq!(gpu.classify_all(&pts).unwrap(), want);
     let on_face = pts[pts.len() - 200..].iter().filter(|p| p.y.abs() <= 1.0 && p.z.abs() <= 1.0).count();
-    assert!(on_face > 50 && gpu.stats().flagged >= on_face, "points in the flat tetrahedra's plane are flagged");
+    assert!(
+        on_face > 50 && gpu.stats().flagged >= on_face,
+        "points in the flat tetrahedra's plane are flagged"
+    );
     let mut gpu = GpuGridInclusion::new(&ctx, grid(), 4).unwrap();
     assert_eq!(gpu.classify_all(&pts).unwrap(), want);
 }
