@@ -161,8 +161,18 @@ impl FeitoTorres {
     }
 
     pub fn with_options(mesh: &Mesh, apex: Option<DVec3>, rule: EdgeRule) -> Result<FeitoTorres> {
+        FeitoTorres::with_policy(mesh, apex, rule, false)
+    }
+
+    /// As [`Self::with_options`]; `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
+    pub fn with_policy(
+        mesh: &Mesh,
+        apex: Option<DVec3>,
+        rule: EdgeRule,
+        allow_open: bool,
+    ) -> Result<FeitoTorres> {
         let start = Instant::now();
-        let surface = Surface::new(mesh)?;
+        let surface = Surface::with_policy(mesh, allow_open)?;
         let apex = apex.unwrap_or_else(|| default_apex(&surface));
         let order = morton_order(surface.covering());
         let tetras = order.iter().map(|&t| tetra_at(&surface, apex, t as usize)).collect();

@@ -136,8 +136,13 @@ pub struct Jordan {
 
 impl Jordan {
     pub fn new(mesh: &Mesh) -> Result<Jordan> {
+        Jordan::with_policy(mesh, false)
+    }
+
+    /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
+    pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<Jordan> {
         let start = Instant::now();
-        let surface = Surface::new(mesh)?;
+        let surface = Surface::with_policy(mesh, allow_open)?;
         let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
         Ok(Jordan { surface, stats })
     }

@@ -213,25 +213,35 @@ pub struct Options {
     pub tetragrid_resolution: usize,
     /// Jordan octree depth (the thesis' "Octree-6").
     pub octree_depth: u32,
+    /// Accept a surface that is not closed and consistently oriented (answers are then
+    /// those of the covering's generalized winding number, not of a solid).
+    pub allow_open: bool,
 }
 
 impl Default for Options {
     fn default() -> Options {
-        Options { apex: None, tetragrid_resolution: tetragrid::DEFAULT_RESOLUTION, octree_depth: 6 }
+        Options {
+            apex: None,
+            tetragrid_resolution: tetragrid::DEFAULT_RESOLUTION,
+            octree_depth: 6,
+            allow_open: false,
+        }
     }
 }
 
 /// Builds the CPU classifier `method` for `mesh`.
 pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
-    let ft = || FeitoTorres::with_options(mesh, options.apex, EdgeRule::Rerun);
+    let ft = || FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open);
     Ok(match method {
         Method::Cpu => Box::new(ft()?),
         Method::Bvh => Box::new(bvh::Bvh::new(ft()?)),
         Method::Octants => Box::new(octants::Octants::new(ft()?)),
         Method::TetraGrid => Box::new(tetragrid::TetraGrid::new(ft()?, options.tetragrid_resolution)?),
-        Method::Jordan => Box::new(jordan::Jordan::new(mesh)?),
-        Method::JordanOctree => Box::new(octree::JordanOctree::new(mesh, options.octree_depth)?),
-        Method::Winding => Box::new(winding::WindingNumber::new(mesh)?),
+        Method::Jordan => Box::new(jordan::Jordan::with_policy(mesh, options.allow_open)?),
+        Method::JordanOctree => {
+            Box::new(octree::JordanOctree::with_policy(mesh, options.octree_depth, options.allow_open)?)
+        }
+        Method::Winding => Box::new(winding::WindingNumber::with_policy(mesh, options.allow_open)?),
         Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => return Err(InclusionError::NeedsGpu(method)),
     })
 }

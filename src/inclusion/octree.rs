@@ -55,11 +55,16 @@ pub struct JordanOctree {
 impl JordanOctree {
     /// Builds an octree of at most `depth` levels below the root (1..=10).
     pub fn new(mesh: &Mesh, depth: u32) -> Result<JordanOctree> {
+        JordanOctree::with_policy(mesh, depth, false)
+    }
+
+    /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
+    pub fn with_policy(mesh: &Mesh, depth: u32, allow_open: bool) -> Result<JordanOctree> {
         if !(1..=10).contains(&depth) {
             return Err(InclusionError::OctreeDepth(depth));
         }
         let start = Instant::now();
-        let surface = Surface::new(mesh)?;
+        let surface = Surface::with_policy(mesh, allow_open)?;
         let eps = surface.eps();
         let covering = surface.covering();
         let boxes: Vec<(DVec3, DVec3)> = (0..covering.triangles.len())

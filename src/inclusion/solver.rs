@@ -32,7 +32,7 @@ impl Solver {
     ) -> Result<Solver> {
         let grid = || {
             TetraGrid::new(
-                FeitoTorres::with_options(mesh, options.apex, super::EdgeRule::Rerun)?,
+                FeitoTorres::with_policy(mesh, options.apex, super::EdgeRule::Rerun, options.allow_open)?,
                 options.tetragrid_resolution,
             )
         };

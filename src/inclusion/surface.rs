@@ -29,10 +29,21 @@ impl Surface {
         Surface::from_covering(Covering::new(mesh))
     }
 
+    /// Like [`Surface::new`], but with `allow_open` an open or inconsistently oriented
+    /// surface is accepted as it is (`texgeo inclusion --allow-open`): the covering still
+    /// sums to the generalized winding number, which is no longer 0 or 1.
+    pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<Surface, InclusionError> {
+        if allow_open { Ok(Surface::unchecked(Covering::new(mesh))) } else { Surface::new(mesh) }
+    }
+
     pub fn from_covering(covering: Covering) -> Result<Surface, InclusionError> {
         if let Some(e) = covering.unbalanced_edge() {
             return Err(e.into());
         }
+        Ok(Surface::unchecked(covering))
+    }
+
+    fn unchecked(covering: Covering) -> Surface {
         let (lo, hi) = covering.bounds();
         let eps = REL_TOL * (hi - lo).length();
         let face_planes = (0..covering.num_faces())
@@ -55,7 +66,7 @@ impl Surface {
                 planar.then_some((n, off))
             })
             .collect();
-        Ok(Surface { covering, eps, lo, hi, face_planes })
+        Surface { covering, eps, lo, hi, face_planes }
     }
 
     pub fn covering(&self) -> &Covering {

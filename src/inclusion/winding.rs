@@ -56,8 +56,13 @@ pub struct WindingNumber {
 
 impl WindingNumber {
     pub fn new(mesh: &Mesh) -> Result<WindingNumber> {
+        WindingNumber::with_policy(mesh, false)
+    }
+
+    /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
+    pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<WindingNumber> {
         let start = Instant::now();
-        let surface = Surface::new(mesh)?;
+        let surface = Surface::with_policy(mesh, allow_open)?;
         let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
         Ok(WindingNumber { surface, stats })
     }

@@ -30,6 +30,9 @@ pub struct Args {
     /// GPU methods: tetrahedra per point-vertex (1 = the thesis' one point per tetrahedron).
     #[arg(long)]
     batch: Option<u32>,
+    /// Accept a mesh that is not closed and consistently oriented (with a warning).
+    #[arg(long)]
+    allow_open: bool,
     /// Write one line per point: 1 inside, 0 outside, 2 on the boundary.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -47,7 +50,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         (None, None) => anyhow::bail!("give --points FILE or --random N"),
     };
     let ctx = if method.is_cpu() { None } else { Some(crate::open_context(device)?) };
-    let options = Options { tetragrid_resolution: args.grid, ..Options::default() };
+    let options =
+        Options { tetragrid_resolution: args.grid, allow_open: args.allow_open, ..Options::default() };
+    if args.allow_open {
+        if let Some(e) = texgeo::mesh::covering::Covering::new(&mesh).unbalanced_edge() {
+            eprintln!(
+                "texgeo: warning: {} is not closed and consistently oriented (edge {}-{} used {}x one way, {}x the other); \
+                 answers follow the covering's winding number and may not describe a solid",
+                args.mesh, e.a, e.b, e.forward, e.backward
+            );
+        }
+    }
     let t = Instant::now();
     let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
