@@ -193,32 +193,47 @@ impl<'d> Recorder<'d> {
         layers: std::ops::Range<u32>,
         rect: Rect,
     ) -> Result<Buffer> {
+        let size = rect[2] as u64 * rect[3] as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
+        let buffer = Buffer::readback(self.dev, size)?;
+        self.readback_into(tex, layers, rect, &buffer, 0)?;
+        Ok(buffer)
+    }
+
+    /// Copies a rectangle of some layers of `tex` into `buffer` (made by
+    /// `Buffer::readback`) at byte `offset`, rows tightly packed, layer after layer —
+    /// many passes can share one readback buffer.
+    pub fn readback_into(
+        &mut self,
+        tex: &Texture,
+        layers: std::ops::Range<u32>,
+        rect: Rect,
+        buffer: &Buffer,
+        offset: u64,
+    ) -> Result<()> {
         self.check(tex)?;
         let [x, y, w, h] = rect;
+        let size = w as u64 * h as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
         if layers.is_empty()
             || layers.end > tex.layers()
             || w == 0
             || h == 0
             || x.checked_add(w).is_none_or(|e| e > tex.width())
             || y.checked_add(h).is_none_or(|e| e > tex.height())
+            || offset.checked_add(size).is_none_or(|e| e > buffer.size())
+            || offset % 4 != 0
         {
             return Err(GpuError::Usage(format!(
-                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture",
+                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture into {} bytes at {offset} of a {}-byte buffer",
                 tex.width(),
                 tex.height(),
-                tex.layers()
+                tex.layers(),
+                size,
+                buffer.size()
             )));
         }
-        let size = w as u64 * h as u64 * (layers.end - layers.start) as u64 * tex.format().bytes_per_texel();
-        let buffer = Buffer::new(
-            self.dev,
-            size,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-            "readback",
-        )?;
         self.use_texture(tex, Use::CopySrc);
         let region = [vk::BufferImageCopy::default()
+            .buffer_offset(offset)
             .image_subresource(
                 vk::ImageSubresourceLayers::default()
                     .aspect_mask(vk::ImageAspectFlags::COLOR)
@@ -234,8 +249,8 @@ impl<'d> Recorder<'d> {
             .dst_stage_mask(vk::PipelineStageFlags2::HOST)
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
         let dep = vk::DependencyInfo::default().memory_barriers(&host);
-        // SAFETY: region checked above; the buffer is returned to the caller, who keeps it
-        // at least until `submit` returns.
+        // SAFETY: region checked above; the caller keeps the buffer at least until
+        // `submit` returns.
         unsafe {
             self.dev.raw.cmd_copy_image_to_buffer(
                 self.cmd,
@@ -246,7 +261,7 @@ impl<'d> Recorder<'d> {
             );
             self.dev.raw.cmd_pipeline_barrier2(self.cmd, &dep);
         }
-        Ok(buffer)
+        Ok(())
     }
 
     /// Resets `timer` (call before the first `timestamp` of a submission).
@@ -507,24 +522,36 @@ impl<'p> RenderScope<'_, 'p> {
     /// Binds the per-vertex (and, when the pipeline has per-instance inputs, per-instance)
     /// vertex buffers.
     pub fn vertex_buffers(&mut self, per_vertex: &Buffer, per_instance: Option<&Buffer>) -> Result<()> {
+        self.vertex_buffers_at(Some((per_vertex, 0)), per_instance.map(|b| (b, 0)))
+    }
+
+    /// Binds vertex buffers starting at byte offsets; `None` where the pipeline has no
+    /// inputs of that rate (per vertex, per instance).
+    pub fn vertex_buffers_at(
+        &mut self,
+        per_vertex: Option<(&Buffer, u64)>,
+        per_instance: Option<(&Buffer, u64)>,
+    ) -> Result<()> {
         let strides = self.bound()?.strides;
-        let mut raw = Vec::new();
-        if strides[0] > 0 {
-            raw.push(per_vertex.raw);
-        }
-        match (strides[1] > 0, per_instance) {
-            (true, Some(b)) => raw.push(b.raw),
-            (false, None) => {}
-            (true, None) => return Err(GpuError::Usage("the pipeline needs a per-instance buffer".into())),
-            (false, Some(_)) => {
-                return Err(GpuError::Usage("the pipeline has no per-instance inputs".into()));
+        let bind = |binding: u32, stride: u32, buffer: Option<(&Buffer, u64)>, what: &str| -> Result<()> {
+            match (stride > 0, buffer) {
+                (true, Some((b, offset))) => {
+                    if offset >= b.size() {
+                        return Err(GpuError::Usage(format!("{what} buffer offset {offset} past its end")));
+                    }
+                    // SAFETY: buffer alive for the submission; offset inside it.
+                    unsafe { self.dev.raw.cmd_bind_vertex_buffers(self.cmd, binding, &[b.raw], &[offset]) };
+                    Ok(())
+                }
+                (false, None) => Ok(()),
+                (true, None) => Err(GpuError::Usage(format!("the pipeline needs a {what} buffer"))),
+                // A buffer for inputs the pipeline lacks is ignored only when it is the
+                // per-vertex one of a vertex-less pipeline (e.g. a full-target quad).
+                (false, Some(_)) => Err(GpuError::Usage(format!("the pipeline has no {what} inputs"))),
             }
-        }
-        let first = if strides[0] > 0 { 0 } else { 1 };
-        let offsets = vec![0; raw.len()];
-        // SAFETY: buffers alive for the submission.
-        unsafe { self.dev.raw.cmd_bind_vertex_buffers(self.cmd, first, &raw, &offsets) };
-        Ok(())
+        };
+        bind(0, strides[0], per_vertex, "per-vertex")?;
+        bind(1, strides[1], per_instance, "per-instance")
     }
 
     /// Draws `vertices` vertices (points or triangle corners), `instances` times.

@@ -2,6 +2,7 @@
 
 mod bench;
 mod demo;
+mod inclusion;
 mod info;
 mod mesh;
 mod voxelize;
@@ -31,6 +32,8 @@ enum Command {
     /// Inspect and convert meshes (OBJ, OFF, PLY, STL).
     #[command(subcommand)]
     Mesh(mesh::Command),
+    /// Point in solid (Feito-Torres): classify query points as inside, outside or on the boundary.
+    Inclusion(inclusion::Args),
     /// Run a benchmark and write Markdown + CSV tables.
     #[command(subcommand)]
     Bench(bench::Command),
@@ -52,6 +55,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
         Command::Mesh(c) => mesh::run(c),
+        Command::Inclusion(a) => inclusion::run(device, a),
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
