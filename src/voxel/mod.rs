@@ -125,12 +125,15 @@ pub struct Voxelizer {
     section: Option<crate::gpu::Pipeline>,
     /// Zone height for `zoned` (None: [`pgpu::zone_height`]).
     pub zone: Option<usize>,
+    /// Apply the exact fallback near the surface (on by default; off only to study a
+    /// method's raw output — it can then be wrong there).
+    pub fallback: bool,
 }
 
 impl Voxelizer {
     /// A voxelizer; GPU methods need `ctx`.
     pub fn new(ctx: Option<Context>) -> Voxelizer {
-        Voxelizer { ctx, slice: None, section: None, zone: None }
+        Voxelizer { ctx, slice: None, section: None, zone: None, fallback: true }
     }
 
     fn context(&self, method: Method) -> Result<&Context> {
@@ -152,7 +155,7 @@ impl Voxelizer {
                 let mut volume = cpu::rasterize(solid, grid)?;
                 timings.draw = t.elapsed();
                 let t = Instant::now();
-                let report = band::fix(&mut volume, solid, grid, band::tolerance_f64(grid.n))?;
+                let report = self.fix(&mut volume, solid, grid, band::tolerance_f64(grid.n))?;
                 timings.fallback = t.elapsed();
                 (volume, report)
             }
@@ -167,7 +170,7 @@ impl Voxelizer {
                 let mut volume = self.run_gpu(&ctx, solid, grid, method, &mut timings)?;
                 let t = Instant::now();
                 let tau = band::tolerance_gpu(grid.n, ctx.info().sub_pixel_bits);
-                let report = band::fix(&mut volume, solid, grid, tau)?;
+                let report = self.fix(&mut volume, solid, grid, tau)?;
                 timings.fallback = t.elapsed();
                 (volume, report)
             }
@@ -178,6 +181,14 @@ impl Voxelizer {
 }
 
 impl Voxelizer {
+    fn fix(&self, volume: &mut Volume, solid: &Solid, grid: &Grid, tau: f64) -> Result<BandReport> {
+        if self.fallback {
+            band::fix(volume, solid, grid, tau)
+        } else {
+            Ok(BandReport { tolerance: tau, ..BandReport::default() })
+        }
+    }
+
     fn run_gpu(
         &mut self,
         ctx: &Context,

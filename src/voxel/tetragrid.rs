@@ -88,23 +88,39 @@ pub fn enlarge(t: &[DVec3; 4], offset: f64) -> Option<[DVec3; 4]> {
 /// whose centres the enlarged tetra (planes moved by `offset_diagonals` voxel diagonals)
 /// covers. A flat tetra gets the cells of its grown bounding box.
 pub fn cells(grid: &Grid, t: &[DVec3; 4], offset_diagonals: f64, out: &mut Vec<u32>) {
-    let h = grid.h();
-    let offset = offset_diagonals * h * 3f64.sqrt();
+    let n = grid.n;
+    let offset = offset_diagonals * grid.h() * 3f64.sqrt();
+    for_each_cell(grid.min, grid.h(), n, t, offset, |i, j, k| out.push(cell_index(n, i, j, k) as u32));
+}
+
+/// The conservative rasterizer itself, for any n³ grid of cubic cells of side `cell`
+/// whose minimum corner is `origin` (so other grids, like the inclusion TetraGrid's, can
+/// use it): calls `f(i, j, k)` for every cell whose centre lies inside the tetra `t` with
+/// its face planes moved outward by `offset` (world units) and inside its bounding box
+/// grown by `offset`. With `offset` ≥ cell·√3/2 every cell `t` touches is visited.
+pub fn for_each_cell(
+    origin: DVec3,
+    cell: f64,
+    n: usize,
+    t: &[DVec3; 4],
+    offset: f64,
+    mut f: impl FnMut(usize, usize, usize),
+) {
     let lo = t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p)) - DVec3::splat(offset);
     let hi = t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p)) + DVec3::splat(offset);
     // Rounding slack, far below any cell size.
-    let slack = 1e-9 * (hi - lo).max_element().max(h);
-    let planes = face_planes(t).map(|p| p.map(|(n, d)| (n, d + offset + slack)));
-    let n = grid.n;
+    let slack = 1e-9 * (hi - lo).max_element().max(cell);
+    let planes = face_planes(t).map(|p| p.map(|(nrm, d)| (nrm, d + offset + slack)));
     let range = |min: f64, a: f64, b: f64| -> std::ops::Range<usize> {
-        let first = ((a - slack - min) / h - 0.5).ceil().max(0.0);
-        let last = ((b + slack - min) / h - 0.5).floor().min(n as f64 - 1.0);
+        let first = ((a - slack - min) / cell - 0.5).ceil().max(0.0);
+        let last = ((b + slack - min) / cell - 0.5).floor().min(n as f64 - 1.0);
         if first > last { 0..0 } else { first as usize..last as usize + 1 }
     };
-    for j in range(grid.min.y, lo.y, hi.y) {
-        let y = grid.centre_coord(grid.min.y, j);
-        for k in range(grid.min.z, lo.z, hi.z) {
-            let z = grid.centre_coord(grid.min.z, k);
+    let centre = |min: f64, i: usize| min + (i as f64 + 0.5) * cell;
+    for j in range(origin.y, lo.y, hi.y) {
+        let y = centre(origin.y, j);
+        for k in range(origin.z, lo.z, hi.z) {
+            let z = centre(origin.z, k);
             // The x interval of the row inside all four moved planes.
             let (mut xa, mut xb) = (lo.x, hi.x);
             if let Some(planes) = &planes {
@@ -118,11 +134,10 @@ pub fn cells(grid: &Grid, t: &[DVec3; 4], offset_diagonals: f64, out: &mut Vec<u
                     }
                 }
             }
-            if xa > xb {
-                continue;
-            }
-            for i in range(grid.min.x, xa, xb) {
-                out.push(cell_index(n, i, j, k) as u32);
+            if xa <= xb {
+                for i in range(origin.x, xa, xb) {
+                    f(i, j, k);
+                }
             }
         }
     }
