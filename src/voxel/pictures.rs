@@ -42,3 +42,27 @@ pub fn write_rgba_slices(n: usize, slices: &[Vec<u8>], dir: &Path) -> Result<Vec
         })
         .collect()
 }
+
+/// A rendered picture of the volume (SPEC §4.1): the solid seen from −z, each pixel the
+/// first occupied voxel along +z, shaded by depth; coloured by `aspect` slices (as from
+/// `aspect::render`) when given, grey otherwise. y points up.
+pub fn render_front(volume: &Volume, aspect: Option<&[Vec<u8>]>) -> image::RgbaImage {
+    let n = volume.n();
+    let mut img = image::RgbaImage::from_pixel(n as u32, n as u32, image::Rgba([24, 26, 32, 255]));
+    for j in 0..n {
+        for i in 0..n {
+            let Some(k) = (0..n).find(|&k| volume.get(i, j, k)) else { continue };
+            let shade = 1.0 - 0.65 * k as f32 / n as f32;
+            let base = match aspect.and_then(|a| a.get(j)) {
+                Some(s) if s.len() >= n * n * 4 => {
+                    let o = (k * n + i) * 4;
+                    [s[o], s[o + 1], s[o + 2]]
+                }
+                _ => [210, 210, 210],
+            };
+            let c = base.map(|v| (v as f32 * shade) as u8);
+            img.put_pixel(i as u32, (n - 1 - j) as u32, image::Rgba([c[0], c[1], c[2], 255]));
+        }
+    }
+    img
+}

@@ -6,6 +6,7 @@ use anyhow::Context as _;
 use texgeo::gpu::{TexFormat, XorRaster, reduce_sum};
 use texgeo::mesh::procedural;
 use texgeo::random::Rng;
+use texgeo::voxel;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -81,5 +82,35 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             r.euler_characteristic
         );
     }
+
+    // 4. Voxelization (issue 4): the torus knot sliced by the zoned vertex shader, checked
+    // against the exact scanline, written as binvox, PNG slices and a marble picture.
+    let knot = procedural::torus_knot();
+    let n = 96;
+    let grid = voxel::Grid::for_mesh(&knot, n)?;
+    let solid = voxel::Solid::new(&knot)?;
+    let mut voxelizer = voxel::Voxelizer::new(Some(ctx.clone()));
+    let zoned = voxelizer.run(&solid, &grid, voxel::Method::Zoned)?;
+    let exact = voxelizer.run(&solid, &grid, voxel::Method::Scanline)?;
+    anyhow::ensure!(zoned.volume == exact.volume, "zoned and scanline voxelizations differ");
+    let binvox_path = args.out.join("knot.binvox");
+    voxel::binvox::write(&binvox_path, &grid, &zoned.volume)?;
+    let slices = voxel::pictures::write_slices(&zoned.volume, &args.out.join("knot-slices"))?;
+    let colours = voxel::aspect::render(&ctx, &zoned.volume, &voxel::aspect::Aspect::default())?;
+    voxel::pictures::write_rgba_slices(n, &colours, &args.out.join("knot-aspect"))?;
+    let picture = args.out.join("knot-voxels.png");
+    voxel::pictures::render_front(&zoned.volume, Some(&colours))
+        .save(&picture)
+        .with_context(|| format!("writing {}", picture.display()))?;
+    println!(
+        "\nvoxelized the torus knot at {n}³ (zoned, {:.0} ms): {} voxels occupied, equal to the exact scanline; \
+         {} centres near the surface decided exactly; wrote {}, {} slice PNGs, marble slices and {}",
+        zoned.timings.total.as_secs_f64() * 1e3,
+        zoned.volume.count(),
+        zoned.band.candidates,
+        binvox_path.display(),
+        slices.len(),
+        picture.display()
+    );
     Ok(())
 }

@@ -99,7 +99,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         let params = Aspect { material: args.material, frequency: args.frequency, ..Aspect::default() };
         let slices = aspect::render(ctx, &result.volume, &params)?;
         let files = pictures::write_rgba_slices(args.res, &slices, &dir)?;
-        println!("wrote {} {} aspect slices into {}", files.len(), args.material.name(), dir.display());
+        let picture = dir.join("front.png");
+        pictures::render_front(&result.volume, Some(&slices))
+            .save(&picture)
+            .with_context(|| format!("writing {}", picture.display()))?;
+        println!(
+            "wrote {} {} aspect slices and a rendered view {} into {}",
+            files.len(),
+            args.material.name(),
+            picture.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(),
+            dir.display()
+        );
     }
     Ok(())
 }
