@@ -4,7 +4,8 @@
 
 use glam::DVec3;
 use texgeo::gpu::Context;
-use texgeo::inclusion::gpu::{GpuGridInclusion, GpuInclusion, GpuOptions, Phase2};
+use texgeo::inclusion::gpu::{GpuInclusion, GpuOptions, Phase2};
+use texgeo::inclusion::gpu_grid::GpuGridInclusion;
 use texgeo::inclusion::tetragrid::TetraGrid;
 use texgeo::inclusion::{Class, Classifier, FeitoTorres};
 use texgeo::mesh::{Mesh, procedural};
