@@ -89,9 +89,12 @@ fn point_sets(mesh: &Mesh, cfg: &Config) -> Vec<Vec<DVec3>> {
     (0..cfg.sets).map(|k| Rng::new(4000 + k as u64).points_in_box(cfg.points, lo, hi)).collect()
 }
 
+/// Something that classifies a set of points (a CPU classifier or a GPU solver).
+type Classify<'a> = dyn FnMut(&[DVec3]) -> Result<Vec<Class>, InclusionError> + 'a;
+
 /// Mean time per set and whether every answer equals `want`.
 fn mean_time(
-    solver: &mut dyn FnMut(&[DVec3]) -> Result<Vec<Class>, InclusionError>,
+    solver: &mut Classify,
     sets: &[Vec<DVec3>],
     want: &[Vec<Class>],
 ) -> Result<(Duration, bool), InclusionError> {
