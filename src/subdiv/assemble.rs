@@ -1,0 +1,218 @@
+//! Assembly of the refined mesh from the last fragment stream (SPEC §5.4; the thesis'
+//! "se descarta el anillo externo"): each fragment keeps only its owned region, and
+//! vertices are welded *topologically*, by the coarse-mesh element they lie on, never by
+//! position.
+//!
+//! After `j` fragment levels every coarse quad is a G × G grid of quads (G = 2^(j+1)),
+//! whose four corner quarters are owned by the fragments at its four corners. The output
+//! is numbered by coarse element, so it is closed and manifold whenever the coarse mesh
+//! is, whatever the positions:
+//!
+//! - coarse vertex v → vertex v;
+//! - edge e, point t ∈ (0, G) steps from its first vertex → `V + e·(G−1) + t − 1`;
+//! - face f, grid point (i, j) with 0 < i, j < G in the frame of its corner 0 (i towards
+//!   corner 1, j towards corner 3) → `V + E·(G−1) + f·(G−1)² + (j−1)·(G−1) + i − 1`.
+//!
+//! Each position is gathered from the fragment that owns it (points shared by two or four
+//! owned regions are taken from one of them). Faces and positions are filled in parallel
+//! over blocks of coarse faces and edges.
+
+use glam::DVec3;
+
+use crate::mesh::Mesh;
+
+use super::fragment::FragmentMesh;
+use super::topology::Topology;
+use super::{Result, SubdivError};
+
+/// Builds the refined mesh from `stream`, a fragment stream of ring radius `radius` in
+/// which every fragment holds its owned region after `levels` fragment levels
+/// (`2^levels ≤ radius` rings). `position` reads one stream entry.
+pub fn assemble<T: Sync>(
+    fragments: &FragmentMesh,
+    stream: &[T],
+    radius: u32,
+    levels: u32,
+    position: impl Fn(&T) -> DVec3 + Sync,
+) -> Result<Mesh> {
+    let owned = 1u64 << levels;
+    let layout = fragments.layout(radius);
+    if owned > u64::from(radius) || (stream.len() as u64) < layout.total {
+        return Err(SubdivError::Fragment(format!(
+            "a stream of {} entries at ring radius {radius} cannot hold {owned} owned rings ({} entries needed)",
+            stream.len(),
+            layout.total
+        )));
+    }
+    let topo = fragments.coarse();
+    let g = 2 * owned;
+    let (nv, ne, nf) = (topo.num_vertices() as u64, topo.num_edges() as u64, topo.num_faces() as u64);
+    let vertices = nv + ne * (g - 1) + nf * (g - 1) * (g - 1);
+    let quads = nf * g * g;
+    if vertices >= u64::from(u32::MAX) || 4 * quads >= u64::from(u32::MAX) {
+        return Err(SubdivError::TooLarge { level: fragments.cpu_levels() + levels, vertices });
+    }
+    let grid = Grid { topo, g: g as u32, nv: nv as u32, face0: (nv + ne * (g - 1)) as u32 };
+    let n = owned as u32;
+
+    // Faces: a G × G grid of quads per coarse face, in face order.
+    let mut indices = vec![0u32; (4 * quads) as usize];
+    let per_face = (4 * g * g) as usize;
+    for_each_block(&mut indices, per_face, |first, block| {
+        let mut ids = Vec::new();
+        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+            grid.face_ids((first + k) as u32, &mut ids);
+            let row = grid.g as usize + 1;
+            let mut q = 0;
+            for j in 0..grid.g as usize {
+                for i in 0..grid.g as usize {
+                    let c = j * row + i;
+                    out[q..q + 4].copy_from_slice(&[ids[c], ids[c + 1], ids[c + 1 + row], ids[c + row]]);
+                    q += 4;
+                }
+            }
+        }
+    });
+
+    // Positions, gathered from the owning fragment.
+    let mut positions = vec![DVec3::ZERO; vertices as usize];
+    let (vertex_part, rest) = positions.split_at_mut(nv as usize);
+    let (edge_part, face_part) = rest.split_at_mut((ne * (g - 1)) as usize);
+    let at = |f: u32, s: u32, a: u32, b: u32| {
+        let class = fragments.fragments()[f as usize].class;
+        let i = fragments.fragment_start(&layout, f) + class.index(s, a.into(), b.into());
+        position(&stream[i as usize])
+    };
+    for (v, out) in vertex_part.iter_mut().enumerate() {
+        *out = match fragments.fragment_of(v as u32) {
+            Some(f) => at(f, 0, 0, 0),
+            // A vertex no face uses stays where it is.
+            None => fragments.base_positions()[v],
+        };
+    }
+    let per_edge = (g - 1) as usize;
+    for_each_block(edge_part, per_edge, |first, block| {
+        for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
+            let e = (first + k) as u32;
+            let ends = topo.edge_vertices(e);
+            let frag = ends.map(|v| fragments.fragment_of(v).unwrap_or(0));
+            let spoke = ends.map(|v| fragments.spoke_along(e, v));
+            for (t, p) in (1..grid.g).zip(out.iter_mut()) {
+                *p = if t <= n { at(frag[0], spoke[0], t, 0) } else { at(frag[1], spoke[1], grid.g - t, 0) };
+            }
+        }
+    });
+    let per_face = ((g - 1) * (g - 1)) as usize;
+    for_each_block(face_part, per_face, |first, block| {
+        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+            let f = (first + k) as u32;
+            let owner = corner_owners(fragments, f);
+            let mut p = out.iter_mut();
+            for j in 1..grid.g {
+                for i in 1..grid.g {
+                    // The quarter (corner m) holding (i, j), and (a, b) in that corner's sector.
+                    let (m, a, b) = match (i <= n, j <= n) {
+                        (true, true) => (0, i, j),
+                        (false, true) => (1, j, grid.g - i),
+                        (false, false) => (2, grid.g - i, grid.g - j),
+                        (true, false) => (3, grid.g - j, i),
+                    };
+                    if let Some(out) = p.next() {
+                        *out = at(owner[m].0, owner[m].1, a, b);
+                    }
+                }
+            }
+        }
+    });
+
+    let offsets = (0..=(4 * quads) as usize).step_by(4).collect();
+    Ok(Mesh::from_parts(positions, offsets, indices)?)
+}
+
+/// The fragment and sector owning each corner quarter of coarse face `f`.
+fn corner_owners(fragments: &FragmentMesh, f: u32) -> [(u32, u32); 4] {
+    let h0 = fragments.coarse().face_half_edges(f).start;
+    std::array::from_fn(|m| {
+        let h = h0 + m as u32;
+        let c = fragments.coarse().origin(h);
+        (fragments.fragment_of(c).unwrap_or(0), fragments.sector_of(h))
+    })
+}
+
+/// Output vertex numbering of the (G + 1)² grid points of a coarse face.
+struct Grid<'a> {
+    topo: &'a Topology,
+    g: u32,
+    nv: u32,
+    /// First id of face-interior points.
+    face0: u32,
+}
+
+impl Grid<'_> {
+    /// Ids of the grid points of face `f`, row by row (j outer, i inner).
+    fn face_ids(&self, f: u32, ids: &mut Vec<u32>) {
+        let g = self.g;
+        let row = g as usize + 1;
+        ids.clear();
+        ids.resize(row * row, 0);
+        let h0 = self.topo.face_half_edges(f).start;
+        // Side m runs from corner m to corner m + 1; `t` counts steps from corner m.
+        let side = |m: u32, t: u32| {
+            let h = h0 + m;
+            let e = self.topo.edge(h);
+            let t = if self.topo.edge_half_edge(e) == h { t } else { g - t };
+            self.nv + e * (g - 1) + t - 1
+        };
+        let corner = |m: u32| self.topo.origin(h0 + m);
+        for j in 0..=g {
+            for i in 0..=g {
+                let id = match (i, j) {
+                    (0, 0) => corner(0),
+                    (_, 0) if i == g => corner(1),
+                    (_, _) if i == g && j == g => corner(2),
+                    (0, _) if j == g => corner(3),
+                    (_, 0) => side(0, i),
+                    (_, _) if i == g => side(1, j),
+                    (_, _) if j == g => side(2, g - i),
+                    (0, _) => side(3, g - j),
+                    _ => self.face0 + f * (g - 1) * (g - 1) + (j - 1) * (g - 1) + (i - 1),
+                };
+                ids[j as usize * row + i as usize] = id;
+            }
+        }
+    }
+}
+
+/// Runs `work(first_item, block)` over `out` cut into about one block per core, each
+/// block a whole number of `item_len`-long items.
+fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, &mut [T]) + Sync) {
+    if item_len == 0 || out.is_empty() {
+        return;
+    }
+    let items = out.len() / item_len;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(items.max(1));
+    let per_block = items.div_ceil(threads);
+    std::thread::scope(|scope| {
+        for (b, block) in out.chunks_mut(per_block * item_len).enumerate() {
+            let work = &work;
+            scope.spawn(move || work(b * per_block, block));
+        }
+    });
+}
+
+/// Watertightness of a mesh (SPEC §5.4): manifold and consistently oriented (else the
+/// topology error), and its boundary-edge count and Euler characteristic V − E + F.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Watertight {
+    pub boundary_edges: usize,
+    pub euler: i64,
+}
+
+impl Watertight {
+    pub fn of(mesh: &Mesh) -> Result<Watertight> {
+        let topo = Topology::new(mesh)?;
+        let boundary_edges = (0..topo.num_edges() as u32).filter(|&e| topo.is_boundary_edge(e)).count();
+        let euler = mesh.num_vertices() as i64 - topo.num_edges() as i64 + mesh.num_faces() as i64;
+        Ok(Watertight { boundary_edges, euler })
+    }
+}
