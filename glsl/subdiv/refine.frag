@@ -55,27 +55,19 @@ int ring_offset(int r) {
 }
 
 // Input texel of vertex (a, b) of sector s, after moving (a, -1) and (0, b) to the
-// neighbouring sector.
+// neighbouring sector. Written with selects, not branches: SIMD lanes diverge here.
 vec3 at(int s, int a, int b) {
-    if (b < 0) {
-        b = a;
-        a = 1;
-        s = (s == 0) ? K - 1 : s - 1;
-    }
-    int i = BASE;
-    if (a == 0 && b != 0) {
-        a = b;
-        b = 0;
-        s += 1;
-        if (s == K && E == 0) {
-            s = 0;
-        }
-    }
-    if (a != 0) {
-        int r = max(a, b);
-        int t = (a == r) ? b : 2 * r - a;
-        i += 1 + ring_offset(r) + s * 2 * r + t;
-    }
+    bool below = b < 0;
+    int s1 = below ? ((s == 0) ? K - 1 : s - 1) : s;
+    int a1 = below ? 1 : a;
+    int b1 = below ? a : b;
+    bool on_next = a1 == 0;
+    int s2 = on_next ? ((s1 + 1 == K && E == 0) ? 0 : s1 + 1) : s1;
+    int a2 = on_next ? b1 : a1;
+    int b2 = on_next ? 0 : b1;
+    int r = max(a2, b2);
+    int t = (a2 == r) ? b2 : 2 * r - a2;
+    int i = BASE + ((a2 == 0) ? 0 : 1 + ring_offset(r) + s2 * 2 * r + t);
     return texelFetch(src, ivec2(i & ((1 << pc.log2_width) - 1), i >> pc.log2_width), 0).xyz;
 }
 
@@ -142,31 +134,23 @@ void main() {
         int a = (s == K || t <= r) ? r : 2 * r - t;
         int b = (s == K) ? 0 : min(t, r);
         bool border = E == 1 && b == 0 && (s == 0 || s == K);
-        int a2 = a >> 1;
-        int b2 = b >> 1;
-        if ((a & 1) == 0 && (b & 1) == 0) {
-            if (border) {
-                p = 0.75 * at(s, a2, 0) + 0.125 * (at(s, a2 - 1, 0) + at(s, a2 + 1, 0));
-            } else {
-                vec3 edges = at(s, a2 + 1, b2) + at(s, a2 - 1, b2) + at(s, a2, b2 + 1) + at(s, a2, b2 - 1);
-                vec3 diagonals = at(s, a2 + 1, b2 + 1) + at(s, a2 - 1, b2 + 1) + at(s, a2 + 1, b2 - 1)
-                    + at(s, a2 - 1, b2 - 1);
-                p = (36.0 * at(s, a2, b2) + 6.0 * edges + diagonals) / 64.0;
-            }
-        } else if ((b & 1) == 0) {
-            vec3 ends = at(s, a2, b2) + at(s, a2 + 1, b2);
-            if (border) {
-                p = 0.5 * ends;
-            } else {
-                vec3 sides = at(s, a2, b2 + 1) + at(s, a2 + 1, b2 + 1) + at(s, a2, b2 - 1) + at(s, a2 + 1, b2 - 1);
-                p = (6.0 * ends + sides) / 16.0;
-            }
-        } else if ((a & 1) == 0) {
-            vec3 ends = at(s, a2, b2) + at(s, a2, b2 + 1);
-            vec3 sides = at(s, a2 + 1, b2) + at(s, a2 + 1, b2 + 1) + at(s, a2 - 1, b2) + at(s, a2 - 1, b2 + 1);
-            p = (6.0 * ends + sides) / 16.0;
-        } else {
-            p = 0.25 * (at(s, a2, b2) + at(s, a2 + 1, b2) + at(s, a2 + 1, b2 + 1) + at(s, a2, b2 + 1));
+        // The masks are tensor products of 1D ones (B-spline subdivision): per axis, an
+        // even output coordinate takes (1/8, 3/4, 1/8) of the input at c/2 - 1, c/2,
+        // c/2 + 1, an odd one (1/2, 1/2) of c/2 and c/2 + 1, and a half-fan's border
+        // spoke takes only b = 0 (the boundary rules). Taps of weight 0 read the centre
+        // tap again, so every address stays valid.
+        int a0 = a >> 1;
+        int b0 = b >> 1;
+        bool a_even = (a & 1) == 0;
+        bool b_even = (b & 1) == 0;
+        ivec3 ta = ivec3(a_even ? a0 - 1 : a0, a0, a0 + 1);
+        vec3 wa = a_even ? vec3(0.125, 0.75, 0.125) : vec3(0.0, 0.5, 0.5);
+        ivec3 tb = border ? ivec3(0) : ivec3(b_even ? b0 - 1 : b0, b0, b0 + 1);
+        vec3 wb = border ? vec3(0.0, 1.0, 0.0) : (b_even ? vec3(0.125, 0.75, 0.125) : vec3(0.0, 0.5, 0.5));
+        p = vec3(0.0);
+        for (int y = 0; y < 3; ++y) {
+            vec3 row = wa.x * at(s, ta.x, tb[y]) + wa.y * at(s, ta.y, tb[y]) + wa.z * at(s, ta.z, tb[y]);
+            p += wb[y] * row;
         }
     }
     result = vec4(p, 1.0);

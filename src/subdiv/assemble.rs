@@ -21,7 +21,7 @@ use glam::DVec3;
 
 use crate::mesh::Mesh;
 
-use super::fragment::FragmentMesh;
+use super::fragment::{Class, FragmentMesh};
 use super::topology::Topology;
 use super::{Result, SubdivError};
 
@@ -78,14 +78,17 @@ pub fn assemble<T: Sync>(
     let mut positions = vec![DVec3::ZERO; vertices as usize];
     let (vertex_part, rest) = positions.split_at_mut(nv as usize);
     let (edge_part, face_part) = rest.split_at_mut((ne * (g - 1)) as usize);
-    let at = |f: u32, s: u32, a: u32, b: u32| {
+    // Where the owned region of sector s of fragment f starts, and its class.
+    let sector = |f: u32, s: u32| {
         let class = fragments.fragments()[f as usize].class;
-        let i = fragments.fragment_start(&layout, f) + class.index(s, a.into(), b.into());
-        position(&stream[i as usize])
+        (fragments.fragment_start(&layout, f), class, s)
+    };
+    let at = |(start, class, s): (u64, Class, u32), a: u32, b: u32| {
+        position(&stream[(start + class.index(s, a.into(), b.into())) as usize])
     };
     for (v, out) in vertex_part.iter_mut().enumerate() {
         *out = match fragments.fragment_of(v as u32) {
-            Some(f) => at(f, 0, 0, 0),
+            Some(f) => at(sector(f, 0), 0, 0),
             // A vertex no face uses stays where it is.
             None => fragments.base_positions()[v],
         };
@@ -94,11 +97,16 @@ pub fn assemble<T: Sync>(
     for_each_block(edge_part, per_edge, |first, block| {
         for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
             let e = (first + k) as u32;
-            let ends = topo.edge_vertices(e);
-            let frag = ends.map(|v| fragments.fragment_of(v).unwrap_or(0));
-            let spoke = ends.map(|v| fragments.spoke_along(e, v));
-            for (t, p) in (1..grid.g).zip(out.iter_mut()) {
-                *p = if t <= n { at(frag[0], spoke[0], t, 0) } else { at(frag[1], spoke[1], grid.g - t, 0) };
+            let [v0, v1] = topo.edge_vertices(e);
+            let own = |v: u32| sector(fragments.fragment_of(v).unwrap_or(0), fragments.spoke_along(e, v));
+            let (first_half, second_half) = out.split_at_mut(n as usize);
+            let s0 = own(v0);
+            for (t, p) in (1..=n).zip(first_half.iter_mut()) {
+                *p = at(s0, t, 0);
+            }
+            let s1 = own(v1);
+            for (t, p) in (n + 1..grid.g).zip(second_half.iter_mut()) {
+                *p = at(s1, grid.g - t, 0);
             }
         }
     });
@@ -106,7 +114,11 @@ pub fn assemble<T: Sync>(
     for_each_block(face_part, per_face, |first, block| {
         for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
             let f = (first + k) as u32;
-            let owner = corner_owners(fragments, f);
+            let h0 = topo.face_half_edges(f).start;
+            let owner: [_; 4] = std::array::from_fn(|m| {
+                let h = h0 + m as u32;
+                sector(fragments.fragment_of(topo.origin(h)).unwrap_or(0), fragments.sector_of(h))
+            });
             let mut p = out.iter_mut();
             for j in 1..grid.g {
                 for i in 1..grid.g {
@@ -118,7 +130,7 @@ pub fn assemble<T: Sync>(
                         (true, false) => (3, grid.g - j, i),
                     };
                     if let Some(out) = p.next() {
-                        *out = at(owner[m].0, owner[m].1, a, b);
+                        *out = at(owner[m], a, b);
                     }
                 }
             }
@@ -127,16 +139,6 @@ pub fn assemble<T: Sync>(
 
     let offsets = (0..=(4 * quads) as usize).step_by(4).collect();
     Ok(Mesh::from_parts(positions, offsets, indices)?)
-}
-
-/// The fragment and sector owning each corner quarter of coarse face `f`.
-fn corner_owners(fragments: &FragmentMesh, f: u32) -> [(u32, u32); 4] {
-    let h0 = fragments.coarse().face_half_edges(f).start;
-    std::array::from_fn(|m| {
-        let h = h0 + m as u32;
-        let c = fragments.coarse().origin(h);
-        (fragments.fragment_of(c).unwrap_or(0), fragments.sector_of(h))
-    })
 }
 
 /// Output vertex numbering of the (G + 1)² grid points of a coarse face.

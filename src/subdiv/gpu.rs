@@ -162,22 +162,26 @@ pub struct Run {
     pub times: Times,
 }
 
-/// The fragment pass (`glsl/subdiv/refine.frag`), built once and reused.
+/// The fragment pass (`glsl/subdiv/refine.frag`) with its two render targets and its
+/// readback buffer, built once and reused: like a texture-era application, which
+/// allocates its FBO textures once, not per frame. Targets grow when a mesh needs more.
 pub struct Subdivider {
     pipeline: Pipeline,
+    targets: Option<PingPong>,
+    readback: Option<Buffer>,
 }
 
 impl Subdivider {
     pub fn new(ctx: &Context) -> Result<Subdivider> {
         let pipeline =
             Pipeline::quad(ctx, &shaders::subdiv::REFINE_FRAG, &[TexFormat::Rgba32F], Blend::Replace)?;
-        Ok(Subdivider { pipeline })
+        Ok(Subdivider { pipeline, targets: None, readback: None })
     }
 
     /// Refines `mesh` `level` times: the base level on the CPU, the rest as fragment
     /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
     /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0).
-    pub fn refine(&self, ctx: &Context, mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+    pub fn refine(&mut self, ctx: &Context, mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
         let start = Instant::now();
         let needed = BaseLevel::levels_needed(mesh);
         if level < needed {
@@ -207,7 +211,7 @@ impl Subdivider {
     /// Runs `gpu_levels` fragment passes over `fragments` and assembles the result.
     /// `fragments_started` is when fragment building began (for [`Times::fragments`]).
     pub fn refine_fragments(
-        &self,
+        &mut self,
         ctx: &Context,
         fragments: &FragmentMesh,
         gpu_levels: u32,
@@ -239,11 +243,23 @@ impl Subdivider {
             .collect::<Result<Vec<_>, _>>()?;
         let fragments_time = fragments_started.elapsed();
 
-        let mut targets = PingPong::new(ctx, TexFormat::Rgba32F, width, packing.height, "subdiv")?;
-        let timer = Timestamps::new(ctx, gpu_levels + 3)?;
         let last = packing.layouts.len() - 1;
+        let readback_bytes = u64::from(width) * u64::from(packing.rows(last)) * 16;
+        if !self.targets.as_ref().is_some_and(|t| t.width() == width && t.height() >= packing.height) {
+            self.targets = None;
+            self.targets = Some(PingPong::new(ctx, TexFormat::Rgba32F, width, packing.height, "subdiv")?);
+        }
+        if !self.readback.as_ref().is_some_and(|b| b.size() >= readback_bytes) {
+            self.readback = None;
+            self.readback = Some(Buffer::readback(ctx, readback_bytes, "subdiv readback")?);
+        }
+        let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
+            return Err(SubdivError::GpuLimit("render targets were not created".into()));
+        };
+        let pipeline = &self.pipeline;
+        let timer = Timestamps::new(ctx, gpu_levels + 3)?;
         let t = Instant::now();
-        let buffer = ctx.submit(|rec| {
+        ctx.submit(|rec| {
             rec.reset_timestamps(&timer);
             rec.timestamp(&timer, 0)?;
             rec.upload_region(targets.src(), 0, [0, 0, width, rows0], &stream)?;
@@ -261,7 +277,7 @@ impl Subdivider {
                 let reads = [input];
                 let area = [0, 0, width, packing.rows(j + 1)];
                 rec.render(&[Attachment::new(targets.dst(), Load::Discard)], Some(area), &reads, |pass| {
-                    pass.bind(&self.pipeline)?;
+                    pass.bind(pipeline)?;
                     pass.textures(&[(0, input)])?;
                     pass.uniform(1, table)?;
                     pass.push(&params)?;
@@ -270,16 +286,16 @@ impl Subdivider {
                 targets.swap();
                 rec.timestamp(&timer, 2 + j as u32)?;
             }
-            let buffer = rec.readback_region(targets.src(), 0..1, [0, 0, width, packing.rows(last)])?;
+            rec.readback_into(targets.src(), 0..1, [0, 0, width, packing.rows(last)], readback)?;
             rec.timestamp(&timer, gpu_levels + 2)?;
-            Ok(buffer)
+            Ok(())
         })?;
         let submit = t.elapsed();
         let stamps = timer.read_ms(gpu_levels + 3)?;
         let ms = |a: usize, b: usize| Duration::from_secs_f64(((stamps[b] - stamps[a]) / 1e3).max(0.0));
 
         let t = Instant::now();
-        let texels = buffer.view::<[f32; 4]>()?;
+        let texels = readback.view::<[f32; 4]>()?;
         let layout = &packing.layouts[last];
         let mesh = assemble(fragments, texels, layout.radius, gpu_levels, |p| {
             DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
@@ -305,7 +321,8 @@ impl Subdivider {
     }
 }
 
-/// Refines `mesh` `level` times on the GPU with a fresh pipeline (see [`Subdivider`]).
+/// Refines `mesh` `level` times on the GPU with a fresh pipeline and targets (see
+/// [`Subdivider`]).
 pub fn refine(ctx: &Context, mesh: &Mesh, level: u32) -> Result<Mesh> {
     Ok(Subdivider::new(ctx)?.refine(ctx, mesh, level, &Options::default())?.mesh)
 }
