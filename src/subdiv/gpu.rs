@@ -249,7 +249,7 @@ impl Subdivider {
             self.targets = None;
             self.targets = Some(PingPong::new(ctx, TexFormat::Rgba32F, width, packing.height, "subdiv")?);
         }
-        if !self.readback.as_ref().is_some_and(|b| b.size() >= readback_bytes) {
+        if self.readback.as_ref().is_none_or(|b| b.size() < readback_bytes) {
             self.readback = None;
             self.readback = Some(Buffer::readback(ctx, readback_bytes, "subdiv readback")?);
         }
