@@ -149,6 +149,7 @@ impl Times {
 }
 
 /// What one GPU subdivision did.
+#[derive(Debug)]
 pub struct Run {
     pub mesh: Mesh,
     /// Catmull-Clark levels done on the CPU and by fragment passes on the GPU.
