@@ -19,7 +19,6 @@ pub struct Buffer {
     pub(crate) raw: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
-    pub(crate) usage: vk::BufferUsageFlags,
 }
 
 impl Buffer {
@@ -58,7 +57,7 @@ impl Buffer {
                 return Err(e);
             }
         };
-        let buffer = Buffer { dev, raw, allocation: Some(allocation), size, usage };
+        let buffer = Buffer { dev, raw, allocation: Some(allocation), size };
         let a = buffer.allocation.as_ref().ok_or_else(|| GpuError::Usage("buffer without memory".into()))?;
         // SAFETY: memory and offset come from the allocator for this buffer's requirements.
         unsafe { buffer.dev.raw.bind_buffer_memory(raw, a.memory(), a.offset()) }.vk("vkBindBufferMemory")?;
@@ -77,12 +76,6 @@ impl Buffer {
     /// A host-writable buffer of `size` bytes (vertex data or uniforms rewritten between submits).
     pub fn host(ctx: &Context, size: u64, name: &str) -> Result<Buffer> {
         Buffer::new(&ctx.dev, size, Self::HOST_USAGE, MemoryLocation::CpuToGpu, name)
-    }
-
-    /// A host-readable buffer of `size` bytes that readbacks copy into
-    /// (`Recorder::readback_into`), reusable across submissions.
-    pub fn readback(ctx: &Context, size: u64, name: &str) -> Result<Buffer> {
-        Buffer::new(&ctx.dev, size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu, name)
     }
 
     const HOST_USAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(

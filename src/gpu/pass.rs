@@ -208,8 +208,23 @@ impl<'d> Recorder<'d> {
         layers: std::ops::Range<u32>,
         rect: Rect,
     ) -> Result<Buffer> {
-        let [_, _, w, h] = rect;
-        let size = w as u64 * h as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
+        self.check(tex)?;
+        let [x, y, w, h] = rect;
+        if layers.is_empty()
+            || layers.end > tex.layers()
+            || w == 0
+            || h == 0
+            || x.checked_add(w).is_none_or(|e| e > tex.width())
+            || y.checked_add(h).is_none_or(|e| e > tex.height())
+        {
+            return Err(GpuError::Usage(format!(
+                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture",
+                tex.width(),
+                tex.height(),
+                tex.layers()
+            )));
+        }
+        let size = w as u64 * h as u64 * (layers.end - layers.start) as u64 * tex.format().bytes_per_texel();
         let buffer = Buffer::new(
             self.dev,
             size,
@@ -217,46 +232,6 @@ impl<'d> Recorder<'d> {
             MemoryLocation::GpuToCpu,
             "readback",
         )?;
-        self.readback_into(tex, layers, rect, &buffer)?;
-        Ok(buffer)
-    }
-
-    /// Copies a rectangle of some layers of `tex` into the start of `buffer` (made by
-    /// `Buffer::readback`, kept at least until the submission ends): readback without a new
-    /// allocation, for passes repeated on same-sized data.
-    pub fn readback_into(
-        &mut self,
-        tex: &Texture,
-        layers: std::ops::Range<u32>,
-        rect: Rect,
-        buffer: &Buffer,
-    ) -> Result<()> {
-        self.check(tex)?;
-        let [x, y, w, h] = rect;
-        let size = w as u64 * h as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
-        if layers.is_empty()
-            || layers.end > tex.layers()
-            || w == 0
-            || h == 0
-            || x.checked_add(w).is_none_or(|e| e > tex.width())
-            || y.checked_add(h).is_none_or(|e| e > tex.height())
-            || size > buffer.size()
-            || !buffer.usage.contains(vk::BufferUsageFlags::TRANSFER_DST)
-        {
-            return Err(GpuError::Usage(format!(
-                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture into a \
-                 {}-byte buffer{}",
-                tex.width(),
-                tex.height(),
-                tex.layers(),
-                buffer.size(),
-                if buffer.usage.contains(vk::BufferUsageFlags::TRANSFER_DST) {
-                    ""
-                } else {
-                    " not made for readback"
-                }
-            )));
-        }
         self.use_texture(tex, Use::CopySrc);
         let region = [vk::BufferImageCopy::default()
             .image_subresource(
@@ -274,8 +249,8 @@ impl<'d> Recorder<'d> {
             .dst_stage_mask(vk::PipelineStageFlags2::HOST)
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
         let dep = vk::DependencyInfo::default().memory_barriers(&host);
-        // SAFETY: region and buffer size checked above; the caller keeps the buffer alive at
-        // least until `submit` returns.
+        // SAFETY: region checked above; the buffer is returned to the caller, who keeps it
+        // at least until `submit` returns.
         unsafe {
             self.dev.raw.cmd_copy_image_to_buffer(
                 self.cmd,
@@ -286,7 +261,7 @@ impl<'d> Recorder<'d> {
             );
             self.dev.raw.cmd_pipeline_barrier2(self.cmd, &dep);
         }
-        Ok(())
+        Ok(buffer)
     }
 
     /// Resets `timer` (call before the first `timestamp` of a submission).
