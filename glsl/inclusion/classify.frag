@@ -1,6 +1,6 @@
 #version 450
-#extension GL_GOOGLE_include_directive : require
-// Alg. 4-2, phase 1: write the classification values computed by the vertex.
+// Alg. 4-2, phase 1: write the values summed by the point-vertex to its texel, one
+// attachment per four query points.
 layout(location = 0) flat in vec4 v[8];
 layout(location = 0) out vec4 o0;
 layout(location = 1) out vec4 o1;

@@ -73,6 +73,16 @@ impl Buffer {
         Ok(b)
     }
 
+    /// A buffer of `size` bytes the GPU copies into and the host reads (see
+    /// `Recorder::readback_into`).
+    pub fn readback_for(ctx: &Context, size: u64) -> Result<Buffer> {
+        Buffer::readback(&ctx.dev, size)
+    }
+
+    pub(crate) fn readback(dev: &Arc<Device>, size: u64) -> Result<Buffer> {
+        Buffer::new(dev, size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu, "readback")
+    }
+
     /// A host-writable buffer of `size` bytes (vertex data or uniforms rewritten between submits).
     pub fn host(ctx: &Context, size: u64, name: &str) -> Result<Buffer> {
         Buffer::new(&ctx.dev, size, Self::HOST_USAGE, MemoryLocation::CpuToGpu, name)

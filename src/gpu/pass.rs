@@ -208,32 +208,47 @@ impl<'d> Recorder<'d> {
         layers: std::ops::Range<u32>,
         rect: Rect,
     ) -> Result<Buffer> {
+        let size = rect[2] as u64 * rect[3] as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
+        let buffer = Buffer::readback(self.dev, size)?;
+        self.readback_into(tex, layers, rect, &buffer, 0)?;
+        Ok(buffer)
+    }
+
+    /// Copies a rectangle of some layers of `tex` into `buffer` (made by
+    /// `Buffer::readback`) at byte `offset`, rows tightly packed, layer after layer —
+    /// many passes can share one readback buffer.
+    pub fn readback_into(
+        &mut self,
+        tex: &Texture,
+        layers: std::ops::Range<u32>,
+        rect: Rect,
+        buffer: &Buffer,
+        offset: u64,
+    ) -> Result<()> {
         self.check(tex)?;
         let [x, y, w, h] = rect;
+        let size = w as u64 * h as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
         if layers.is_empty()
             || layers.end > tex.layers()
             || w == 0
             || h == 0
             || x.checked_add(w).is_none_or(|e| e > tex.width())
             || y.checked_add(h).is_none_or(|e| e > tex.height())
+            || offset.checked_add(size).is_none_or(|e| e > buffer.size())
+            || offset % 4 != 0
         {
             return Err(GpuError::Usage(format!(
-                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture",
+                "readback of layers {layers:?}, rect {rect:?} from a {}×{}×{} texture into {} bytes at {offset} of a {}-byte buffer",
                 tex.width(),
                 tex.height(),
-                tex.layers()
+                tex.layers(),
+                size,
+                buffer.size()
             )));
         }
-        let size = w as u64 * h as u64 * (layers.end - layers.start) as u64 * tex.format().bytes_per_texel();
-        let buffer = Buffer::new(
-            self.dev,
-            size,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-            "readback",
-        )?;
         self.use_texture(tex, Use::CopySrc);
         let region = [vk::BufferImageCopy::default()
+            .buffer_offset(offset)
             .image_subresource(
                 vk::ImageSubresourceLayers::default()
                     .aspect_mask(vk::ImageAspectFlags::COLOR)
@@ -249,8 +264,8 @@ impl<'d> Recorder<'d> {
             .dst_stage_mask(vk::PipelineStageFlags2::HOST)
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
         let dep = vk::DependencyInfo::default().memory_barriers(&host);
-        // SAFETY: region checked above; the buffer is returned to the caller, who keeps it
-        // at least until `submit` returns.
+        // SAFETY: region checked above; the caller keeps the buffer at least until
+        // `submit` returns.
         unsafe {
             self.dev.raw.cmd_copy_image_to_buffer(
                 self.cmd,
@@ -261,7 +276,7 @@ impl<'d> Recorder<'d> {
             );
             self.dev.raw.cmd_pipeline_barrier2(self.cmd, &dep);
         }
-        Ok(buffer)
+        Ok(())
     }
 
     /// Resets `timer` (call before the first `timestamp` of a submission).

@@ -26,9 +26,10 @@ impl std::fmt::Display for Location {
 
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    /// A file could not be opened, read or written.
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    /// A file could not be opened, read or written. (The I/O error is part of the message,
+    /// not a separate `source`, so error chains print it once.)
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
     /// A file's contents are wrong: `path:line: message`.
     #[error("{}{location}: {message}", path.display())]
     Parse { path: PathBuf, location: Location, message: String },

@@ -5,15 +5,19 @@ use glam::DVec3;
 
 pub mod error;
 pub mod formats;
+pub mod procedural;
+pub mod validate;
 
 pub use error::{MeshError, Result};
+pub use validate::Report;
 
 /// A polygon mesh with f64 positions and faces of any degree ≥ 3.
 ///
 /// Faces are stored compressed (CSR): face `f` is
 /// `indices[offsets[f]..offsets[f + 1]]`, counter-clockwise seen from outside.
 /// A `Mesh` is always valid by construction: every index is in range, every
-/// face has at least three vertices, every coordinate is finite.
+/// face has at least three vertices, every coordinate is finite, and there are fewer than
+/// 2^32 vertices and 2^32 face corners (so both fit in a u32).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     positions: Vec<DVec3>,
@@ -41,6 +45,9 @@ impl Mesh {
         }
         if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(MeshError::invalid(format!("vertex {i} has a non-finite coordinate {p}")));
+        }
+        if indices.len() > u32::MAX as usize {
+            return Err(MeshError::invalid("more than 2^32 face corners"));
         }
         if offsets.first() != Some(&0) || offsets.last() != Some(&indices.len()) {
             return Err(MeshError::invalid("face offsets do not span the index list"));

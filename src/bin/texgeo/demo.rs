@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use texgeo::gpu::{TexFormat, XorRaster, reduce_sum};
+use texgeo::mesh::procedural;
 use texgeo::random::Rng;
 
 #[derive(clap::Args)]
@@ -59,5 +60,26 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         "XOR raster: {k} overlapping triangles -> {set} texels of odd parity, picture {}",
         png.display()
     );
+
+    // 3. The built-in models and what the mesh checks say about them.
+    println!("\nbuilt-in models:");
+    println!(
+        "{:<12} {:>6} {:>6} {:>7} {:>9} {:>9} {:>4}",
+        "name", "V", "F", "closed", "oriented", "manifold", "chi"
+    );
+    for name in procedural::BUILTIN_NAMES {
+        let Some(m) = procedural::by_name(name) else { continue };
+        let r = m.report();
+        let yn = |b: bool| if b { "yes" } else { "no" };
+        println!(
+            "{name:<12} {:>6} {:>6} {:>7} {:>9} {:>9} {:>4}",
+            m.num_vertices(),
+            m.num_faces(),
+            yn(r.is_closed()),
+            yn(r.is_oriented()),
+            yn(r.is_manifold()),
+            r.euler_characteristic
+        );
+    }
     Ok(())
 }

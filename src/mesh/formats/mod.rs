@@ -2,12 +2,22 @@
 //! either read whole and checked, or rejected with an error naming file, line (or byte
 //! offset) and the problem. No allocation is sized from a count the file claims before
 //! the data behind it has been seen.
+//!
+//! | format | read | write |
+//! |---|---|---|
+//! | OBJ | `v`/`f` via `tobj`, polygons kept, groups merged | `v`/`f`, exact decimals |
+//! | OFF | OFF/COFF/NOFF/CNOFF | OFF, exact decimals |
+//! | PLY | ascii, binary little/big endian | binary little endian, `double` (exact) |
+//! | STL | ascii, binary; vertices welded | binary (f32; faces fan-triangulated) |
 
 use std::path::Path;
 
 use super::{Mesh, MeshError, Result, error::Location};
 
+pub mod obj;
 pub mod off;
+pub mod ply;
+pub mod stl;
 pub(crate) mod text;
 
 /// A file format texgeo reads and writes, chosen by extension.
@@ -44,21 +54,28 @@ impl Format {
 pub fn read(path: impl AsRef<Path>) -> Result<Mesh> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.into(), source })?;
-    if bytes.is_empty() {
-        return Err(MeshError::parse(path, Location::File, "the file is empty"));
-    }
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
     read_bytes(&bytes, format, path)
 }
 
 /// Reads a mesh from memory; `path` is only used to name the source in errors.
+///
+/// An empty file, and a file that holds no faces, are errors: every texgeo algorithm
+/// needs faces, and a mesh without them almost always means the wrong file.
 pub fn read_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
-    match format {
-        Format::Off => off::read(bytes, path),
-        other => {
-            Err(MeshError::parse(path, Location::File, format!("{other:?} reading is not available yet")))
-        }
+    if bytes.is_empty() {
+        return Err(MeshError::parse(path, Location::File, "the file is empty"));
     }
+    let mesh = match format {
+        Format::Obj => obj::read(bytes, path),
+        Format::Off => off::read(bytes, path),
+        Format::Ply => ply::read(bytes, path),
+        Format::Stl => stl::read(bytes, path),
+    }?;
+    if mesh.num_faces() == 0 {
+        return Err(MeshError::parse(path, Location::File, "the file holds no faces"));
+    }
+    Ok(mesh)
 }
 
 /// Writes a mesh, choosing the format from the file extension.
@@ -66,14 +83,16 @@ pub fn write(path: impl AsRef<Path>, mesh: &Mesh) -> Result<()> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
     let mut out = Vec::new();
-    write_to(&mut out, mesh, format).map_err(|source| MeshError::Io { path: path.into(), source })?;
-    std::fs::write(path, out).map_err(|source| MeshError::Io { path: path.into(), source })
+    write_to(&mut out, mesh, format).map_err(|error| MeshError::Io { path: path.into(), error })?;
+    std::fs::write(path, out).map_err(|error| MeshError::Io { path: path.into(), error })
 }
 
 /// Writes a mesh in `format` to any writer.
 pub fn write_to(out: &mut impl std::io::Write, mesh: &Mesh, format: Format) -> std::io::Result<()> {
     match format {
+        Format::Obj => obj::write(out, mesh),
         Format::Off => off::write(out, mesh),
-        other => Err(std::io::Error::other(format!("{other:?} writing is not available yet"))),
+        Format::Ply => ply::write(out, mesh),
+        Format::Stl => stl::write(out, mesh),
     }
 }

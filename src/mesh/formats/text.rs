@@ -13,11 +13,9 @@ pub(crate) struct Lines<'a> {
 }
 
 impl<'a> Lines<'a> {
-    /// Fails on bytes that are not UTF-8, naming the byte offset.
+    /// Fails on bytes that are not UTF-8, naming the line and byte offset.
     pub fn new(bytes: &'a [u8], path: &'a Path) -> Result<Lines<'a>, MeshError> {
-        let text = std::str::from_utf8(bytes).map_err(|e| {
-            MeshError::parse(path, Location::Byte(e.valid_up_to() as u64), "not a text file (invalid UTF-8)")
-        })?;
+        let text = utf8(bytes, path, 0, 0)?;
         Ok(Lines { path, inner: text.lines().enumerate(), last_line: 0 })
     }
 
@@ -36,6 +34,26 @@ impl<'a> Lines<'a> {
     pub fn error(&self, line: usize, message: impl Into<String>) -> MeshError {
         MeshError::parse(self.path, Location::Line(line), message)
     }
+}
+
+/// `bytes` as text, or an error naming the line and byte offset of the first invalid
+/// UTF-8 sequence. `lines_before` and `bytes_before` say where `bytes` starts in the file
+/// (for text that follows a header).
+pub(crate) fn utf8<'a>(
+    bytes: &'a [u8],
+    path: &Path,
+    lines_before: usize,
+    bytes_before: usize,
+) -> Result<&'a str, MeshError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let line = lines_before + 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        MeshError::parse(
+            path,
+            Location::Line(line),
+            format!("not a text file (invalid UTF-8 at byte {})", bytes_before + at),
+        )
+    })
 }
 
 /// Parses a finite f64, or explains why not.
