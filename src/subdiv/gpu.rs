@@ -252,7 +252,7 @@ impl Subdivider {
         }
         if self.readback.as_ref().is_none_or(|b| b.size() < readback_bytes) {
             self.readback = None;
-            self.readback = Some(Buffer::readback(ctx, readback_bytes, "subdiv readback")?);
+            self.readback = Some(Buffer::readback_for(ctx, readback_bytes)?);
         }
         let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
             return Err(SubdivError::GpuLimit("render targets were not created".into()));
@@ -287,7 +287,7 @@ impl Subdivider {
                 targets.swap();
                 rec.timestamp(&timer, 2 + j as u32)?;
             }
-            rec.readback_into(targets.src(), 0..1, [0, 0, width, packing.rows(last)], readback)?;
+            rec.readback_into(targets.src(), 0..1, [0, 0, width, packing.rows(last)], readback, 0)?;
             rec.timestamp(&timer, gpu_levels + 2)?;
             Ok(())
         })?;
