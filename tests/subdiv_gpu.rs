@@ -10,7 +10,6 @@ use common::shapes;
 use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::Mesh;
-use texgeo::subdiv::assemble::Watertight;
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::fragment::{self, BaseLevel, FragmentMesh};
 use texgeo::subdiv::gpu::{MAX_RUNS, Options, Packing, Subdivider};
@@ -29,12 +28,9 @@ fn opensubdiv(mesh: &Mesh, level: u32) -> Mesh {
     osd::refine(mesh, level).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn boundary_edges(mesh: &Mesh) -> usize {
-    Watertight::of(mesh).unwrap_or_else(|e| panic!("{e}")).boundary_edges
-}
-
 /// GPU at every level of `levels` equals OpenSubdiv (counts, positions, faces as cycles),
-/// is manifold and closed (or has the input's boundary, refined), keeps the input's Euler
+/// is watertight by the mesh checks (`mesh::validate`: manifold, oriented, closed — or
+/// with the input's boundary, each edge split 2^level times), keeps the input's Euler
 /// characteristic, and did every level past the base level as a fragment pass.
 fn assert_gpu_matches_opensubdiv(
     ctx: &Context,
@@ -44,7 +40,7 @@ fn assert_gpu_matches_opensubdiv(
     levels: std::ops::RangeInclusive<u32>,
     options: &Options,
 ) {
-    let input = Watertight::of(mesh).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let input = mesh.report();
     let base_levels = BaseLevel::levels_needed(mesh);
     for level in levels {
         let run =
@@ -54,10 +50,12 @@ fn assert_gpu_matches_opensubdiv(
         let reference = opensubdiv(mesh, level);
         let c = Comparison::new(&run.mesh, &reference, TOLERANCE);
         assert!(c.is_match(), "{name} level {level} (GPU vs OpenSubdiv):\n{c}");
-        let w =
-            Watertight::of(&run.mesh).unwrap_or_else(|e| panic!("{name} level {level}: not manifold: {e}"));
-        assert_eq!(w.euler, input.euler, "{name} level {level}: Euler characteristic");
-        assert_eq!(w.boundary_edges, input.boundary_edges << level, "{name} level {level}: boundary edges");
+        let w = run.mesh.report();
+        assert!(w.is_manifold() && w.is_oriented(), "{name} level {level}: {w}");
+        assert_eq!(w.is_closed(), input.is_closed(), "{name} level {level}: {w}");
+        assert_eq!(w.euler_characteristic, input.euler_characteristic, "{name} level {level}: {w}");
+        assert_eq!(w.boundary_edges, input.boundary_edges << level, "{name} level {level}: {w}");
+        assert_eq!((w.non_manifold_edges, w.degenerate_faces), (0, 0), "{name} level {level}: {w}");
     }
 }
 
@@ -118,7 +116,7 @@ fn open_meshes_match_opensubdiv() {
     let options = Options::default();
     assert_gpu_matches_opensubdiv(&ctx, &mut sub, "grid", &shapes::grid(3), 1..=4, &options);
     assert_gpu_matches_opensubdiv(&ctx, &mut sub, "open_cube", &shapes::open_cube(), 1..=4, &options);
-    assert!(boundary_edges(&shapes::grid(3)) > 0);
+    assert!(shapes::grid(3).report().boundary_edges > 0);
 }
 
 /// The committed OpenSubdiv outputs (reference/subdiv/README.md) need no helper.

@@ -201,20 +201,3 @@ fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, 
         }
     });
 }
-
-/// Watertightness of a mesh (SPEC §5.4): manifold and consistently oriented (else the
-/// topology error), and its boundary-edge count and Euler characteristic V − E + F.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Watertight {
-    pub boundary_edges: usize,
-    pub euler: i64,
-}
-
-impl Watertight {
-    pub fn of(mesh: &Mesh) -> Result<Watertight> {
-        let topo = Topology::new(mesh)?;
-        let boundary_edges = (0..topo.num_edges() as u32).filter(|&e| topo.is_boundary_edge(e)).count();
-        let euler = mesh.num_vertices() as i64 - topo.num_edges() as i64 + mesh.num_faces() as i64;
-        Ok(Watertight { boundary_edges, euler })
-    }
-}
