@@ -191,7 +191,7 @@ fn limits_give_clear_errors() {
     // One fragment over 2^24 texels: the cone's valence-40 apex at 12 fragment levels.
     let fragments = FragmentMesh::new(&cone(40)).unwrap();
     let err = Packing::new(&fragments, 12, 16384, None).unwrap_err();
-    assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("valence"), "{err}");
+    assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("valence 40"), "{err}");
     let err = sub.refine(&ctx, &cone(40), 14, &Options::default()).unwrap_err();
     assert!(matches!(err, SubdivError::GpuLimit(_)), "{err}");
     // More texels than a texture holds.
@@ -255,4 +255,34 @@ fn isolated_vertices_stay() {
         1..=3,
         &Options::default(),
     );
+}
+
+/// `texgeo subdivide`: writes the mesh, `--validate` passes against OpenSubdiv, and a
+/// non-manifold input is a clear error with exit status 2.
+#[test]
+fn subdivide_command() {
+    let exe = env!("CARGO_BIN_EXE_texgeo");
+    let out = std::env::temp_dir().join(format!("texgeo-subdivide-{}.off", std::process::id()));
+    let run = std::process::Command::new(exe)
+        .args(["subdivide", "builtin:pyramid", "-l", "3", "--validate", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(stdout.contains("validation passed") && stdout.contains("position error: max"), "{stdout}");
+    let written = texgeo::mesh::formats::read(&out).unwrap();
+    let _ = std::fs::remove_file(&out);
+    let reference = cpu::refine(&texgeo::mesh::procedural::pyramid(), 3).unwrap();
+    assert_eq!(
+        (written.num_vertices(), written.num_faces()),
+        (reference.num_vertices(), reference.num_faces())
+    );
+    assert!(written.report().is_closed());
+
+    let run =
+        std::process::Command::new(exe).args(["subdivide", "builtin:two-cubes", "-l", "2"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("non-manifold edge") && stderr.contains("manifold"), "{stderr}");
 }

@@ -77,12 +77,14 @@ impl Packing {
         let layouts: Vec<StreamLayout> = radii(gpu_levels).into_iter().map(|r| fragments.layout(r)).collect();
         let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
         let last = layouts.last().map_or(2, |l| l.radius);
-        if let Some(big) = fragments.runs().iter().map(|r| r.class.len(last)).max()
-            && big >= MAX_FRAGMENT_TEXELS
+        if let Some(run) = fragments.runs().iter().max_by_key(|r| r.class.len(last))
+            && run.class.len(last) >= MAX_FRAGMENT_TEXELS
         {
             return Err(SubdivError::GpuLimit(format!(
-                "a fragment of {big} texels at level {gpu_levels} exceeds {MAX_FRAGMENT_TEXELS} \
-                 (valence too high for this level; use the CPU method)"
+                "a fragment of valence {} at ring radius {last} ({gpu_levels} fragment levels) needs {} \
+                 texels, over the pass's {MAX_FRAGMENT_TEXELS}; use fewer levels or the CPU method",
+                run.class.valence,
+                run.class.len(last)
             )));
         }
         let max_width = if max_side == 0 { 1 } else { 1u32 << max_side.ilog2() };

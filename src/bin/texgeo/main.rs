@@ -1,9 +1,11 @@
-//! The `texgeo` command line. Errors print one message and exit with status 2.
+//! The `texgeo` command line. Errors print one message and exit with status 2 (a failed
+//! `--validate` comparison exits with status 1).
 
 mod bench;
 mod demo;
 mod info;
 mod mesh;
+mod subdivide;
 
 use clap::{Parser, Subcommand};
 use texgeo::gpu::{Context, ContextOptions, DeviceChoice};
@@ -30,6 +32,8 @@ enum Command {
     /// Inspect and convert meshes (OBJ, OFF, PLY, STL).
     #[command(subcommand)]
     Mesh(mesh::Command),
+    /// Catmull-Clark subdivision: fragment meshes on the GPU, or the CPU reference.
+    Subdivide(subdivide::Args),
     /// Run a benchmark and write Markdown + CSV tables.
     #[command(subcommand)]
     Bench(bench::Command),
@@ -49,6 +53,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
         Command::Mesh(c) => mesh::run(c),
+        Command::Subdivide(a) => subdivide::run(device, a),
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
     };
