@@ -37,7 +37,7 @@ enum Command {
     /// Run a benchmark and write Markdown + CSV tables.
     #[command(subcommand)]
     Bench(bench::Command),
-    /// A short tour on built-in data: reduction, XOR raster, model statistics.
+    /// A short tour on built-in data: reduction, XOR raster, model statistics, Catmull-Clark.
     Demo(demo::Args),
 }
 
