@@ -111,33 +111,45 @@ pub fn assemble<T: Sync>(
         }
     });
     let per_face = ((g - 1) * (g - 1)) as usize;
+    let side = grid.g as usize - 1;
     for_each_block(face_part, per_face, |first, block| {
         for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
             let f = (first + k) as u32;
             let h0 = topo.face_half_edges(f).start;
-            let owner: [_; 4] = std::array::from_fn(|m| {
-                let h = h0 + m as u32;
-                sector(fragments.fragment_of(topo.origin(h)).unwrap_or(0), fragments.sector_of(h))
-            });
-            let mut p = out.iter_mut();
-            for j in 1..grid.g {
-                for i in 1..grid.g {
-                    // The quarter (corner m) holding (i, j), and (a, b) in that corner's sector.
-                    let (m, a, b) = match (i <= n, j <= n) {
-                        (true, true) => (0, i, j),
-                        (false, true) => (1, j, grid.g - i),
-                        (false, false) => (2, grid.g - i, grid.g - j),
-                        (true, false) => (3, grid.g - j, i),
-                    };
-                    if let Some(out) = p.next() {
-                        *out = at(owner[m], a, b);
+            for m in 0..4 {
+                // The quarter at corner m: sector s of the fragment centred there. Its
+                // points off the spokes (a, b ≥ 1) are, ring by ring, the entries t ≥ 1 of
+                // the sector's 2r consecutive entries: read in storage order, written at
+                // their (i, j) in the face's frame.
+                let h = h0 + m;
+                let (start, class, s) =
+                    sector(fragments.fragment_of(topo.origin(h)).unwrap_or(0), fragments.sector_of(h));
+                let g = grid.g as usize;
+                for r in 1..=n as u64 {
+                    let ring = start + 1 + class.ring_offset(r) + u64::from(s) * 2 * r;
+                    let entries = &stream[(ring + 1) as usize..(ring + 2 * r) as usize];
+                    for (t, texel) in (1..2 * r as usize).zip(entries) {
+                        let r = r as usize;
+                        let (a, b) = if t <= r { (r, t) } else { (2 * r - t, r) };
+                        let (i, j) = match m {
+                            0 => (a, b),
+                            1 => (g - b, a),
+                            2 => (g - a, g - b),
+                            _ => (b, g - a),
+                        };
+                        out[(j - 1) * side + i - 1] = position(texel);
                     }
                 }
             }
         }
     });
 
-    let offsets = (0..=(4 * quads) as usize).step_by(4).collect();
+    let mut offsets = vec![0usize; quads as usize + 1];
+    for_each_block(&mut offsets, 1, |first, block| {
+        for (k, o) in block.iter_mut().enumerate() {
+            *o = 4 * (first + k);
+        }
+    });
     Ok(Mesh::from_parts(positions, offsets, indices)?)
 }
 
@@ -158,28 +170,35 @@ impl Grid<'_> {
         ids.clear();
         ids.resize(row * row, 0);
         let h0 = self.topo.face_half_edges(f).start;
-        // Side m runs from corner m to corner m + 1; `t` counts steps from corner m.
-        let side = |m: u32, t: u32| {
-            let h = h0 + m;
+        // Side m runs from corner m to corner m + 1; point t steps from corner m is point
+        // t or g − t of its edge, depending on the edge's orientation.
+        let sides: [(u32, bool); 4] = std::array::from_fn(|m| {
+            let h = h0 + m as u32;
             let e = self.topo.edge(h);
-            let t = if self.topo.edge_half_edge(e) == h { t } else { g - t };
-            self.nv + e * (g - 1) + t - 1
+            (self.nv + e * (g - 1), self.topo.edge_half_edge(e) == h)
+        });
+        let side = |m: usize, t: u32| {
+            let (first, forward) = sides[m];
+            first + if forward { t } else { g - t } - 1
         };
         let corner = |m: u32| self.topo.origin(h0 + m);
-        for j in 0..=g {
-            for i in 0..=g {
-                let id = match (i, j) {
-                    (0, 0) => corner(0),
-                    (_, 0) if i == g => corner(1),
-                    (_, _) if i == g && j == g => corner(2),
-                    (0, _) if j == g => corner(3),
-                    (_, 0) => side(0, i),
-                    (_, _) if i == g => side(1, j),
-                    (_, _) if j == g => side(2, g - i),
-                    (0, _) => side(3, g - j),
-                    _ => self.face0 + f * (g - 1) * (g - 1) + (j - 1) * (g - 1) + (i - 1),
-                };
-                ids[j as usize * row + i as usize] = id;
+        let g_us = g as usize;
+        ids[0] = corner(0);
+        ids[g_us] = corner(1);
+        ids[g_us * row] = corner(3);
+        ids[g_us * row + g_us] = corner(2);
+        for t in 1..g {
+            let t_us = t as usize;
+            ids[t_us] = side(0, t);
+            ids[t_us * row + g_us] = side(1, t);
+            ids[g_us * row + t_us] = side(2, g - t);
+            ids[t_us * row] = side(3, g - t);
+        }
+        let interior = self.face0 + f * (g - 1) * (g - 1);
+        for j in 1..g_us {
+            let first = interior + (j as u32 - 1) * (g - 1);
+            for (i, id) in ids[j * row + 1..j * row + g_us].iter_mut().enumerate() {
+                *id = first + i as u32;
             }
         }
     }

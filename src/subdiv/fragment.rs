@@ -346,9 +346,22 @@ impl FragmentMesh {
         for frag in &self.fragments {
             spokes.clear();
             spokes.extend(self.coarse.spokes(frag.centre));
-            for i in 0..frag.class.len(2) {
-                let (s, a, b) = frag.class.coords(i).unwrap_or((0, 0, 0));
-                out.push(texel(self.base[self.base_vertex(frag.centre, &spokes, s, a, b) as usize]));
+            let c = frag.centre;
+            let mut push = |s: u32, a: u32, b: u32| {
+                out.push(texel(self.base[self.base_vertex(c, &spokes, s, a, b) as usize]));
+            };
+            // The storage order: centre, then ring by ring, sector by sector (t ≤ r → (r, t),
+            // t > r → (2r − t, r)), a half-fan's last spoke at the end of each ring.
+            push(0, 0, 0);
+            for r in 1..=2 {
+                for s in 0..frag.class.valence {
+                    for t in 0..2 * r {
+                        if t <= r { push(s, r, t) } else { push(s, 2 * r - t, r) }
+                    }
+                }
+                if frag.class.boundary {
+                    push(frag.class.valence, r, 0);
+                }
             }
         }
         out
