@@ -22,7 +22,8 @@
 //!
 //! - at most [`MAX_RUNS`] classes (distinct valence/half-fan pairs) per mesh;
 //! - one fragment at most 2^24 texels at the last level (the shader's exact float
-//!   division), i.e. k·R(R+1) < 2^24: valence 14 000 at level 5 of a quad mesh;
+//!   division), i.e. k·R(R+1) < 2^24 at the last radius R = 2^j: valence below 61 680 at
+//!   level 5 of a quad mesh (R = 16), below 4 032 at level 7 (R = 64);
 //! - every stream at most W × H texels with W, H ≤ `maxImageDimension2D` and
 //!   below 2^28 texels (16384² on lavapipe, 4 GiB per target).
 
