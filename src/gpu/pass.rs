@@ -511,24 +511,36 @@ impl<'p> RenderScope<'_, 'p> {
     /// Binds the per-vertex (and, when the pipeline has per-instance inputs, per-instance)
     /// vertex buffers.
     pub fn vertex_buffers(&mut self, per_vertex: &Buffer, per_instance: Option<&Buffer>) -> Result<()> {
+        self.vertex_buffers_at(Some((per_vertex, 0)), per_instance.map(|b| (b, 0)))
+    }
+
+    /// Binds vertex buffers starting at byte offsets; `None` where the pipeline has no
+    /// inputs of that rate (per vertex, per instance).
+    pub fn vertex_buffers_at(
+        &mut self,
+        per_vertex: Option<(&Buffer, u64)>,
+        per_instance: Option<(&Buffer, u64)>,
+    ) -> Result<()> {
         let strides = self.bound()?.strides;
-        let mut raw = Vec::new();
-        if strides[0] > 0 {
-            raw.push(per_vertex.raw);
-        }
-        match (strides[1] > 0, per_instance) {
-            (true, Some(b)) => raw.push(b.raw),
-            (false, None) => {}
-            (true, None) => return Err(GpuError::Usage("the pipeline needs a per-instance buffer".into())),
-            (false, Some(_)) => {
-                return Err(GpuError::Usage("the pipeline has no per-instance inputs".into()));
+        let bind = |binding: u32, stride: u32, buffer: Option<(&Buffer, u64)>, what: &str| -> Result<()> {
+            match (stride > 0, buffer) {
+                (true, Some((b, offset))) => {
+                    if offset >= b.size() {
+                        return Err(GpuError::Usage(format!("{what} buffer offset {offset} past its end")));
+                    }
+                    // SAFETY: buffer alive for the submission; offset inside it.
+                    unsafe { self.dev.raw.cmd_bind_vertex_buffers(self.cmd, binding, &[b.raw], &[offset]) };
+                    Ok(())
+                }
+                (false, None) => Ok(()),
+                (true, None) => Err(GpuError::Usage(format!("the pipeline needs a {what} buffer"))),
+                // A buffer for inputs the pipeline lacks is ignored only when it is the
+                // per-vertex one of a vertex-less pipeline (e.g. a full-target quad).
+                (false, Some(_)) => Err(GpuError::Usage(format!("the pipeline has no {what} inputs"))),
             }
-        }
-        let first = if strides[0] > 0 { 0 } else { 1 };
-        let offsets = vec![0; raw.len()];
-        // SAFETY: buffers alive for the submission.
-        unsafe { self.dev.raw.cmd_bind_vertex_buffers(self.cmd, first, &raw, &offsets) };
-        Ok(())
+        };
+        bind(0, strides[0], per_vertex, "per-vertex")?;
+        bind(1, strides[1], per_instance, "per-instance")
     }
 
     /// Draws `vertices` vertices (points or triangle corners), `instances` times.

@@ -26,8 +26,15 @@ pub struct Reducer {
 }
 
 impl Reducer {
-    /// A reducer for RGBA32F inputs up to `max_width`×`max_height` with `layers` layers.
+    /// A reducer for RGBA32F inputs up to `max_width`×`max_height` with `layers` layers,
+    /// reduced as one tile (any size).
     pub fn new(ctx: &Context, max_width: u32, max_height: u32, layers: u32) -> Result<Reducer> {
+        Reducer::for_tiles(ctx, [max_width, max_height], [max_width, max_height], layers)
+    }
+
+    /// A reducer for inputs up to `max_size` cut into tiles of `tile` texels (the ping-pong
+    /// targets hold the first pass's output, which halves only the axes tiles span).
+    pub fn for_tiles(ctx: &Context, max_size: [u32; 2], tile: [u32; 2], layers: u32) -> Result<Reducer> {
         if layers == 0 || layers > MAX_LAYERS {
             return Err(GpuError::Usage(format!(
                 "the reducer handles 1..={MAX_LAYERS} layers, not {layers}"
@@ -35,7 +42,8 @@ impl Reducer {
         }
         let targets = vec![TexFormat::Rgba32F; layers as usize];
         let pipeline = Pipeline::quad(ctx, &shaders::gpu::REDUCE_FRAG, &targets, Blend::Replace)?;
-        let (w, h) = (max_width.div_ceil(2).max(1), max_height.div_ceil(2).max(1));
+        let half = |n: u32, t: u32| if t > 1 { n.div_ceil(2) } else { n }.max(1);
+        let (w, h) = (half(max_size[0], tile[0]), half(max_size[1], tile[1]));
         let pair = PingPong::new_layered(ctx, TexFormat::Rgba32F, w, h, layers, "reduce")?;
         Ok(Reducer { pipeline, pair, layers })
     }
@@ -88,11 +96,17 @@ impl Reducer {
                 )));
             }
         }
-        if w.div_ceil(2) > self.pair.width() || h.div_ceil(2) > self.pair.height() {
+        let first =
+            [if tile[0] > 1 { w.div_ceil(2) } else { w }, if tile[1] > 1 { h.div_ceil(2) } else { h }];
+        if (tile[0] > 1 || tile[1] > 1) && (first[0] > self.pair.width() || first[1] > self.pair.height()) {
             return Err(GpuError::Usage(format!(
-                "reducer sized for {}×{} inputs, asked for {w}×{h}",
-                self.pair.width() * 2,
-                self.pair.height() * 2
+                "reducer targets are {}×{}, the first pass of {w}×{h} in {}×{} tiles needs {}×{}",
+                self.pair.width(),
+                self.pair.height(),
+                tile[0],
+                tile[1],
+                first[0],
+                first[1]
             )));
         }
         let (mut cur, mut t) = (size, tile);

@@ -1,6 +1,7 @@
 //! Query point files for `texgeo inclusion --points FILE`: one point per line, `x y z`,
 //! blank lines and `#` comments allowed. Errors name the file and line.
 
+use std::io::Write;
 use std::path::Path;
 
 use glam::DVec3;
@@ -38,12 +39,12 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
 }
 
 /// Writes one class per line (`1` inside, `0` outside, `2` on the boundary).
-pub fn write_classes(out: &mut impl std::io::Write, classes: &[super::Class]) -> std::io::Result<()> {
+pub fn write_classes(out: &mut impl Write, classes: &[super::Class]) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     for c in classes {
         writeln!(w, "{}", *c as u8)?;
     }
-    std::io::Write::flush(&mut w)
+    w.flush()
 }
 
 #[cfg(test)]

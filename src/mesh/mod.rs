@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 
+pub mod covering;
 pub mod error;
 pub mod formats;
 pub mod procedural;

@@ -3,6 +3,7 @@
 
 mod bench;
 mod demo;
+mod inclusion;
 mod info;
 mod mesh;
 mod subdivide;
@@ -32,6 +33,8 @@ enum Command {
     /// Inspect and convert meshes (OBJ, OFF, PLY, STL).
     #[command(subcommand)]
     Mesh(mesh::Command),
+    /// Point in solid (Feito-Torres): classify query points as inside, outside or on the boundary.
+    Inclusion(inclusion::Args),
     /// Catmull-Clark subdivision: fragment meshes on the GPU, or the CPU reference.
     Subdivide(subdivide::Args),
     /// Run a benchmark and write Markdown + CSV tables.
@@ -53,6 +56,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
         Command::Mesh(c) => mesh::run(c),
+        Command::Inclusion(a) => inclusion::run(device, a),
         Command::Subdivide(a) => subdivide::run(device, a),
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context as _;
+use texgeo::mesh::covering::Covering;
 use texgeo::mesh::{Mesh, formats, procedural};
 
 #[derive(clap::Subcommand)]
@@ -68,4 +69,25 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
 }
 
 /// Volume, area and centroids from the simplicial covering (SPEC §2).
-fn print_measures(_m: &Mesh) {}
+fn print_measures(m: &Mesh) {
+    let c = Covering::new(m);
+    let (lo, hi) = m.bounds();
+    println!("bounding box           {lo} .. {hi}");
+    println!("area                   {}", c.area());
+    match c.unbalanced_edge() {
+        None => {
+            println!("volume                 {} (signed tetrahedra, Alg. 3-1)", c.volume());
+            if let Some(g) = c.centroid() {
+                println!("centroid               {g} (volume)");
+            }
+        }
+        Some(e) => println!(
+            "volume                 undefined: the surface is not closed and consistently oriented \
+             (edge {}-{} used {}x forward, {}x backward)",
+            e.a, e.b, e.forward, e.backward
+        ),
+    }
+    if let Some(g) = c.face_weighted_centroid() {
+        println!("centroid               {g} (face vertices, thesis §3.6.1)");
+    }
+}

@@ -1,0 +1,105 @@
+//! Generalized winding number: the independent oracle (SPEC §3.4 comparisons).
+//!
+//! w(P) = Σ Ω(t) / 4π over the covering triangles, Ω the signed solid angle of a triangle
+//! seen from P (Van Oosterom & Strackee 1983). Negative triangles of non-convex faces
+//! subtract what their positive partners add, so the covering works as is. Inside iff
+//! |w| ≥ 0.5; within ε of a face, OnBoundary (the shared rule of [`crate::inclusion`]).
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use glam::DVec3;
+
+use super::surface::Surface;
+use super::{BuildStats, Class, Classifier, Result};
+use crate::mesh::Mesh;
+
+/// Signed solid angle of triangle (a, b, c) seen from the origin (corners relative to the
+/// viewer): positive when the origin is behind the triangle, i.e. on the side opposite to
+/// its normal (b−a)×(c−a) — so w = +1 inside an outward-oriented closed surface.
+pub fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let num = a.dot(b.cross(c));
+    let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    2.0 * num.atan2(den)
+}
+
+/// Winding number of the covering around `p` (≈ integer away from the boundary).
+pub fn winding_number(surface: &Surface, p: DVec3) -> f64 {
+    let covering = surface.covering();
+    let sum: f64 = (0..covering.triangles.len())
+        .map(|t| {
+            let [a, b, c] = covering.triangle(t);
+            solid_angle(a - p, b - p, c - p)
+        })
+        .sum();
+    sum / (4.0 * PI)
+}
+
+/// OnBoundary within ε of a face, else Inside iff |w| ≥ 0.5 (measured from a point moved
+/// off the plane of a non-convex face if `p` lies in one, see [`Surface::off_polygon_planes`]).
+pub fn classify(surface: &Surface, p: DVec3) -> Class {
+    let n = surface.covering().triangles.len();
+    if (0..n).any(|t| surface.on_boundary_near(t, p)) {
+        return Class::OnBoundary;
+    }
+    let p = surface.off_polygon_planes(p, 0..n);
+    if winding_number(surface, p).abs() >= 0.5 { Class::Inside } else { Class::Outside }
+}
+
+/// The winding-number oracle as a [`Classifier`].
+#[derive(Clone, Debug)]
+pub struct WindingNumber {
+    surface: Surface,
+    stats: BuildStats,
+}
+
+impl WindingNumber {
+    pub fn new(mesh: &Mesh) -> Result<WindingNumber> {
+        WindingNumber::with_policy(mesh, false)
+    }
+
+    /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
+    pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<WindingNumber> {
+        let start = Instant::now();
+        let surface = Surface::with_policy(mesh, allow_open)?;
+        let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
+        Ok(WindingNumber { surface, stats })
+    }
+
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    pub fn winding_number(&self, p: DVec3) -> f64 {
+        winding_number(&self.surface, p)
+    }
+}
+
+impl Classifier for WindingNumber {
+    fn name(&self) -> &str {
+        "winding"
+    }
+
+    fn classify(&self, p: DVec3) -> Class {
+        classify(&self.surface, p)
+    }
+
+    fn build_stats(&self) -> BuildStats {
+        self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solid_angle_of_an_octant() {
+        // The triangle X, Y, Z subtends one eighth of the sphere from the origin, which
+        // sees it counter-clockwise (its normal (1,1,1) points away from the origin).
+        let w = solid_angle(DVec3::X, DVec3::Y, DVec3::Z);
+        assert!((w - 4.0 * PI / 8.0).abs() < 1e-15);
+        assert!((solid_angle(DVec3::X, DVec3::Z, DVec3::Y) + 4.0 * PI / 8.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,360 @@
+//! Simplicial coverings (SPEC §2, thesis §3.4–3.6).
+//!
+//! A polygon face P0…Pn−1 (n > 3) is covered by the n triangles (C, Pi, Pi+1), C its
+//! vertex centroid; a triangle face covers itself. The triangles keep the face's
+//! orientation, so on a non-convex face some of them are negative and the signed sum
+//! still covers the face exactly — no tessellation. Joining every covering triangle to a
+//! common apex O gives the covering tetrahedra of the solid; their signed volumes add up
+//! to the solid's volume (Alg. 3-1).
+//!
+//! Everything is index based: covering point `i < mesh.num_vertices()` is mesh vertex
+//! `i`, the rest are face centroids, so the identity of every covering vertex is known
+//! (the vertex-set rule of Alg. 4-1 and the GPU upload need it).
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use super::Mesh;
+
+/// The simplicial covering of a polygon mesh's faces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Covering {
+    /// Mesh vertices, then one centroid per face of degree > 3 (in face order).
+    pub points: Vec<DVec3>,
+    /// Covering triangles as indices into `points`, oriented like their face.
+    pub triangles: Vec<[u32; 3]>,
+    /// The mesh face each covering triangle comes from.
+    pub face_of: Vec<u32>,
+    /// Covering triangles of face `f` are `face_start[f]..face_start[f + 1]`.
+    pub face_start: Vec<u32>,
+    /// Number of mesh vertices (the first points).
+    pub num_mesh_vertices: usize,
+    polygon_offsets: Vec<usize>,
+    polygon_indices: Vec<u32>,
+}
+
+/// A directed edge whose reverse is not used as often as it is: the surface is open or
+/// inconsistently oriented there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnbalancedEdge {
+    pub a: u32,
+    pub b: u32,
+    /// Times the edge is used as a→b.
+    pub forward: u32,
+    /// Times the edge is used as b→a.
+    pub backward: u32,
+}
+
+/// Signed volume of the tetrahedron (O, A, B, C): det(A−O, B−O, C−O) / 6 (Def. 3.21).
+pub fn signed_tetra_volume(o: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    (a - o).dot((b - o).cross(c - o)) / 6.0
+}
+
+impl Covering {
+    /// Covers every face: triangles as they are, n-gons by the fan from their centroid.
+    pub fn new(mesh: &Mesh) -> Covering {
+        let nv = mesh.num_vertices();
+        let (offsets, indices) = mesh.face_parts();
+        let mut points = mesh.positions().to_vec();
+        let mut triangles =
+            Vec::with_capacity(mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum());
+        let mut face_of = Vec::with_capacity(triangles.capacity());
+        let mut face_start = Vec::with_capacity(mesh.num_faces() + 1);
+        face_start.push(0);
+        for (f, face) in mesh.faces().enumerate() {
+            if face.len() == 3 {
+                triangles.push([face[0], face[1], face[2]]);
+                face_of.push(f as u32);
+            } else {
+                let sum = face.iter().fold(DVec3::ZERO, |s, &i| s + mesh.positions()[i as usize]);
+                let c = points.len() as u32;
+                points.push(sum / face.len() as f64);
+                for (i, &p) in face.iter().enumerate() {
+                    triangles.push([c, p, face[(i + 1) % face.len()]]);
+                    face_of.push(f as u32);
+                }
+            }
+            face_start.push(triangles.len() as u32);
+        }
+        Covering {
+            points,
+            triangles,
+            face_of,
+            face_start,
+            num_mesh_vertices: nv,
+            polygon_offsets: offsets.to_vec(),
+            polygon_indices: indices.to_vec(),
+        }
+    }
+
+    pub fn num_faces(&self) -> usize {
+        self.face_start.len() - 1
+    }
+
+    /// The vertex indices (= covering point indices) of mesh face `f`, in order.
+    pub fn polygon(&self, f: usize) -> &[u32] {
+        &self.polygon_indices[self.polygon_offsets[f]..self.polygon_offsets[f + 1]]
+    }
+
+    /// Indices of the covering triangles of face `f`.
+    pub fn face_triangles(&self, f: usize) -> std::ops::Range<usize> {
+        self.face_start[f] as usize..self.face_start[f + 1] as usize
+    }
+
+    /// The three corners of covering triangle `t`.
+    pub fn triangle(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.points[i as usize])
+    }
+
+    /// Axis-aligned bounds of the covering points (both zero when there are none).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        if self.points.is_empty() {
+            return (DVec3::ZERO, DVec3::ZERO);
+        }
+        self.points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
+    /// Sum of the signed covering-tetra volumes with apex `o` (Alg. 3-1, §3.6.3).
+    ///
+    /// For a closed, consistently oriented mesh the result does not depend on `o`.
+    pub fn signed_volume_about(&self, o: DVec3) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.triangle(t);
+                signed_tetra_volume(o, a, b, c)
+            })
+            .sum()
+    }
+
+    /// Signed volume (Alg. 3-1) with the apex at the centre of the bounding box, which keeps
+    /// the determinants small; positive for outward-facing orientation.
+    pub fn volume(&self) -> f64 {
+        let (lo, hi) = self.bounds();
+        self.signed_volume_about((lo + hi) * 0.5)
+    }
+
+    /// Signed area of every covering triangle, measured along its face's vector area: a
+    /// triangle turning against its face (on a non-convex face) is negative (§3.6.2).
+    pub fn triangle_signed_areas(&self) -> Vec<f64> {
+        let face_dirs: Vec<DVec3> = self.face_vector_areas().iter().map(|v| v.normalize_or_zero()).collect();
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.triangle(t);
+                0.5 * (b - a).cross(c - a).dot(face_dirs[self.face_of[t] as usize])
+            })
+            .collect()
+    }
+
+    /// Vector area of every face: the sum of its covering triangles' vector areas (for a
+    /// planar polygon, its normal times its area).
+    pub fn face_vector_areas(&self) -> Vec<DVec3> {
+        (0..self.num_faces())
+            .map(|f| {
+                self.face_triangles(f).fold(DVec3::ZERO, |s, t| {
+                    let [a, b, c] = self.triangle(t);
+                    s + 0.5 * (b - a).cross(c - a)
+                })
+            })
+            .collect()
+    }
+
+    /// Area of every face: the signed areas of its covering triangles summed (§3.6.2).
+    pub fn face_areas(&self) -> Vec<f64> {
+        self.face_vector_areas().iter().map(|v| v.length()).collect()
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        self.face_areas().iter().sum()
+    }
+
+    /// The volume centroid Σ Vᵢ·(O+A+B+C)/4 / V over the covering tetras; `None` when the
+    /// volume is zero (relative to the bounding box).
+    pub fn centroid(&self) -> Option<DVec3> {
+        let (lo, hi) = self.bounds();
+        let o = (lo + hi) * 0.5;
+        let (mut v, mut m) = (0.0, DVec3::ZERO);
+        for t in 0..self.triangles.len() {
+            let [a, b, c] = self.triangle(t);
+            let vt = signed_tetra_volume(o, a, b, c);
+            v += vt;
+            m += vt * (o + a + b + c) * 0.25;
+        }
+        let scale = (hi - lo).max_element().powi(3);
+        (v.abs() > 1e-12 * scale).then(|| m / v)
+    }
+
+    /// The thesis' centroid (§3.6.1): face centroids weighted by their vertex counts,
+    /// Σ CGᵢ·Kᵢ / Σ Kᵢ — the mean of the face corners, not the volume centroid.
+    pub fn face_weighted_centroid(&self) -> Option<DVec3> {
+        let sum = self.polygon_indices.iter().fold(DVec3::ZERO, |s, &i| s + self.points[i as usize]);
+        (!self.polygon_indices.is_empty()).then(|| sum / self.polygon_indices.len() as f64)
+    }
+
+    /// The first mesh edge (in vertex order) used a different number of times in each
+    /// direction, if any. `None` means the faces form a closed, consistently oriented
+    /// surface (a 2-cycle), which is what the covering methods need; non-manifold edges
+    /// (used twice each way) are fine.
+    pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
+        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        for f in 0..self.num_faces() {
+            let poly = self.polygon(f);
+            for (i, &a) in poly.iter().enumerate() {
+                let b = poly[(i + 1) % poly.len()];
+                if a == b {
+                    continue;
+                }
+                let e = uses.entry((a.min(b), a.max(b))).or_default();
+                if a < b {
+                    e.0 += 1;
+                } else {
+                    e.1 += 1;
+                }
+            }
+        }
+        uses.into_iter()
+            .filter(|(_, (f, b))| f != b)
+            .min_by_key(|(k, _)| *k)
+            .map(|((a, b), (forward, backward))| UnbalancedEdge { a, b, forward, backward })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::TAU;
+
+    use super::*;
+
+    fn quad_box(lo: DVec3, hi: DVec3) -> Mesh {
+        let p: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2]))
+            .collect();
+        let f = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![2, 6, 7, 3],
+            vec![0, 4, 6, 2],
+            vec![1, 3, 7, 5],
+        ];
+        Mesh::new(p, f).unwrap()
+    }
+
+    /// A prism of height `h` over the polygon `xy` (counter-clockwise), polygon caps kept whole.
+    fn prism(xy: &[(f64, f64)], h: f64) -> Mesh {
+        let n = xy.len() as u32;
+        let mut p: Vec<DVec3> = xy.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+        p.extend(xy.iter().map(|&(x, y)| DVec3::new(x, y, h)));
+        let mut f = vec![(0..n).rev().collect::<Vec<_>>(), (n..2 * n).collect()];
+        for i in 0..n {
+            let j = (i + 1) % n;
+            f.push(vec![i, j, n + j, n + i]);
+        }
+        Mesh::new(p, f).unwrap()
+    }
+
+    fn torus(big: f64, small: f64, nu: u32, nv: u32) -> Mesh {
+        let mut p = Vec::new();
+        for i in 0..nu {
+            let t = TAU * i as f64 / nu as f64;
+            for j in 0..nv {
+                let s = TAU * j as f64 / nv as f64;
+                let r = big + small * s.cos();
+                p.push(DVec3::new(r * t.cos(), r * t.sin(), small * s.sin()));
+            }
+        }
+        let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
+        let f = (0..nu)
+            .flat_map(|i| (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+            .collect();
+        Mesh::new(p, f).unwrap()
+    }
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol * (1.0 + b.abs())
+    }
+
+    #[test]
+    fn cube_volume_area_centroid() {
+        let c = Covering::new(&quad_box(DVec3::splat(-1.0), DVec3::splat(1.0)));
+        assert_eq!(c.triangles.len(), 24);
+        assert_eq!(c.points.len(), 8 + 6);
+        assert!(close(c.volume(), 8.0, 1e-14));
+        assert!(close(c.signed_volume_about(DVec3::new(5.0, -3.0, 7.0)), 8.0, 1e-13));
+        assert!(close(c.area(), 24.0, 1e-14));
+        assert!(c.centroid().unwrap().length() < 1e-14);
+        assert!(c.face_weighted_centroid().unwrap().length() < 1e-14);
+        assert!(c.triangle_signed_areas().iter().all(|&a| close(a, 1.0, 1e-14)));
+        assert_eq!(c.unbalanced_edge(), None);
+    }
+
+    #[test]
+    fn offset_box_centroids_differ_from_origin() {
+        let c = Covering::new(&quad_box(DVec3::new(1.0, 2.0, 3.0), DVec3::new(3.0, 3.0, 7.0)));
+        assert!(close(c.volume(), 8.0, 1e-13));
+        assert!((c.centroid().unwrap() - DVec3::new(2.0, 2.5, 5.0)).length() < 1e-13);
+        assert!((c.face_weighted_centroid().unwrap() - DVec3::new(2.0, 2.5, 5.0)).length() < 1e-13);
+    }
+
+    #[test]
+    fn non_convex_l_prism() {
+        // L = [0,4]x[0,1] ∪ [0,1]x[1,3]: area 6, perimeter 14. Its vertex centroid (5/3, 4/3)
+        // lies in the notch, outside the L, so two cap triangles are negative.
+        let l = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)];
+        let h = 0.5;
+        let c = Covering::new(&prism(&l, h));
+        assert_eq!(c.unbalanced_edge(), None);
+        assert!(close(c.volume(), 6.0 * h, 1e-14));
+        assert!(close(c.area(), 2.0 * 6.0 + 14.0 * h, 1e-14));
+        let areas = c.triangle_signed_areas();
+        let caps: Vec<f64> = c.face_triangles(1).map(|t| areas[t]).collect();
+        assert_eq!(caps.iter().filter(|&&a| a < 0.0).count(), 2, "{caps:?}");
+        assert!(close(caps.iter().sum::<f64>(), 6.0, 1e-14));
+        // Volume centroid: bar (area 4, centre (2, 1/2)) + arm (area 2, centre (1/2, 2)).
+        let want = DVec3::new((4.0 * 2.0 + 2.0 * 0.5) / 6.0, (4.0 * 0.5 + 2.0 * 2.0) / 6.0, h / 2.0);
+        assert!((c.centroid().unwrap() - want).length() < 1e-14);
+        // Corner-weighted centroid: every vertex is a corner of exactly 3 faces (its cap and
+        // two side quads), so it is the mean of the 12 vertices.
+        let fw = c.face_weighted_centroid().unwrap();
+        assert!((fw - DVec3::new(10.0 / 6.0, 8.0 / 6.0, h / 2.0)).length() < 1e-14, "{fw}");
+    }
+
+    #[test]
+    fn centroid_on_a_corner_gives_degenerate_triangles_but_right_sums() {
+        // Symmetric L: the vertex centroid (1,1) is the reflex corner itself.
+        let l = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)];
+        let c = Covering::new(&prism(&l, 1.0));
+        let areas = c.triangle_signed_areas();
+        assert_eq!(c.face_triangles(1).filter(|&t| areas[t] == 0.0).count(), 2);
+        assert!(close(c.volume(), 3.0, 1e-14));
+        assert!(close(c.area(), 6.0 + 8.0, 1e-14));
+    }
+
+    #[test]
+    fn torus_volume_matches_the_polyhedron() {
+        // Each of the nu slices is swept by a regular nv-gon of area A = nv/2 r² sin(2π/nv)
+        // whose centroid is at distance R from the axis; the slice's volume is
+        // sin(2π/nu) · R · A (its planar trapezoid faces interpolate linearly).
+        let (big, small, nu, nv) = (2.0, 0.5, 24, 12);
+        let c = Covering::new(&torus(big, small, nu, nv));
+        assert_eq!(c.unbalanced_edge(), None);
+        let a = nv as f64 / 2.0 * small * small * (TAU / nv as f64).sin();
+        let want = nu as f64 * (TAU / nu as f64).sin() * big * a;
+        assert!(close(c.volume(), want, 1e-13), "{} vs {want}", c.volume());
+        assert!(c.centroid().unwrap().length() < 1e-12);
+    }
+
+    #[test]
+    fn open_or_flipped_meshes_have_unbalanced_edges() {
+        let cube = quad_box(DVec3::ZERO, DVec3::ONE);
+        let mut faces: Vec<Vec<u32>> = cube.faces().map(<[u32]>::to_vec).collect();
+        let open = Mesh::new(cube.positions().to_vec(), faces[1..].to_vec()).unwrap();
+        let e = Covering::new(&open).unbalanced_edge().unwrap();
+        assert_eq!(e.forward + e.backward, 1);
+        faces[2].reverse();
+        let flipped = Mesh::new(cube.positions().to_vec(), faces).unwrap();
+        let e = Covering::new(&flipped).unbalanced_edge().unwrap();
+        assert!(e.forward == 2 || e.backward == 2, "{e:?}");
+    }
+}

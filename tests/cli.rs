@@ -1,0 +1,107 @@
+//! The `texgeo` command line: output, exit status 2 with one clear message on errors.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn texgeo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("texgeo-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn info_names_the_device_and_logic_op() {
+    let o = texgeo(&["info"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("device: "), "{out}");
+    assert!(out.contains("logicOp: yes"), "{out}");
+}
+
+#[test]
+fn mesh_stats_and_convert() {
+    let o = texgeo(&["mesh", "stats", "builtin:cube"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("closed: yes, oriented: yes, manifold: yes"), "{out}");
+    assert!(out.contains("Euler characteristic   2"), "{out}");
+    assert!(out.contains("area                   24"), "{out}");
+    let obj = temp("knot.obj");
+    let o = texgeo(&["mesh", "convert", "builtin:knot", obj.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = texgeo(&["mesh", "stats", obj.to_str().unwrap()]);
+    assert!(stdout(&o).contains("1200 (1200×3-gon)"), "{}", stdout(&o));
+}
+
+#[test]
+fn errors_exit_2_with_one_message() {
+    let bad = temp("bad.off");
+    std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").unwrap();
+    for (args, needle) in [
+        (vec!["mesh", "stats", "no/such/file.off"], "no/such/file.off"),
+        (vec!["mesh", "stats", bad.to_str().unwrap()], "bad.off:6: vertex index 7 is out of range"),
+        (vec!["mesh", "stats", "builtin:nothing"], "no built-in model 'nothing'"),
+        (vec!["mesh", "stats", "model.xyz"], "unknown mesh format"),
+        (
+            vec!["inclusion", "builtin:cube", "--random", "10", "--method", "magic"],
+            "unknown inclusion method 'magic'",
+        ),
+    ] {
+        let o = texgeo(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = stderr(&o);
+        assert!(err.starts_with("texgeo: error: ") && err.contains(needle), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "one message: {err}");
+    }
+    // clap's own usage errors also exit with 2.
+    assert_eq!(texgeo(&["inclusion"]).status.code(), Some(2));
+}
+
+#[test]
+fn inclusion_writes_one_class_per_point() {
+    let pts = temp("points.txt");
+    std::fs::write(&pts, "# x y z\n0 0 0\n2 0 0\n1 0 0\n0.5 0.5 -0.5\n").unwrap();
+    let out = temp("classes.txt");
+    for method in ["cpu", "tetragrid", "gpu", "cpu+gpu", "gpu+tetragrid", "jordan", "winding"] {
+        let o = texgeo(&[
+            "inclusion",
+            "builtin:cube",
+            "--points",
+            pts.to_str().unwrap(),
+            "--method",
+            method,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "1\n0\n2\n1\n", "{method}");
+    }
+    let o = texgeo(&["inclusion", "builtin:knot", "--random", "500", "--method", "gpu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("500 points"), "{}", stdout(&o));
+}
+
+#[test]
+fn open_meshes_are_refused_unless_allowed() {
+    let open = temp("open.off");
+    std::fs::write(&open, "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n").unwrap();
+    let o = texgeo(&["inclusion", open.to_str().unwrap(), "--random", "10", "--method", "cpu"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not closed"), "{}", stderr(&o));
+    let o =
+        texgeo(&["inclusion", open.to_str().unwrap(), "--random", "10", "--method", "cpu", "--allow-open"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("warning"), "{}", stderr(&o));
+}
