@@ -32,6 +32,28 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// The 2010 thesis' Table 5: Catmull-Clark to level 5 with fragment meshes on the GPU
+    /// vs the CPU reference and OpenSubdiv, on built-in models and fetched ones.
+    Subdivide {
+        /// Subdivision level.
+        #[arg(long, short, default_value_t = 5)]
+        level: u32,
+        /// Extra mesh files (or `builtin:NAME`) to measure after the default models.
+        #[arg(long = "mesh", value_name = "MESH")]
+        meshes: Vec<String>,
+        /// Folder of fetched models (tools/fetch-models); those of the default set found
+        /// there are measured.
+        #[arg(long, default_value = "models")]
+        models: PathBuf,
+        /// Measure only the given --mesh files.
+        #[arg(long)]
+        only: bool,
+        /// Also compare every GPU result with OpenSubdiv (slow on millions of faces).
+        #[arg(long)]
+        validate: bool,
+        #[command(flatten)]
+        common: Common,
+    },
 }
 
 /// Models for the thesis-table benchmarks: `--models` or the stand-ins found in `--models-dir`.
@@ -109,6 +131,16 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
             finish(bench::reduce::run(&ctx, &sizes, common.runs)?, &common)
+        }
+        Command::Subdivide { level, meshes, models, only, validate, common } => {
+            use bench::subdiv::{Model, Settings, default_models};
+            let mut list = if only { Vec::new() } else { default_models(&models)? };
+            for m in &meshes {
+                list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+            }
+            anyhow::ensure!(!list.is_empty(), "no models to measure");
+            let settings = Settings { level, runs: common.runs, validate };
+            finish(bench::subdiv::run(&ctx, &list, settings)?, &common)
         }
     }
 }

@@ -2,3 +2,4 @@
 
 pub mod inclusion;
 pub mod reduce;
+pub mod subdiv;
