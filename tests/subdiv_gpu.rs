@@ -9,7 +9,7 @@ mod common;
 use common::shapes;
 use glam::DVec3;
 use texgeo::gpu::Context;
-use texgeo::mesh::Mesh;
+use texgeo::mesh::{Mesh, procedural};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::fragment::{self, BaseLevel, FragmentMesh};
 use texgeo::subdiv::gpu::{MAX_RUNS, Options, Packing, Subdivider};
@@ -103,7 +103,7 @@ fn valences_3_to_8_and_ngon_match_opensubdiv() {
 fn torus_knot_1200_triangles_matches_opensubdiv() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
-    let knot = shapes::torus_knot(100, 6);
+    let knot = procedural::torus_knot();
     assert_eq!(knot.num_faces(), 1200);
     assert_gpu_matches_opensubdiv(&ctx, &mut sub, "torus_knot", &knot, 1..=4, &Options::default());
 }
