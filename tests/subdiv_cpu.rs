@@ -5,7 +5,7 @@ mod common;
 
 use common::shapes;
 use glam::DVec3;
-use texgeo::mesh::Mesh;
+use texgeo::mesh::{Mesh, procedural};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::topology::Topology;
 use texgeo::subdiv::{SubdivError, cpu, osd};
@@ -73,7 +73,7 @@ fn matches_opensubdiv_open_meshes() {
 
 #[test]
 fn matches_opensubdiv_torus_knot_1200() {
-    let knot = shapes::torus_knot(100, 6);
+    let knot = procedural::torus_knot();
     assert_eq!(knot.num_faces(), 1200);
     assert_matches_opensubdiv("torus_knot", &knot, 1..=3);
 }

@@ -21,7 +21,9 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 
 #[test]
 fn binvox_round_trips_exactly() {
-    for (mesh, n) in [(procedural::torus_knot(), 37), (procedural::cube_with_cavity(), 64), (procedural::cube(), 1)] {
+    for (mesh, n) in
+        [(procedural::torus_knot(), 37), (procedural::cube_with_cavity(), 64), (procedural::cube(), 1)]
+    {
         let r = voxelize(None, &mesh, n, Method::Scanline).unwrap();
         let bytes = binvox::to_bytes(&r.grid, &r.volume).unwrap();
         assert!(bytes.starts_with(format!("#binvox 1\ndim {n} {n} {n}\n").as_bytes()));
@@ -149,7 +151,10 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                             if tetra_box_overlap(&t, lo, lo + DVec3::splat(h)) {
                                 touched += 1;
                                 let c = tetragrid::cell_index(n, i, j, k) as u32;
-                                assert!(listed.contains(&c), "n {n} offset {offset}: cell ({i},{j},{k}) of {t:?}");
+                                assert!(
+                                    listed.contains(&c),
+                                    "n {n} offset {offset}: cell ({i},{j},{k}) of {t:?}"
+                                );
                             }
                         }
                     }
@@ -157,13 +162,19 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                 // Conservative, but not the whole grid: every listed cell is within the
                 // offset (plus a cell diagonal) of the tetra's box.
                 assert!(cells.len() >= touched);
-                let (tlo, thi) = (t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p)), t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p)));
+                let (tlo, thi) = (
+                    t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p)),
+                    t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p)),
+                );
                 let reach = (offset + 1.0) * h * 3f64.sqrt();
                 for &c in &cells {
                     let c = c as usize;
                     let (i, k, j) = (c % n, c / n % n, c / (n * n));
                     let centre = grid.centre(i, j, k);
-                    assert!(centre.cmpge(tlo - DVec3::splat(reach)).all() && centre.cmple(thi + DVec3::splat(reach)).all());
+                    assert!(
+                        centre.cmpge(tlo - DVec3::splat(reach)).all()
+                            && centre.cmple(thi + DVec3::splat(reach)).all()
+                    );
                 }
             }
         }

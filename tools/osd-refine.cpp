@@ -10,9 +10,10 @@
 // precision. The last level is written to OUT as OFF with %.17g coordinates, in
 // OpenSubdiv's default vertex order (vertex points, face points, edge points).
 //
-// With --repeat N, topology creation + refinement + interpolation is timed N times and
-// one line is printed on stdout:
-//   osd-refine: level=L vertices=V faces=F repeat=N min_seconds=S
+// With --repeat N, topology creation + refinement + interpolation is timed N times (the
+// previous run's result is freed outside the timed region) and one line is printed on
+// stdout:
+//   osd-refine: level=L vertices=V faces=F repeat=N min_seconds=S median_seconds=M
 // Errors go to stderr as `file:line: message` and exit with status 1.
 //
 // Face indices are range-checked here: OpenSubdiv itself does not check them.
@@ -287,17 +288,21 @@ int main(int argc, char** argv) {
     if (mesh.faceSizes.empty()) fail(in, "the mesh has no faces");
 
     Result r;
-    double best = std::numeric_limits<double>::infinity();
+    std::vector<double> seconds;
     for (long k = 0; k < std::max(repeat, 1L); ++k) {
+        r = Result();
         auto t0 = std::chrono::steady_clock::now();
         r = refine(mesh, int(level), fullTopology);
         auto t1 = std::chrono::steady_clock::now();
-        best = std::min(best, std::chrono::duration<double>(t1 - t0).count());
+        seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
     }
     if (repeat > 0) {
+        std::sort(seconds.begin(), seconds.end());
+        size_t n = seconds.size();
+        double median = n % 2 == 1 ? seconds[n / 2] : 0.5 * (seconds[n / 2 - 1] + seconds[n / 2]);
         Far::TopologyLevel const& last = r.refiner->GetLevel(int(level));
-        std::printf("osd-refine: level=%ld vertices=%d faces=%d repeat=%ld min_seconds=%.6f\n", level,
-                    last.GetNumVertices(), last.GetNumFaces(), repeat, best);
+        std::printf("osd-refine: level=%ld vertices=%d faces=%d repeat=%ld min_seconds=%.6f median_seconds=%.6f\n",
+                    level, last.GetNumVertices(), last.GetNumFaces(), repeat, seconds[0], median);
     }
     if (positional.size() == 3) writeOff(positional[2], r);
     return 0;

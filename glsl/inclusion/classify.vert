@@ -1,14 +1,17 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Alg. 4-2, phase 1 over every covering tetrahedron: vertex i sums tetrahedra
-// [i*batch, (i+1)*batch) for point group first_group + instance.
+// [i*batch, (i+1)*batch) for point group `instance` and lands in that group's tile.
 #include "texel.glsl"
 #include "classify_common.glsl"
 
 void main() {
     uint vertex = uint(gl_VertexIndex);
-    uint group = pc.first_group + uint(gl_InstanceIndex);
-    place(vertex, uint(gl_InstanceIndex));
+    uint group = uint(gl_InstanceIndex);
+    ivec2 t = texel_of(vertex, uint(pc.size.x));
+    t.y += int(group * pc.tile_rows);
+    gl_Position = texel_centre(t, pc.size);
+    gl_PointSize = 1.0;
     vec3 q[GROUP_POINTS];
     float acc[GROUP_POINTS];
     for (int k = 0; k < GROUP_POINTS; ++k) {

@@ -1,34 +1,33 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Alg. 4-2, phase 1 with the TetraGrid: each instance is a job, the query points of
-// one grid cell (up to 32) against that cell's tetrahedra only. Vertex i sums batch i
-// of the cell's list; vertices past the end of a shorter list are sent off target.
+// Alg. 4-2, phase 1 with the TetraGrid: the query points of one grid cell (up to 32,
+// a job) against that cell's tetrahedra only. Each point-vertex is one batch of one
+// job's list and carries where it goes: the vertices of a job fill 4x4 tiles of the
+// target, which the 2x2 reduction sums to one texel each.
 #include "texel.glsl"
 #include "classify_common.glsl"
 
 layout(set = 0, binding = 2) uniform usampler2D cell_lists;
 // Per job: x = first entry of the cell's list, y = list length, z = first point,
-// w = point count. Instance i of a draw runs job first_group + i.
+// w = point count.
 layout(set = 0, binding = 3) uniform Jobs {
     uvec4 jobs[MAX_POINTS];
 } jobs;
 
+// x: job, y: batch of the job's list, zw: target texel.
+layout(location = 0) in uvec4 item;
+
 void main() {
-    uvec4 job = jobs.jobs[pc.first_group + uint(gl_InstanceIndex)];
-    uint vertex = uint(gl_VertexIndex);
-    uint first = vertex * pc.batch;
-    if (first >= job.y) {
-        gl_Position = vec4(2.0, 2.0, 0.0, 1.0); // outside the view volume: no fragment
-        gl_PointSize = 1.0;
-        return;
-    }
-    place(vertex, uint(gl_InstanceIndex));
+    uvec4 job = jobs.jobs[item.x];
+    gl_Position = texel_centre(ivec2(item.zw), pc.size);
+    gl_PointSize = 1.0;
     vec3 q[GROUP_POINTS];
     float acc[GROUP_POINTS];
     for (int k = 0; k < GROUP_POINTS; ++k) {
         q[k] = points.p[job.z + uint(k)].xyz;
         acc[k] = 0.0;
     }
+    uint first = item.y * pc.batch;
     uint last = min(first + pc.batch, job.y);
     for (uint e = first; e < last; ++e) {
         uint at = job.x + e;

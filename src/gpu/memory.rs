@@ -130,6 +130,19 @@ impl Buffer {
         Ok(from_bytes(self.bytes()?))
     }
 
+    /// The buffer's contents viewed as values without copying (after the submission that
+    /// filled it has completed); a trailing partial value is left out.
+    pub fn view<T: Pod>(&self) -> Result<&[T]> {
+        let bytes = self.bytes()?;
+        if bytes.as_ptr().align_offset(std::mem::align_of::<T>()) != 0 {
+            return Err(GpuError::Usage("mapped buffer memory is not aligned for this type".into()));
+        }
+        let n = bytes.len() / std::mem::size_of::<T>();
+        // SAFETY: aligned (checked), `n` values lie inside the mapped bytes, Pod accepts any
+        // bit pattern, and the borrow of `self` keeps the mapping alive.
+        Ok(unsafe { std::slice::from_raw_parts(bytes.as_ptr() as *const T, n) })
+    }
+
     /// The buffer's bytes (after the submission that filled it has completed).
     pub fn bytes(&self) -> Result<&[u8]> {
         let size = self.size as usize;

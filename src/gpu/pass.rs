@@ -118,17 +118,31 @@ impl<'d> Recorder<'d> {
 
     /// Uploads `data` (tightly packed rows) into layer `layer` of `tex`.
     pub fn upload<T: Pod>(&mut self, tex: &Texture, layer: u32, data: &[T]) -> Result<()> {
+        self.upload_region(tex, layer, [0, 0, tex.width(), tex.height()], data)
+    }
+
+    /// Uploads `data` (tightly packed rows of `rect`'s width) into the rectangle `rect` of
+    /// layer `layer` of `tex`; the rest of the texture keeps its contents.
+    pub fn upload_region<T: Pod>(&mut self, tex: &Texture, layer: u32, rect: Rect, data: &[T]) -> Result<()> {
         self.check(tex)?;
         let bytes = as_bytes(data);
-        if bytes.len() as u64 != tex.layer_bytes() || layer >= tex.layers() {
+        let [x, y, w, h] = rect;
+        let expected = w as u64 * h as u64 * tex.format().bytes_per_texel();
+        if bytes.len() as u64 != expected
+            || layer >= tex.layers()
+            || w == 0
+            || h == 0
+            || x.checked_add(w).is_none_or(|e| e > tex.width())
+            || y.checked_add(h).is_none_or(|e| e > tex.height())
+        {
             return Err(GpuError::Usage(format!(
-                "upload of {} bytes into layer {layer} of a {}×{}×{} {:?} texture ({} bytes per layer)",
+                "upload of {} bytes into layer {layer}, rect {rect:?} of a {}×{}×{} {:?} texture \
+                 ({expected} bytes expected)",
                 bytes.len(),
                 tex.width(),
                 tex.height(),
                 tex.layers(),
                 tex.format(),
-                tex.layer_bytes()
             )));
         }
         let usage = vk::BufferUsageFlags::TRANSFER_SRC;
@@ -143,7 +157,8 @@ impl<'d> Recorder<'d> {
                     .base_array_layer(layer)
                     .layer_count(1),
             )
-            .image_extent(vk::Extent3D { width: tex.width(), height: tex.height(), depth: 1 })];
+            .image_offset(vk::Offset3D { x: x as i32, y: y as i32, z: 0 })
+            .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })];
         // SAFETY: sizes checked above; buffer kept alive until the submission ends.
         unsafe {
             self.dev.raw.cmd_copy_buffer_to_image(

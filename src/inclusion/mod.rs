@@ -48,6 +48,7 @@ use crate::mesh::covering::UnbalancedEdge;
 pub mod bvh;
 pub mod cpu;
 pub mod gpu;
+pub mod gpu_grid;
 pub mod jordan;
 pub mod octants;
 pub mod octree;

@@ -134,6 +134,14 @@ impl JordanOctree {
         self.depth
     }
 
+    /// The octree alone (nodes and triangle lists), without the shared surface data.
+    pub fn index_stats(&self) -> BuildStats {
+        BuildStats {
+            build_time: self.stats.build_time,
+            bytes: vec_bytes(&self.nodes) + vec_bytes(&self.items),
+        }
+    }
+
     fn leaf_items(&self, node: &Node) -> &[u32] {
         &self.items[node.start as usize..(node.start + node.count) as usize]
     }

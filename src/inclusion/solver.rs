@@ -3,7 +3,8 @@
 
 use glam::DVec3;
 
-use super::gpu::{GpuGridInclusion, GpuInclusion, GpuOptions, GpuStats, Phase2};
+use super::gpu::{GpuInclusion, GpuOptions, GpuStats, Phase2};
+use super::gpu_grid::GpuGridInclusion;
 use super::tetragrid::TetraGrid;
 use super::{BuildStats, Class, Classifier, FeitoTorres, Method, Options, Result, build};
 use crate::gpu::Context;
@@ -12,7 +13,7 @@ use crate::mesh::Mesh;
 /// Defaults for the GPU methods: tetrahedra per point-vertex, measured on lavapipe
 /// (`texgeo bench inclusion` reports the thesis' batch of 1 beside them).
 pub const GPU_BATCH: u32 = 64;
-pub const GPU_GRID_BATCH: u32 = 32;
+pub const GPU_GRID_BATCH: u32 = 64;
 
 pub enum Solver {
     Cpu(Box<dyn Classifier>),

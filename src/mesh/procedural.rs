@@ -147,8 +147,14 @@ pub fn torus(major: f64, minor: f64, nu: usize, nv: usize) -> Mesh {
 /// Closed, manifold, genus 1; strands stay ≥ 1.66 apart, so the tube does not
 /// self-intersect.
 pub fn torus_knot() -> Mesh {
-    const ALONG: usize = 75;
-    const AROUND: usize = 8;
+    torus_knot_tube(75, 8)
+}
+
+/// The same (2,3) torus-knot tube with `along` rings of `around` vertices:
+/// `2 · along · around` triangles (e.g. 400 × 8 = 6400, the size of CGAL's knot1.off).
+/// Both counts are clamped to at least 3.
+pub fn torus_knot_tube(along: usize, around: usize) -> Mesh {
+    let (along, around) = (along.max(3), around.max(3));
     const TUBE: f64 = 0.4;
     let (p, q, big, small) = (2.0, 3.0, 2.0, 1.0);
     let curve = |t: f64| {
@@ -165,24 +171,24 @@ pub fn torus_knot() -> Mesh {
         )
         .normalize()
     };
-    let mut positions = Vec::with_capacity(ALONG * AROUND);
-    for i in 0..ALONG {
-        let t = TAU * i as f64 / ALONG as f64;
+    let mut positions = Vec::with_capacity(along * around);
+    for i in 0..along {
+        let t = TAU * i as f64 / along as f64;
         let (c, tan) = (curve(t), tangent(t));
         // The direction away from the z axis is never along the tangent (the curve always
         // turns around the axis), so this frame is well defined and periodic.
         let radial = DVec3::new(c.x, c.y, 0.0).normalize();
         let n = (radial - radial.dot(tan) * tan).normalize();
         let b = tan.cross(n);
-        for j in 0..AROUND {
-            let psi = TAU * j as f64 / AROUND as f64;
+        for j in 0..around {
+            let psi = TAU * j as f64 / around as f64;
             positions.push(c + TUBE * (psi.cos() * n + psi.sin() * b));
         }
     }
-    let at = |i: usize, j: usize| ((i % ALONG) * AROUND + j % AROUND) as u32;
-    let mut faces = Vec::with_capacity(2 * ALONG * AROUND);
-    for i in 0..ALONG {
-        for j in 0..AROUND {
+    let at = |i: usize, j: usize| ((i % along) * around + j % around) as u32;
+    let mut faces = Vec::with_capacity(2 * along * around);
+    for i in 0..along {
+        for j in 0..around {
             // With (tangent, n, b) right-handed, going around j then along i faces outward.
             let (a, b, c, d) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
             faces.push(vec![a, b, c]);

@@ -12,6 +12,8 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
     /// Lines printed under the table (what was measured, how, caveats).
     pub notes: Vec<String>,
+    /// File stem of the table's CSV (`REPORT-STEM.csv`); empty = numbered.
+    pub stem: String,
 }
 
 impl Table {
@@ -21,6 +23,12 @@ impl Table {
             columns: columns.iter().map(|c| c.to_string()).collect(),
             ..Default::default()
         }
+    }
+
+    /// Names the table's CSV file.
+    pub fn named(mut self, stem: &str) -> Table {
+        self.stem = stem.to_string();
+        self
     }
 
     pub fn row(&mut self, cells: Vec<String>) {
@@ -89,7 +97,9 @@ impl Report {
         std::fs::write(&md, self.to_markdown())?;
         written.push(md);
         for (k, t) in self.tables.iter().enumerate() {
-            let name = if self.tables.len() == 1 {
+            let name = if !t.stem.is_empty() {
+                format!("{}-{}.csv", self.name, t.stem)
+            } else if self.tables.len() == 1 {
                 format!("{}.csv", self.name)
             } else {
                 let slug: String = t

@@ -25,6 +25,15 @@ pub enum SubdivError {
     /// The mesh has more elements than 32-bit indices can address at the requested level.
     #[error("level {level} would be too large for 32-bit indices ({vertices} vertices)")]
     TooLarge { level: u32, vertices: u64 },
+    /// The fragment-mesh path cannot represent this input or stream (SPEC §5.2).
+    #[error("fragment mesh: {0}")]
+    Fragment(String),
+    /// The GPU fragment path needs more than the device offers (texture size, classes).
+    #[error("GPU subdivision: {0}")]
+    GpuLimit(String),
+    /// A Vulkan failure (including validation errors) in the GPU fragment path.
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::GpuError),
     /// A refined mesh could not be assembled or a mesh file could not be read or written.
     #[error(transparent)]
     Mesh(#[from] MeshError),

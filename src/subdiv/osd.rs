@@ -47,8 +47,9 @@ pub struct Options {
 pub struct Run {
     /// The last level, in OpenSubdiv's vertex order (absent with `no_output`).
     pub mesh: Option<Mesh>,
-    /// Minimum time of refine + interpolate over the repeats, in seconds.
+    /// Minimum and median time of refine + interpolate over the repeats, in seconds.
     pub min_seconds: Option<f64>,
+    pub median_seconds: Option<f64>,
 }
 
 /// OpenSubdiv's Catmull-Clark refinement of `mesh` to `level`.
@@ -62,6 +63,13 @@ pub fn time(mesh: &Mesh, level: u32, repeat: u32) -> Result<f64> {
     let options = Options { repeat: Some(repeat.max(1)), no_output: true, ..Options::default() };
     let run = run(mesh, level, &options)?;
     run.min_seconds.ok_or_else(|| helper_error(Path::new("osd-refine"), "no timing was printed"))
+}
+
+/// Median seconds of refine + interpolate of `mesh` to `level` over `repeat` runs.
+pub fn time_median(mesh: &Mesh, level: u32, repeat: u32) -> Result<f64> {
+    let options = Options { repeat: Some(repeat.max(1)), no_output: true, ..Options::default() };
+    let run = run(mesh, level, &options)?;
+    run.median_seconds.ok_or_else(|| helper_error(Path::new("osd-refine"), "no timing was printed"))
 }
 
 /// Runs the helper on `mesh` with `options`.
@@ -88,24 +96,32 @@ pub fn run(mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
         let stderr = String::from_utf8_lossy(&result.stderr);
         return Err(helper_error(&helper, format!("{}: {}", result.status, stderr.trim())));
     }
-    let min_seconds = match options.repeat {
-        Some(_) => Some(
-            parse_seconds(&String::from_utf8_lossy(&result.stdout))
-                .ok_or_else(|| helper_error(&helper, "expected 'min_seconds=S' on stdout".to_string()))?,
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    let (min_seconds, median_seconds) = match options.repeat {
+        Some(_) => (
+            Some(parse_seconds(&stdout, "min_seconds=").ok_or_else(|| {
+                helper_error(&helper, "expected 'min_seconds=S' on stdout (run tools/setup)".to_string())
+            })?),
+            Some(parse_seconds(&stdout, "median_seconds=").ok_or_else(|| {
+                helper_error(
+                    &helper,
+                    "expected 'median_seconds=S' on stdout (an old helper: run tools/setup)".to_string(),
+                )
+            })?),
         ),
-        None => None,
+        None => (None, None),
     };
     let mesh = if options.no_output { None } else { Some(formats::read(&output)?) };
-    Ok(Run { mesh, min_seconds })
+    Ok(Run { mesh, min_seconds, median_seconds })
 }
 
 fn helper_error(path: &Path, message: impl Into<String>) -> SubdivError {
     SubdivError::Helper { path: path.to_path_buf(), message: message.into() }
 }
 
-/// The value of `min_seconds=` in the helper's timing line.
-fn parse_seconds(stdout: &str) -> Option<f64> {
-    stdout.split_whitespace().find_map(|t| t.strip_prefix("min_seconds="))?.parse().ok()
+/// The value of `key` (`min_seconds=` or `median_seconds=`) in the helper's timing line.
+fn parse_seconds(stdout: &str, key: &str) -> Option<f64> {
+    stdout.split_whitespace().find_map(|t| t.strip_prefix(key))?.parse().ok()
 }
 
 /// A private temporary folder, removed on drop.
@@ -134,8 +150,10 @@ impl Drop for TempDir {
 mod tests {
     #[test]
     fn parses_the_timing_line() {
-        let line = "osd-refine: level=5 vertices=10 faces=8 repeat=3 min_seconds=1.250000\n";
-        assert_eq!(super::parse_seconds(line), Some(1.25));
-        assert_eq!(super::parse_seconds("nothing"), None);
+        let line =
+            "osd-refine: level=5 vertices=10 faces=8 repeat=3 min_seconds=1.250000 median_seconds=1.5\n";
+        assert_eq!(super::parse_seconds(line, "min_seconds="), Some(1.25));
+        assert_eq!(super::parse_seconds(line, "median_seconds="), Some(1.5));
+        assert_eq!(super::parse_seconds("nothing", "min_seconds="), None);
     }
 }

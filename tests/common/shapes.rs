@@ -8,7 +8,7 @@
 use std::f64::consts::TAU;
 
 use glam::DVec3;
-use texgeo::mesh::Mesh;
+use texgeo::mesh::{Mesh, procedural};
 
 /// A shape of the set: its name (used in file names and messages) and mesh.
 pub struct Shape {
@@ -20,26 +20,9 @@ fn mesh(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Mesh {
     Mesh::new(positions, faces).expect("test shapes are valid meshes")
 }
 
-/// Cube [−1,1]³, six quads: every vertex has valence 3.
+/// Cube [−1,1]³, six quads: every vertex has valence 3 (the built-in model).
 pub fn cube() -> Mesh {
-    let positions = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { -1.0 } else { 1.0 },
-                if i & 2 == 0 { -1.0 } else { 1.0 },
-                if i & 4 == 0 { -1.0 } else { 1.0 },
-            )
-        })
-        .collect();
-    let faces = vec![
-        vec![0, 2, 3, 1],
-        vec![4, 5, 7, 6],
-        vec![0, 1, 5, 4],
-        vec![1, 3, 7, 5],
-        vec![3, 2, 6, 7],
-        vec![2, 0, 4, 6],
-    ];
-    mesh(positions, faces)
+    procedural::cube()
 }
 
 /// Cube without its top face: an open mesh, boundary vertices of valence 3.
@@ -49,15 +32,9 @@ pub fn open_cube() -> Mesh {
     mesh(cube.positions().to_vec(), faces)
 }
 
-/// Regular tetrahedron: four triangles, valence 3.
+/// Regular tetrahedron: four triangles, valence 3 (the built-in model).
 pub fn tetrahedron() -> Mesh {
-    let positions = vec![
-        DVec3::new(1.0, 1.0, 1.0),
-        DVec3::new(1.0, -1.0, -1.0),
-        DVec3::new(-1.0, 1.0, -1.0),
-        DVec3::new(-1.0, -1.0, 1.0),
-    ];
-    mesh(positions, vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 1], vec![1, 3, 2]])
+    procedural::tetrahedron()
 }
 
 /// Square pyramid: four triangles and a quad, apex valence 4, base valence 3.
@@ -138,37 +115,11 @@ pub fn grid(n: u32) -> Mesh {
     mesh(positions, faces)
 }
 
-/// A (2,3) torus knot tube of `2 · nu · nv` triangles (the thesis' "Torusknot" has 1200:
-/// `nu = 100, nv = 6`; CGAL's knot1.off-sized 6400: `nu = 400, nv = 8`).
-pub fn torus_knot(nu: u32, nv: u32) -> Mesh {
-    let curve = |s: f64| {
-        let r = 2.0 + (3.0 * s).cos();
-        DVec3::new(r * (2.0 * s).cos(), r * (2.0 * s).sin(), -(3.0 * s).sin())
-    };
-    let mut positions = Vec::new();
-    for i in 0..nu {
-        let s = TAU * f64::from(i) / f64::from(nu);
-        let c = curve(s);
-        let tangent = (curve(s + 1e-4) - curve(s - 1e-4)).normalize();
-        let normal = tangent.cross(c).normalize();
-        let binormal = tangent.cross(normal);
-        for j in 0..nv {
-            let a = TAU * f64::from(j) / f64::from(nv);
-            positions.push(c + 0.4 * (a.cos() * normal + a.sin() * binormal));
-        }
-    }
-    let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
-    let faces = (0..nu)
-        .flat_map(|i| {
-            (0..nv).flat_map(move |j| {
-                [
-                    vec![id(i, j), id(i, j + 1), id(i + 1, j + 1)],
-                    vec![id(i, j), id(i + 1, j + 1), id(i + 1, j)],
-                ]
-            })
-        })
-        .collect();
-    mesh(positions, faces)
+/// The built-in (2,3) torus-knot tube with `2 · along · around` triangles: 75 × 8 is the
+/// 1200-triangle `builtin:knot` (the thesis' "Torusknot"), 400 × 8 the 6400 of CGAL's
+/// knot1.off.
+pub fn torus_knot(along: usize, around: usize) -> Mesh {
+    procedural::torus_knot_tube(along, around)
 }
 
 /// The named set, small enough for every level the tests use.
@@ -181,6 +132,6 @@ pub fn all() -> Vec<Shape> {
         Shape { name: "valences", mesh: valences() },
         Shape { name: "grid", mesh: grid(3) },
         Shape { name: "open_cube", mesh: open_cube() },
-        Shape { name: "torus_knot", mesh: torus_knot(100, 6) },
+        Shape { name: "torus_knot", mesh: procedural::torus_knot() },
     ]
 }

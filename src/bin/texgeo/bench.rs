@@ -2,10 +2,28 @@
 
 use std::path::PathBuf;
 
+use texgeo::mesh::Mesh;
 use texgeo::report::{Report, bench};
 
 #[derive(clap::Subcommand)]
 pub enum Command {
+    /// Point in solid: the thesis' Tables 4-4 to 4-9 for every method.
+    Inclusion {
+        #[command(flatten)]
+        models: Models,
+        /// Point sets per model (the thesis: 10).
+        #[arg(long, default_value_t = 10)]
+        sets: usize,
+        /// Points per set (the thesis: 1000).
+        #[arg(long, default_value_t = 1000)]
+        points: usize,
+        /// TetraGrid resolutions for Tables 4-4 and 4-5.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![2, 4, 8, 16, 32, 64])]
+        resolutions: Vec<usize>,
+        /// Folder for the Markdown and CSV files.
+        #[arg(long, short, default_value = "out/bench")]
+        out: PathBuf,
+    },
     /// 2×2 ping-pong sum reduction (512², 2048², 4096²) against a plain CPU sum.
     Reduce {
         /// Texture sides to measure.
@@ -14,6 +32,67 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// The 2010 thesis' Table 5: Catmull-Clark to level 5 with fragment meshes on the GPU
+    /// vs the CPU reference and OpenSubdiv, on built-in models and fetched ones.
+    Subdivide {
+        /// Subdivision level.
+        #[arg(long, short, default_value_t = 5)]
+        level: u32,
+        /// Extra mesh files (or `builtin:NAME`) to measure after the default models.
+        #[arg(long = "mesh", value_name = "MESH")]
+        meshes: Vec<String>,
+        /// Folder of fetched models (tools/fetch-models); those of the default set found
+        /// there are measured.
+        #[arg(long, default_value = "models")]
+        models: PathBuf,
+        /// Measure only the given --mesh files.
+        #[arg(long)]
+        only: bool,
+        /// Also compare every GPU result with OpenSubdiv (slow on millions of faces).
+        #[arg(long)]
+        validate: bool,
+        #[command(flatten)]
+        common: Common,
+    },
+}
+
+/// Models for the thesis-table benchmarks: `--models` or the stand-ins found in `--models-dir`.
+#[derive(clap::Args)]
+pub struct Models {
+    /// Meshes to use (files or `builtin:NAME`), instead of the thesis stand-ins.
+    #[arg(long, value_delimiter = ',')]
+    models: Vec<String>,
+    /// Where `tools/fetch-models` put the CGAL meshes.
+    #[arg(long, default_value = "models")]
+    models_dir: PathBuf,
+}
+
+impl Models {
+    /// (thesis model, name, mesh) for each model to run.
+    fn load(
+        &self,
+        stand_ins: &[(&'static str, &'static str)],
+    ) -> anyhow::Result<Vec<(&'static str, String, Mesh)>> {
+        if !self.models.is_empty() {
+            return self.models.iter().map(|m| Ok(("–", m.clone(), crate::mesh::load(m)?))).collect();
+        }
+        let mut out = Vec::new();
+        for &(thesis, spec) in stand_ins {
+            let path = if spec.starts_with("builtin:") {
+                spec.to_string()
+            } else {
+                self.models_dir.join(spec).display().to_string()
+            };
+            if spec.starts_with("builtin:") || std::path::Path::new(&path).exists() {
+                out.push((thesis, spec.to_string(), crate::mesh::load(&path)?));
+            } else {
+                eprintln!(
+                    "texgeo: {path} not found (run tools/fetch-models); skipping the {thesis} stand-in"
+                );
+            }
+        }
+        Ok(out)
+    }
 }
 
 #[derive(clap::Args)]
@@ -37,11 +116,31 @@ fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
 pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
     let ctx = crate::open_context(device)?;
     match cmd {
+        Command::Inclusion { models, sets, points, resolutions, out } => {
+            anyhow::ensure!(sets > 0 && points > 0, "--sets and --points must be positive");
+            let models = models
+                .load(bench::inclusion::STAND_INS)?
+                .into_iter()
+                .map(|(thesis, name, mesh)| bench::inclusion::Model { thesis, name, mesh })
+                .collect::<Vec<_>>();
+            let cfg = bench::inclusion::Config { sets, points, resolutions };
+            finish(bench::inclusion::run(&ctx, &models, &cfg)?, &Common { runs: 0, out })
+        }
         Command::Reduce { sizes, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
             finish(bench::reduce::run(&ctx, &sizes, common.runs)?, &common)
+        }
+        Command::Subdivide { level, meshes, models, only, validate, common } => {
+            use bench::subdiv::{Model, Settings, default_models};
+            let mut list = if only { Vec::new() } else { default_models(&models)? };
+            for m in &meshes {
+                list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+            }
+            anyhow::ensure!(!list.is_empty(), "no models to measure");
+            let settings = Settings { level, runs: common.runs, validate };
+            finish(bench::subdiv::run(&ctx, &list, settings)?, &common)
         }
     }
 }

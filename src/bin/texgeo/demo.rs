@@ -83,8 +83,106 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         );
     }
 
-    // 4. Voxelization (issue 4): the torus knot sliced by the zoned vertex shader, checked
-    // against the exact scanline, written as binvox, PNG slices and a marble picture.
+    // 4. Point in solid on the GPU, checked against the exact CPU test and the oracle.
+    inclusion(&ctx, &args.out)?;
+
+    // 5. Catmull-Clark with fragment meshes on the GPU, checked against the references.
+    subdivision(&ctx, &args.out)?;
+
+    // 6. Solid voxelization by tetra slicing, checked against the exact scanline.
+    voxelization(&ctx, &args.out)
+}
+
+/// A 256×256 grid of points on the plane z = 0 through the torus knot, classified by the
+/// GPU Feito-Torres test, the exact CPU test and Jordan ray crossings, as a picture.
+fn inclusion(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Result<()> {
+    use texgeo::inclusion::solver::Solver;
+    use texgeo::inclusion::{Class, Method, Options};
+    let knot = procedural::torus_knot();
+    let (lo, hi) = knot.bounds();
+    let n = 256;
+    let points: Vec<glam::DVec3> = (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64 + 0.5, (k / n) as f64 + 0.5);
+            glam::DVec3::new(lo.x + (hi.x - lo.x) * i / n as f64, hi.y - (hi.y - lo.y) * j / n as f64, 0.0)
+        })
+        .collect();
+    println!(
+        "
+point in solid, {} points on the plane z = 0 through builtin:knot:",
+        points.len()
+    );
+    let mut answers = Vec::new();
+    for method in [Method::Gpu, Method::GpuTetraGrid, Method::Cpu, Method::TetraGrid, Method::JordanOctree] {
+        let mut solver = Solver::new(method, &knot, &Options::default(), Some(ctx), None)?;
+        let t = std::time::Instant::now();
+        let classes = solver.classify_all(&points)?;
+        let inside = classes.iter().filter(|&&c| c == Class::Inside).count();
+        println!("  {:<14} {inside:>6} inside in {:>7.1} ms", method.name(), t.elapsed().as_secs_f64() * 1e3);
+        answers.push(classes);
+    }
+    let agree = answers.windows(2).all(|w| w[0] == w[1]);
+    println!("  all methods agree point for point: {}", if agree { "yes" } else { "NO" });
+    anyhow::ensure!(agree, "inclusion methods disagree");
+    let pixels: Vec<u8> = answers[0]
+        .iter()
+        .map(|c| match c {
+            Class::Inside => 255,
+            Class::OnBoundary => 128,
+            Class::Outside => 0,
+        })
+        .collect();
+    let png = out.join("inclusion-knot-slice.png");
+    image::GrayImage::from_raw(n as u32, n as u32, pixels)
+        .context("image size")?
+        .save(&png)
+        .with_context(|| format!("writing {}", png.display()))?;
+    println!("  picture {}", png.display());
+    Ok(())
+}
+
+/// The cube (the thesis' 8 fragments) and the 1200-triangle torus knot to level 3 on the
+/// GPU, compared with the CPU reference and OpenSubdiv, written as OBJ.
+fn subdivision(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Result<()> {
+    use texgeo::subdiv::{compare::Comparison, cpu, gpu, osd};
+    println!("\nCatmull-Clark, level 3 (fragment passes on the GPU vs references):");
+    let mut subdivider = gpu::Subdivider::new(ctx)?;
+    for name in ["cube", "knot"] {
+        let Some(mesh) = procedural::by_name(name) else { continue };
+        let run = subdivider.refine(ctx, &mesh, 3, &gpu::Options::default())?;
+        let refined = &run.mesh;
+        let error = |reference: &texgeo::mesh::Mesh| {
+            let c = Comparison::new(refined, reference, 1e-5);
+            let verdict = if c.is_match() { "match" } else { "MISMATCH" };
+            format!("{verdict}, max error {:.1e} × diagonal", c.max_error / c.diagonal.max(f64::MIN_POSITIVE))
+        };
+        let vs_cpu = error(&cpu::refine(&mesh, 3)?);
+        let vs_osd = match osd::refine(&mesh, 3) {
+            Ok(reference) => error(&reference),
+            Err(e) => format!("not run ({e})"),
+        };
+        let file = out.join(format!("subdiv-{name}-level3.obj"));
+        texgeo::mesh::formats::write(&file, refined)
+            .with_context(|| format!("writing {}", file.display()))?;
+        println!(
+            "{name}: {} fragments, {} CPU + {} GPU levels -> {} vertices, {} quads in {:.1} ms, {}",
+            run.fragments,
+            run.cpu_levels,
+            run.gpu_levels,
+            refined.num_vertices(),
+            refined.num_faces(),
+            run.times.total.as_secs_f64() * 1e3,
+            file.display()
+        );
+        println!("  vs CPU reference: {vs_cpu}; vs OpenSubdiv: {vs_osd}");
+    }
+    Ok(())
+}
+
+/// The torus knot voxelized at 96³ by the zoned vertex shader (Alg. 5-2, PGPU-MP),
+/// checked against the exact scanline, written as binvox, PNG slices, Perlin marble
+/// slices (Fig. 5-9) and a rendered view.
+fn voxelization(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Result<()> {
     let knot = procedural::torus_knot();
     let n = 96;
     let grid = voxel::Grid::for_mesh(&knot, n)?;
@@ -93,12 +191,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let zoned = voxelizer.run(&solid, &grid, voxel::Method::Zoned)?;
     let exact = voxelizer.run(&solid, &grid, voxel::Method::Scanline)?;
     anyhow::ensure!(zoned.volume == exact.volume, "zoned and scanline voxelizations differ");
-    let binvox_path = args.out.join("knot.binvox");
+    let binvox_path = out.join("knot.binvox");
     voxel::binvox::write(&binvox_path, &grid, &zoned.volume)?;
-    let slices = voxel::pictures::write_slices(&zoned.volume, &args.out.join("knot-slices"))?;
-    let colours = voxel::aspect::render(&ctx, &zoned.volume, &voxel::aspect::Aspect::default())?;
-    voxel::pictures::write_rgba_slices(n, &colours, &args.out.join("knot-aspect"))?;
-    let picture = args.out.join("knot-voxels.png");
+    let slices = voxel::pictures::write_slices(&zoned.volume, &out.join("knot-slices"))?;
+    let colours = voxel::aspect::render(ctx, &zoned.volume, &voxel::aspect::Aspect::default())?;
+    voxel::pictures::write_rgba_slices(n, &colours, &out.join("knot-aspect"))?;
+    let picture = out.join("knot-voxels.png");
     voxel::pictures::render_front(&zoned.volume, Some(&colours))
         .save(&picture)
         .with_context(|| format!("writing {}", picture.display()))?;

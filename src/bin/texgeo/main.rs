@@ -1,10 +1,12 @@
-//! The `texgeo` command line. Errors print one message and exit with status 2.
+//! The `texgeo` command line. Errors print one message and exit with status 2 (a failed
+//! `--validate` comparison exits with status 1).
 
 mod bench;
 mod demo;
 mod inclusion;
 mod info;
 mod mesh;
+mod subdivide;
 mod voxelize;
 
 use clap::{Parser, Subcommand};
@@ -34,10 +36,12 @@ enum Command {
     Mesh(mesh::Command),
     /// Point in solid (Feito-Torres): classify query points as inside, outside or on the boundary.
     Inclusion(inclusion::Args),
+    /// Catmull-Clark subdivision: fragment meshes on the GPU, or the CPU reference.
+    Subdivide(subdivide::Args),
     /// Run a benchmark and write Markdown + CSV tables.
     #[command(subcommand)]
     Bench(bench::Command),
-    /// A short tour on built-in data: reduction, XOR raster, model statistics.
+    /// A short tour on built-in data: reduction, XOR raster, model statistics, Catmull-Clark.
     Demo(demo::Args),
     /// Solid voxelization by slicing tetrahedra with XOR; writes .binvox (+ PNG slices).
     Voxelize(voxelize::Args),
@@ -56,6 +60,7 @@ fn main() {
         Command::Info(a) => info::run(device, a),
         Command::Mesh(c) => mesh::run(c),
         Command::Inclusion(a) => inclusion::run(device, a),
+        Command::Subdivide(a) => subdivide::run(device, a),
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),

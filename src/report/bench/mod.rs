@@ -1,3 +1,5 @@
 //! Benchmark suites behind `texgeo bench …` and `cargo bench`.
 
+pub mod inclusion;
 pub mod reduce;
+pub mod subdiv;

@@ -1,0 +1,434 @@
+//! `texgeo bench inclusion`: the 2006 thesis' point-in-solid experiments (§4.4), Tables
+//! 4-4 to 4-9, on today's machine and Vulkan device, beside the thesis' numbers.
+//!
+//! Each model gets `sets` sets of `points` uniform random points in its bounding box
+//! (fixed seeds); a table cell is the mean time per set, as in the thesis (§4.4.2).
+//! Every method's answers are checked against `cpu` on every set.
+
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+
+use crate::gpu::Context;
+use crate::inclusion::bvh::Bvh;
+use crate::inclusion::octants::Octants;
+use crate::inclusion::octree::JordanOctree;
+use crate::inclusion::solver::Solver;
+use crate::inclusion::tetragrid::{RESOLUTIONS, TetraGrid};
+use crate::inclusion::{Class, Classifier, EdgeRule, FeitoTorres, InclusionError, Method, Options};
+use crate::mesh::Mesh;
+use crate::random::Rng;
+use crate::report::{Environment, Report, Table};
+
+/// A model of the experiment and the thesis model it stands in for.
+pub struct Model {
+    pub thesis: &'static str,
+    pub name: String,
+    pub mesh: Mesh,
+}
+
+/// Which models stand in for the thesis' (closed meshes of similar size and shape from
+/// Debian's libcgal-demo; `builtin:` ones need no download).
+pub const STAND_INS: &[(&str, &str)] = &[
+    ("Torusknot", "builtin:knot"),
+    ("Celtic Cross", "handle.off"),
+    ("Vertebra", "femur.off"),
+    ("Lion Head", "bear.off"),
+    ("Golf Ball", "diplodocus.off"),
+    ("Armadillo", "armadillo.off"),
+    ("Venus / Buddha / Dragon", "bunny00.off"),
+];
+
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub sets: usize,
+    pub points: usize,
+    /// TetraGrid resolutions of Tables 4-4 and 4-5.
+    pub resolutions: Vec<usize>,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config { sets: 10, points: 1000, resolutions: vec![2, 4, 8, 16, 32, 64] }
+    }
+}
+
+/// The thesis' tables, embedded so the binary carries them.
+const THESIS: [(&str, &str); 6] = [
+    ("4-4", include_str!("../../../reference/inclusion/table4-4.csv")),
+    ("4-5", include_str!("../../../reference/inclusion/table4-5.csv")),
+    ("4-6", include_str!("../../../reference/inclusion/table4-6.csv")),
+    ("4-7", include_str!("../../../reference/inclusion/table4-7.csv")),
+    ("4-8", include_str!("../../../reference/inclusion/table4-8.csv")),
+    ("4-9", include_str!("../../../reference/inclusion/table4-9.csv")),
+];
+
+fn thesis_table(id: &str) -> Table {
+    let csv = THESIS.iter().find(|(t, _)| *t == id).map(|(_, c)| *c).unwrap_or("");
+    let mut lines = csv.lines();
+    let columns: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let mut t = Table::new(
+        format!("Table {id} as printed in the thesis (Pentium 4E 3.4 GHz, GeForce 7800 GTX)"),
+        &columns,
+    )
+    .named(&format!("table{id}-thesis"));
+    for l in lines.filter(|l| !l.trim().is_empty()) {
+        t.row(l.split(',').map(str::to_string).collect());
+    }
+    t
+}
+
+fn secs(d: Duration) -> String {
+    format!("{:.6}", d.as_secs_f64())
+}
+
+fn kib(bytes: usize) -> String {
+    format!("{}", bytes.div_ceil(1024))
+}
+
+/// The point sets of one model (fixed seeds).
+fn point_sets(mesh: &Mesh, cfg: &Config) -> Vec<Vec<DVec3>> {
+    let (lo, hi) = mesh.bounds();
+    (0..cfg.sets).map(|k| Rng::new(4000 + k as u64).points_in_box(cfg.points, lo, hi)).collect()
+}
+
+/// Something that classifies a set of points (a CPU classifier or a GPU solver).
+type Classify<'a> = dyn FnMut(&[DVec3]) -> Result<Vec<Class>, InclusionError> + 'a;
+
+/// Mean time per set and whether every answer equals `want`.
+fn mean_time(
+    solver: &mut Classify,
+    sets: &[Vec<DVec3>],
+    want: &[Vec<Class>],
+) -> Result<(Duration, bool), InclusionError> {
+    // One untimed warm-up (lavapipe compiles shaders at the first draw).
+    solver(&sets[0])?;
+    let mut total = Duration::ZERO;
+    let mut agree = true;
+    for (set, w) in sets.iter().zip(want) {
+        let t = Instant::now();
+        let got = solver(set)?;
+        total += t.elapsed();
+        agree &= got == *w;
+    }
+    Ok((total / sets.len().max(1) as u32, agree))
+}
+
+struct Measured {
+    name: String,
+    thesis: &'static str,
+    vertices: usize,
+    faces: usize,
+    triangles: usize,
+    grid_builds: Vec<(Duration, usize)>,
+    /// Method name → (mean time per set, build time, bytes).
+    times: Vec<(String, Duration, Duration, usize)>,
+    grid_times: Vec<Duration>,
+    gpu_split: Vec<String>,
+    disagreements: Vec<String>,
+    /// Index-only build stats of the methods with preprocessing (Tables 4-7, 4-8).
+    index: Vec<(&'static str, crate::inclusion::BuildStats)>,
+}
+
+impl Measured {
+    fn time(&self, method: &str) -> String {
+        self.times.iter().find(|t| t.0 == method).map(|t| secs(t.1)).unwrap_or_else(|| "–".into())
+    }
+
+    fn index(&self, method: &str) -> Option<(Duration, usize)> {
+        self.index.iter().find(|t| t.0 == method).map(|t| (t.1.build_time, t.1.bytes))
+    }
+
+    fn ratio(&self, method: &str) -> String {
+        let get = |m: &str| self.times.iter().find(|t| t.0 == m).map(|t| t.1.as_secs_f64());
+        match (get("cpu"), get(method)) {
+            (Some(c), Some(m)) if m > 0.0 => format!("{:.1}×", c / m),
+            _ => "–".into(),
+        }
+    }
+}
+
+fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, InclusionError> {
+    let mesh = &model.mesh;
+    let sets = point_sets(mesh, cfg);
+    let covering = crate::mesh::covering::Covering::new(mesh);
+    let mut m = Measured {
+        name: model.name.clone(),
+        thesis: model.thesis,
+        vertices: mesh.num_vertices(),
+        faces: mesh.num_faces(),
+        triangles: covering.triangles.len(),
+        grid_builds: Vec::new(),
+        times: Vec::new(),
+        grid_times: Vec::new(),
+        gpu_split: Vec::new(),
+        disagreements: Vec::new(),
+        index: Vec::new(),
+    };
+
+    // The reference answers: the exact test with basic preprocessing.
+    let cpu = crate::inclusion::build(Method::Cpu, mesh, &Options::default())?;
+    let want: Vec<Vec<Class>> = sets.iter().map(|s| cpu.classify_all(s)).collect();
+
+    // Tables 4-4 and 4-5: TetraGrid at every resolution.
+    for &n in &cfg.resolutions {
+        if !RESOLUTIONS.contains(&n) {
+            return Err(InclusionError::Resolution(n));
+        }
+        let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
+        let grid = TetraGrid::new(ft, n)?;
+        let s = grid.index_stats();
+        m.grid_builds.push((s.build_time, s.bytes));
+        let (t, ok) = mean_time(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
+        if !ok {
+            m.disagreements.push(format!("tetragrid-{n}"));
+        }
+        m.grid_times.push(t);
+    }
+
+    // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6).
+    let methods = [
+        Method::Cpu,
+        Method::CpuGpu,
+        Method::Gpu,
+        Method::Octants,
+        Method::Bvh,
+        Method::TetraGrid,
+        Method::GpuTetraGrid,
+        Method::Jordan,
+        Method::JordanOctree,
+    ];
+    for method in methods {
+        let t = Instant::now();
+        let mut solver = Solver::new(method, mesh, &Options::default(), Some(ctx), None)?;
+        let build = t.elapsed();
+        let stats = solver.build_stats();
+        let (time, ok) = mean_time(&mut |p| solver.classify_all(p), &sets, &want)?;
+        if !ok {
+            m.disagreements.push(method.name().to_string());
+        }
+        if let Some(g) = solver.gpu_stats() {
+            m.gpu_split.push(format!(
+                "{}: last set {} points drawn in {} draw(s), GPU submissions {:.3} ms, host {:.3} ms, {} flagged → exact CPU {:.3} ms",
+                method,
+                g.gpu_points,
+                g.draws,
+                g.gpu.as_secs_f64() * 1e3,
+                g.host.as_secs_f64() * 1e3,
+                g.flagged,
+                g.fallback.as_secs_f64() * 1e3
+            ));
+        }
+        // CPU methods report their own build; GPU ones add texture uploads to the grid's.
+        let build = if method.is_cpu() { stats.build_time } else { build };
+        m.times.push((method.name().to_string(), time, build, stats.bytes));
+    }
+    // Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
+    // covering and per-tetra planes every Feito-Torres variant shares.
+    let ft = || FeitoTorres::with_options(mesh, None, EdgeRule::Rerun);
+    m.index = vec![
+        ("octants", Octants::new(ft()?).index_stats()),
+        ("tetragrid", TetraGrid::new(ft()?, 32)?.index_stats()),
+        ("bvh", Bvh::new(ft()?).index_stats()),
+        ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
+    ];
+    // The thesis' layout: one point-vertex per tetrahedron.
+    let mut thesis_gpu = Solver::new(Method::Gpu, mesh, &Options::default(), Some(ctx), Some(1))?;
+    let (time, ok) = mean_time(&mut |p| thesis_gpu.classify_all(p), &sets, &want)?;
+    if !ok {
+        m.disagreements.push("gpu (batch 1)".into());
+    }
+    m.times.push(("gpu-batch-1".into(), time, Duration::ZERO, 0));
+    Ok(m)
+}
+
+pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, InclusionError> {
+    let mut measured = Vec::new();
+    for model in models {
+        eprintln!("bench inclusion: {} ({} faces)…", model.name, model.mesh.num_faces());
+        measured.push(measure(ctx, model, cfg)?);
+    }
+    let res = &cfg.resolutions;
+    let label = |m: &Measured| format!("{} ({})", m.name, m.thesis);
+
+    let mut cols = vec!["model".to_string(), "vertices".into(), "tetrahedra".into()];
+    for n in res {
+        cols.push(format!("{n}³ s"));
+        cols.push(format!("{n}³ KiB"));
+    }
+    let mut t44 = Table {
+        title: "Table 4-4: TetraGrid build time (s) and memory (KiB)".into(),
+        columns: cols,
+        ..Default::default()
+    };
+    for m in &measured {
+        let mut row = vec![label(m), m.vertices.to_string(), m.triangles.to_string()];
+        for &(t, b) in &m.grid_builds {
+            row.push(secs(t));
+            row.push(kib(b));
+        }
+        t44.row(row);
+    }
+
+    let mut cols = vec!["model".to_string(), "faces".into(), "no optimizer".into()];
+    cols.extend(res.iter().map(|n| format!("TetraGrid {n}³")));
+    let mut t45 = Table {
+        title: format!(
+            "Table 4-5: Feito-Torres without and with TetraGrid, s per set of {} points",
+            cfg.points
+        ),
+        columns: cols,
+        ..Default::default()
+    };
+    for m in &measured {
+        let mut row = vec![label(m), m.faces.to_string(), m.time("cpu")];
+        row.extend(m.grid_times.iter().map(|&t| secs(t)));
+        t45.row(row);
+    }
+
+    let mut t46 = Table::new(
+        format!("Table 4-6: versions of Feito-Torres, s per set of {} points", cfg.points),
+        &[
+            "model",
+            "faces",
+            "basic (cpu)",
+            "CPU+GPU",
+            "GPU",
+            "GPU, thesis layout (batch 1)",
+            "octants",
+            "TetraGrid 32",
+            "GPU+TetraGrid 32",
+        ],
+    );
+    for m in &measured {
+        t46.row(vec![
+            label(m),
+            m.faces.to_string(),
+            m.time("cpu"),
+            m.time("cpu+gpu"),
+            m.time("gpu"),
+            m.time("gpu-batch-1"),
+            m.time("octants"),
+            m.time("tetragrid"),
+            m.time("gpu+tetragrid"),
+        ]);
+    }
+
+    let pre = ["octants", "tetragrid", "bvh", "jordan-octree"];
+    let mut t47 = Table::new(
+        "Table 4-7: memory of each method's index (KiB; BVH stands where the thesis had BSP)",
+        &[
+            "model",
+            "triangles",
+            "Feito (octants)",
+            "Feito (TetraGrid 32)",
+            "Feito (BVH)",
+            "Jordan (octree 6)",
+        ],
+    );
+    let mut t48 = Table::new(
+        "Table 4-8: time to build each method's index (s)",
+        &[
+            "model",
+            "triangles",
+            "Feito (octants)",
+            "Feito (TetraGrid 32)",
+            "Feito (BVH)",
+            "Jordan (octree 6)",
+        ],
+    );
+    for m in &measured {
+        let mut mem = vec![label(m), m.triangles.to_string()];
+        let mut time = mem.clone();
+        for p in pre {
+            let b = m.index(p);
+            mem.push(b.map(|b| kib(b.1)).unwrap_or_default());
+            time.push(b.map(|b| secs(b.0)).unwrap_or_default());
+        }
+        t47.row(mem);
+        t48.row(time);
+    }
+
+    let mut t49 = Table::new(
+        format!("Table 4-9: inclusion tests, s per set of {} points", cfg.points),
+        &[
+            "model",
+            "faces",
+            "Feito CPU",
+            "Feito GPU",
+            "Feito GPU+TetraGrid 32",
+            "Feito BVH",
+            "Jordan",
+            "Jordan octree 6",
+        ],
+    );
+    for m in &measured {
+        t49.row(vec![
+            label(m),
+            m.faces.to_string(),
+            m.time("cpu"),
+            m.time("gpu"),
+            m.time("gpu+tetragrid"),
+            m.time("bvh"),
+            m.time("jordan"),
+            m.time("jordan-octree"),
+        ]);
+    }
+
+    let mut speed = Table::new(
+        "Speed-up over the single-thread exact CPU test (`cpu`), from the means above",
+        &[
+            "model",
+            "cpu+gpu",
+            "gpu",
+            "gpu (batch 1)",
+            "octants",
+            "tetragrid",
+            "gpu+tetragrid",
+            "jordan-octree",
+        ],
+    );
+    for m in &measured {
+        speed.row(vec![
+            label(m),
+            m.ratio("cpu+gpu"),
+            m.ratio("gpu"),
+            m.ratio("gpu-batch-1"),
+            m.ratio("octants"),
+            m.ratio("tetragrid"),
+            m.ratio("gpu+tetragrid"),
+            m.ratio("jordan-octree"),
+        ]);
+    }
+    let disagreements: Vec<String> = measured
+        .iter()
+        .flat_map(|m| m.disagreements.iter().map(move |d| format!("{} on {}", d, m.name)))
+        .collect();
+    speed.note(if disagreements.is_empty() {
+        "Every method gave exactly the `cpu` answer for every point of every set.".to_string()
+    } else {
+        format!("DISAGREEMENTS with `cpu`: {}", disagreements.join(", "))
+    });
+    for m in &measured {
+        for line in &m.gpu_split {
+            speed.note(format!("{}: {line}", m.name));
+        }
+    }
+    speed.note(format!(
+        "{} sets of {} uniform random points in each model's bounding box (seeds 4000…), mean per set after one \
+         untimed warm-up. GPU methods: {} tetrahedra per point-vertex (`gpu`), {} (`gpu+tetragrid`); 32 query \
+         points per point-vertex; points the GPU cannot decide exactly are answered by the exact CPU test.",
+        cfg.sets,
+        cfg.points,
+        crate::inclusion::solver::GPU_BATCH,
+        crate::inclusion::solver::GPU_GRID_BATCH
+    ));
+
+    let mut tables = Vec::new();
+    for (id, today) in [("4-4", t44), ("4-5", t45), ("4-6", t46), ("4-7", t47), ("4-8", t48), ("4-9", t49)] {
+        tables.push(today.named(&format!("table{id}")));
+        tables.push(thesis_table(id));
+    }
+    tables.push(speed.named("speedup"));
+    Ok(Report { name: "inclusion".into(), environment: Environment::new(ctx.info().label()), tables })
+}

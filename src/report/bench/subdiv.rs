@@ -1,0 +1,239 @@
+//! `texgeo bench subdivide`: the 2010 thesis' Table 5 (§3.4) on today's machine — every
+//! model to level 5: the CPU base level (TCPU¹), the GPU fragment levels (TGPU), the
+//! whole refinement on the CPU (TCPU²) — plus OpenSubdiv's own refine + interpolate time,
+//! where the GPU path's time goes, and the thesis' numbers (`reference/subdiv/table5.csv`).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use crate::gpu::Context;
+use crate::mesh::{Mesh, formats, procedural};
+use crate::report::{Environment, Report, Samples, Table, time_runs};
+use crate::subdiv::compare::Comparison;
+use crate::subdiv::gpu::{Options, Run, Subdivider, Times};
+use crate::subdiv::{Result, cpu, osd};
+
+/// The thesis' Table 5 (see `reference/subdiv/README.md`).
+pub const THESIS_TABLE5: &str = include_str!("../../../reference/subdiv/table5.csv");
+
+/// Built-in models measured by default (closed, manifold ones).
+pub const BUILTINS: &[&str] = &["cube", "tetrahedron", "pyramid", "sphere", "torus", "knot"];
+
+/// Fetched models measured when present in the models folder (`tools/fetch-models`).
+pub const FETCHED: &[&str] = &["knot1.off"];
+
+/// A model to measure: a name for the table and its mesh.
+pub struct Model {
+    pub name: String,
+    pub mesh: Mesh,
+}
+
+/// The default models: [`BUILTINS`], then [`FETCHED`] found in `models_dir`.
+pub fn default_models(models_dir: &Path) -> Result<Vec<Model>> {
+    let mut models: Vec<Model> = BUILTINS
+        .iter()
+        .filter_map(|&n| procedural::by_name(n).map(|mesh| Model { name: format!("builtin:{n}"), mesh }))
+        .collect();
+    for file in FETCHED {
+        let path = models_dir.join(file);
+        if path.is_file() {
+            models.push(Model { name: path.display().to_string(), mesh: formats::read(&path)? });
+        }
+    }
+    Ok(models)
+}
+
+/// What to measure.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Subdivision level (Table 5: 5).
+    pub level: u32,
+    /// Timed runs per measurement; medians are reported.
+    pub runs: usize,
+    /// Also compare each GPU result with OpenSubdiv's (slow on millions of faces).
+    pub validate: bool,
+}
+
+/// Median of each component of the GPU path's times.
+fn median_times(all: &[Times]) -> Times {
+    let median = |f: &dyn Fn(&Times) -> Duration| Samples(all.iter().map(f).collect()).median();
+    let passes = all.first().map_or(0, |t| t.passes.len());
+    Times {
+        base: median(&|t| t.base),
+        fragments: median(&|t| t.fragments),
+        upload: median(&|t| t.upload),
+        passes: (0..passes).map(|j| median(&|t| t.passes[j])).collect(),
+        readback: median(&|t| t.readback),
+        submit: median(&|t| t.submit),
+        assembly: median(&|t| t.assembly),
+        total: median(&|t| t.total),
+    }
+}
+
+/// Milliseconds with about three significant digits.
+fn ms(d: Duration) -> String {
+    let v = d.as_secs_f64() * 1e3;
+    if v < 1.0 {
+        format!("{v:.3}")
+    } else if v < 10.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.1}")
+    }
+}
+
+/// The issue's speed target: the GPU path at most half of OpenSubdiv's time on knot1.off.
+const SPEED_TARGET: f64 = 0.5;
+
+pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report> {
+    let level = settings.level;
+    let mut table5 = Table::new(
+        format!("Table 5 today: level {level}, medians (ms)"),
+        &[
+            "model",
+            "input faces",
+            "fragments",
+            "faces",
+            "vertices",
+            "TCPU¹ base level",
+            "TGPU passes",
+            "GPU path",
+            "TCPU² CPU reference",
+            "OpenSubdiv",
+            "GPU path / OpenSubdiv",
+            "vs OpenSubdiv",
+        ],
+    );
+    let mut split = Table::new(
+        format!("Where the GPU path's time goes: level {level}, medians (ms)"),
+        &[
+            "model",
+            "base level (CPU)",
+            "fragment build",
+            "upload",
+            "passes",
+            "readback",
+            "submission (wall)",
+            "assembly",
+            "GPU path",
+            "first run (cold)",
+            "targets",
+        ],
+    );
+    let mut targets = Vec::new();
+    for model in models {
+        let mesh = &model.mesh;
+        // Cold: a fresh pipeline and targets (JIT compilation, first-touch allocation).
+        let start = Instant::now();
+        let mut subdivider = Subdivider::new(ctx)?;
+        let first = subdivider.refine(ctx, mesh, level, &Options::default())?;
+        let cold = start.elapsed();
+        let mut times = Vec::new();
+        let mut last: Option<Run> = None;
+        time_runs(settings.runs, || {
+            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
+            let total = run.times.total;
+            times.push(run.times.clone());
+            last = Some(run);
+            Ok::<_, crate::subdiv::SubdivError>(total)
+        })?;
+        times.remove(0); // the warm-up run
+        let gpu = median_times(&times);
+        let run = last.unwrap_or(first);
+        let cpu_time = time_runs(settings.runs, || {
+            let start = Instant::now();
+            cpu::refine(mesh, level)?;
+            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
+        })?;
+        let osd_seconds = osd::time_median(mesh, level, settings.runs.max(1) as u32)?;
+        let verdict = if settings.validate {
+            let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
+            if c.is_match() {
+                format!("match, max {:.1e} × diag", c.max_error / c.diagonal.max(f64::MIN_POSITIVE))
+            } else {
+                "MISMATCH".to_string()
+            }
+        } else {
+            "not checked".to_string()
+        };
+        let osd_time = Duration::from_secs_f64(osd_seconds);
+        let ratio = gpu.total.as_secs_f64() / osd_seconds.max(1e-9);
+        if model.name.ends_with("knot1.off") {
+            targets.push(format!(
+                "Speed target (knot1.off, level {level}): GPU path {} ms = {ratio:.2} × OpenSubdiv's {} ms: {} \
+                 (target ≤ {SPEED_TARGET}).",
+                ms(gpu.total),
+                ms(osd_time),
+                if ratio <= SPEED_TARGET { "met" } else { "NOT met" }
+            ));
+        }
+        table5.row(vec![
+            model.name.clone(),
+            mesh.num_faces().to_string(),
+            run.fragments.to_string(),
+            run.mesh.num_faces().to_string(),
+            run.mesh.num_vertices().to_string(),
+            ms(gpu.base),
+            ms(gpu.passes_total()),
+            ms(gpu.total),
+            ms(cpu_time.median()),
+            ms(osd_time),
+            format!("{ratio:.2}"),
+            verdict,
+        ]);
+        let passes: Vec<String> = gpu.passes.iter().map(|&p| ms(p)).collect();
+        split.row(vec![
+            model.name.clone(),
+            ms(gpu.base),
+            ms(gpu.fragments),
+            ms(gpu.upload),
+            format!("{} = {}", ms(gpu.passes_total()), passes.join(" + ")),
+            ms(gpu.readback),
+            ms(gpu.submit),
+            ms(gpu.assembly),
+            ms(gpu.total),
+            ms(cold),
+            format!("2 × {}×{}", run.texture[0], run.texture[1]),
+        ]);
+    }
+    table5.note(format!(
+        "{} timed runs after one warm-up; medians. TCPU¹: the CPU levels before fragments exist (1 for \
+         all-quad input, 2 otherwise). TGPU: the fragment passes, GPU timestamps. GPU path: base level + \
+         fragment build + one submission (upload, passes, readback) + assembly of the welded mesh, wall \
+         clock, no file writing; the pipeline and render targets are made once and reused (the cold first \
+         run, which pays shader compilation and allocation, is in the next table). TCPU²: texgeo's f64 CPU \
+         reference, one thread. OpenSubdiv: its helper's own median of refine + interpolate (topology, \
+         uniform refinement with full topology, PrimvarRefiner in double), one thread.",
+        settings.runs
+    ));
+    for t in targets {
+        table5.note(t);
+    }
+    split.note(
+        "Upload, passes and readback are GPU timestamps inside the one submission; the submission's wall \
+         time also holds staging writes and waiting. Fragment build: cutting the base level into fragments, \
+         writing their texel stream and the pass tables. Assembly: dropping the support rings and welding \
+         by coarse element into a Mesh (two threads).",
+    );
+    Ok(Report {
+        name: "subdivide".into(),
+        environment: Environment::new(ctx.info().label()),
+        tables: vec![table5, split, thesis_table5()],
+    })
+}
+
+/// The thesis' Table 5, from `reference/subdiv/table5.csv`.
+pub fn thesis_table5() -> Table {
+    let mut table = Table::new(
+        "Table 5 in the 2010 thesis: level 5 (seconds)",
+        &["fragments", "faces", "vertices", "TCPU¹", "TGPU", "TCPU² (CGAL)"],
+    );
+    for line in THESIS_TABLE5.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+        table.row(line.split(',').map(|c| c.trim().to_string()).collect());
+    }
+    table.note(
+        "NVIDIA GeForce 9800 GT, Pentium 4 3.0 GHz, Windows 7, Cg/OpenGL; CPU times with CGAL. The models are \
+         not named in the thesis; the first row is the cube (8 fragments).",
+    );
+    table
+}

@@ -1,0 +1,222 @@
+//! Assembly of the refined mesh from the last fragment stream (SPEC §5.4; the thesis'
+//! "se descarta el anillo externo"): each fragment keeps only its owned region, and
+//! vertices are welded *topologically*, by the coarse-mesh element they lie on, never by
+//! position.
+//!
+//! After `j` fragment levels every coarse quad is a G × G grid of quads (G = 2^(j+1)),
+//! whose four corner quarters are owned by the fragments at its four corners. The output
+//! is numbered by coarse element, so it is closed and manifold whenever the coarse mesh
+//! is, whatever the positions:
+//!
+//! - coarse vertex v → vertex v;
+//! - edge e, point t ∈ (0, G) steps from its first vertex → `V + e·(G−1) + t − 1`;
+//! - face f, grid point (i, j) with 0 < i, j < G in the frame of its corner 0 (i towards
+//!   corner 1, j towards corner 3) → `V + E·(G−1) + f·(G−1)² + (j−1)·(G−1) + i − 1`.
+//!
+//! Each position is gathered from the fragment that owns it (points shared by two or four
+//! owned regions are taken from one of them). Faces and positions are filled in parallel
+//! over blocks of coarse faces and edges.
+
+use glam::DVec3;
+
+use crate::mesh::Mesh;
+
+use super::fragment::{Class, FragmentMesh};
+use super::topology::Topology;
+use super::{Result, SubdivError};
+
+/// Builds the refined mesh from `stream`, a fragment stream of ring radius `radius` in
+/// which every fragment holds its owned region after `levels` fragment levels
+/// (`2^levels ≤ radius` rings). `position` reads one stream entry.
+pub fn assemble<T: Sync>(
+    fragments: &FragmentMesh,
+    stream: &[T],
+    radius: u32,
+    levels: u32,
+    position: impl Fn(&T) -> DVec3 + Sync,
+) -> Result<Mesh> {
+    let owned = 1u64 << levels;
+    let layout = fragments.layout(radius);
+    if owned > u64::from(radius) || (stream.len() as u64) < layout.total {
+        return Err(SubdivError::Fragment(format!(
+            "a stream of {} entries at ring radius {radius} cannot hold {owned} owned rings ({} entries needed)",
+            stream.len(),
+            layout.total
+        )));
+    }
+    let topo = fragments.coarse();
+    let g = 2 * owned;
+    let (nv, ne, nf) = (topo.num_vertices() as u64, topo.num_edges() as u64, topo.num_faces() as u64);
+    let vertices = nv + ne * (g - 1) + nf * (g - 1) * (g - 1);
+    let quads = nf * g * g;
+    if vertices >= u64::from(u32::MAX) || 4 * quads >= u64::from(u32::MAX) {
+        return Err(SubdivError::TooLarge { level: fragments.cpu_levels() + levels, vertices });
+    }
+    let grid = Grid { topo, g: g as u32, nv: nv as u32, face0: (nv + ne * (g - 1)) as u32 };
+    let n = owned as u32;
+
+    // Faces: a G × G grid of quads per coarse face, in face order.
+    let mut indices = vec![0u32; (4 * quads) as usize];
+    let per_face = (4 * g * g) as usize;
+    for_each_block(&mut indices, per_face, |first, block| {
+        let mut ids = Vec::new();
+        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+            grid.face_ids((first + k) as u32, &mut ids);
+            let row = grid.g as usize + 1;
+            let mut q = 0;
+            for j in 0..grid.g as usize {
+                for i in 0..grid.g as usize {
+                    let c = j * row + i;
+                    out[q..q + 4].copy_from_slice(&[ids[c], ids[c + 1], ids[c + 1 + row], ids[c + row]]);
+                    q += 4;
+                }
+            }
+        }
+    });
+
+    // Positions, gathered from the owning fragment.
+    let mut positions = vec![DVec3::ZERO; vertices as usize];
+    let (vertex_part, rest) = positions.split_at_mut(nv as usize);
+    let (edge_part, face_part) = rest.split_at_mut((ne * (g - 1)) as usize);
+    // Where the owned region of sector s of fragment f starts, and its class.
+    let sector = |f: u32, s: u32| {
+        let class = fragments.fragments()[f as usize].class;
+        (fragments.fragment_start(&layout, f), class, s)
+    };
+    let at = |(start, class, s): (u64, Class, u32), a: u32, b: u32| {
+        position(&stream[(start + class.index(s, a.into(), b.into())) as usize])
+    };
+    for (v, out) in vertex_part.iter_mut().enumerate() {
+        *out = match fragments.fragment_of(v as u32) {
+            Some(f) => at(sector(f, 0), 0, 0),
+            // A vertex no face uses stays where it is.
+            None => fragments.base_positions()[v],
+        };
+    }
+    let per_edge = (g - 1) as usize;
+    for_each_block(edge_part, per_edge, |first, block| {
+        for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
+            let e = (first + k) as u32;
+            let [v0, v1] = topo.edge_vertices(e);
+            let own = |v: u32| sector(fragments.fragment_of(v).unwrap_or(0), fragments.spoke_along(e, v));
+            let (first_half, second_half) = out.split_at_mut(n as usize);
+            let s0 = own(v0);
+            for (t, p) in (1..=n).zip(first_half.iter_mut()) {
+                *p = at(s0, t, 0);
+            }
+            let s1 = own(v1);
+            for (t, p) in (n + 1..grid.g).zip(second_half.iter_mut()) {
+                *p = at(s1, grid.g - t, 0);
+            }
+        }
+    });
+    let per_face = ((g - 1) * (g - 1)) as usize;
+    let side = grid.g as usize - 1;
+    for_each_block(face_part, per_face, |first, block| {
+        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+            let f = (first + k) as u32;
+            let h0 = topo.face_half_edges(f).start;
+            for m in 0..4 {
+                // The quarter at corner m: sector s of the fragment centred there. Its
+                // points off the spokes (a, b ≥ 1) are, ring by ring, the entries t ≥ 1 of
+                // the sector's 2r consecutive entries: read in storage order, written at
+                // their (i, j) in the face's frame.
+                let h = h0 + m;
+                let (start, class, s) =
+                    sector(fragments.fragment_of(topo.origin(h)).unwrap_or(0), fragments.sector_of(h));
+                let g = grid.g as usize;
+                for r in 1..=n as u64 {
+                    let ring = start + 1 + class.ring_offset(r) + u64::from(s) * 2 * r;
+                    let entries = &stream[(ring + 1) as usize..(ring + 2 * r) as usize];
+                    for (t, texel) in (1..2 * r as usize).zip(entries) {
+                        let r = r as usize;
+                        let (a, b) = if t <= r { (r, t) } else { (2 * r - t, r) };
+                        let (i, j) = match m {
+                            0 => (a, b),
+                            1 => (g - b, a),
+                            2 => (g - a, g - b),
+                            _ => (b, g - a),
+                        };
+                        out[(j - 1) * side + i - 1] = position(texel);
+                    }
+                }
+            }
+        }
+    });
+
+    let mut offsets = vec![0usize; quads as usize + 1];
+    for_each_block(&mut offsets, 1, |first, block| {
+        for (k, o) in block.iter_mut().enumerate() {
+            *o = 4 * (first + k);
+        }
+    });
+    Ok(Mesh::from_parts(positions, offsets, indices)?)
+}
+
+/// Output vertex numbering of the (G + 1)² grid points of a coarse face.
+struct Grid<'a> {
+    topo: &'a Topology,
+    g: u32,
+    nv: u32,
+    /// First id of face-interior points.
+    face0: u32,
+}
+
+impl Grid<'_> {
+    /// Ids of the grid points of face `f`, row by row (j outer, i inner).
+    fn face_ids(&self, f: u32, ids: &mut Vec<u32>) {
+        let g = self.g;
+        let row = g as usize + 1;
+        ids.clear();
+        ids.resize(row * row, 0);
+        let h0 = self.topo.face_half_edges(f).start;
+        // Side m runs from corner m to corner m + 1; point t steps from corner m is point
+        // t or g − t of its edge, depending on the edge's orientation.
+        let sides: [(u32, bool); 4] = std::array::from_fn(|m| {
+            let h = h0 + m as u32;
+            let e = self.topo.edge(h);
+            (self.nv + e * (g - 1), self.topo.edge_half_edge(e) == h)
+        });
+        let side = |m: usize, t: u32| {
+            let (first, forward) = sides[m];
+            first + if forward { t } else { g - t } - 1
+        };
+        let corner = |m: u32| self.topo.origin(h0 + m);
+        let g_us = g as usize;
+        ids[0] = corner(0);
+        ids[g_us] = corner(1);
+        ids[g_us * row] = corner(3);
+        ids[g_us * row + g_us] = corner(2);
+        for t in 1..g {
+            let t_us = t as usize;
+            ids[t_us] = side(0, t);
+            ids[t_us * row + g_us] = side(1, t);
+            ids[g_us * row + t_us] = side(2, g - t);
+            ids[t_us * row] = side(3, g - t);
+        }
+        let interior = self.face0 + f * (g - 1) * (g - 1);
+        for j in 1..g_us {
+            let first = interior + (j as u32 - 1) * (g - 1);
+            for (i, id) in ids[j * row + 1..j * row + g_us].iter_mut().enumerate() {
+                *id = first + i as u32;
+            }
+        }
+    }
+}
+
+/// Runs `work(first_item, block)` over `out` cut into about one block per core, each
+/// block a whole number of `item_len`-long items.
+fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, &mut [T]) + Sync) {
+    if item_len == 0 || out.is_empty() {
+        return;
+    }
+    let items = out.len() / item_len;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(items.max(1));
+    let per_block = items.div_ceil(threads);
+    std::thread::scope(|scope| {
+        for (b, block) in out.chunks_mut(per_block * item_len).enumerate() {
+            let work = &work;
+            scope.spawn(move || work(b * per_block, block));
+        }
+    });
+}

@@ -1,0 +1,332 @@
+//! Catmull-Clark on the GPU with fragment meshes (2010 thesis §3.3, SPEC §5.3): the base
+//! level and the fragments on the CPU, then one full-target fragment pass per level,
+//! ping-ponging between two RGBA32F render targets, one readback, and the topological
+//! assembly on the CPU.
+//!
+//! # Packing rule
+//!
+//! The thesis stores one fragment per texture row. Here fragments are sorted into runs
+//! of one class (valence k, closed or half-fan) and stored back to back, each in the
+//! thesis' order (centre, then ring by ring), as one 1D stream of texels; the stream is
+//! wrapped into rows of W = 2^n texels (W ≈ √texels, at most the device's 2D limit), so
+//! a fragment may continue on the next row. Each level has its own stream (fragments
+//! grow from ring radius 2 to 3, 5, 9, …; the last level keeps only the 2^j owned rings);
+//! the pass finds a texel's run by binary search in a uniform table of run starts and its
+//! fragment by division.
+//!
+//! # Limits
+//!
+//! No limit on valence from the row width: a fragment of any valence spans as many rows
+//! as it needs (the "row split"). What does limit the path, each with a clear
+//! [`SubdivError::GpuLimit`] (use the CPU method then):
+//!
+//! - at most [`MAX_RUNS`] classes (distinct valence/half-fan pairs) per mesh;
+//! - one fragment at most 2^24 texels at the last level (the shader's exact float
+//!   division), i.e. k·R(R+1) < 2^24 at the last radius R = 2^j: valence below 61 680 at
+//!   level 5 of a quad mesh (R = 16), below 4 032 at level 7 (R = 64);
+//! - every stream at most W × H texels with W, H ≤ `maxImageDimension2D` and
+//!   below 2^28 texels (16384² on lavapipe, 4 GiB per target).
+
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+
+use crate::gpu::{
+    Attachment, Blend, Buffer, Context, Load, PingPong, Pipeline, TexFormat, Timestamps, shaders,
+};
+use crate::mesh::Mesh;
+
+use super::assemble::assemble;
+use super::fragment::{BaseLevel, FragmentMesh, StreamLayout, radii};
+use super::{Result, SubdivError, cpu};
+
+/// Entries of the run table (`MAX_RUNS` in `glsl/subdiv/refine.frag`).
+pub const MAX_RUNS: usize = 256;
+/// Largest fragment, in texels (the shader's float division is exact below 2^24).
+pub const MAX_FRAGMENT_TEXELS: u64 = 1 << 24;
+/// Largest stream, in texels (texel indices stay far from `i32` overflow).
+pub const MAX_STREAM_TEXELS: u64 = 1 << 28;
+
+/// Where every level's stream lies in the two textures (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Packing {
+    /// Row width, a power of two.
+    pub width: u32,
+    pub log2_width: u32,
+    /// Rows of the two targets (enough for the largest stream).
+    pub height: u32,
+    /// One layout per level, base level first.
+    pub layouts: Vec<StreamLayout>,
+}
+
+impl Packing {
+    /// Packs the streams of `fragments` for `gpu_levels` passes on a device whose 2D
+    /// textures are at most `max_side` texels wide and high. `row_width` forces the row
+    /// width (a power of two), e.g. to make fragments span rows.
+    pub fn new(
+        fragments: &FragmentMesh,
+        gpu_levels: u32,
+        max_side: u32,
+        row_width: Option<u32>,
+    ) -> Result<Packing> {
+        if fragments.runs().len() > MAX_RUNS {
+            return Err(SubdivError::GpuLimit(format!(
+                "{} fragment classes (distinct valences); the pass handles at most {MAX_RUNS}",
+                fragments.runs().len()
+            )));
+        }
+        let layouts: Vec<StreamLayout> = radii(gpu_levels).into_iter().map(|r| fragments.layout(r)).collect();
+        let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
+        let last = layouts.last().map_or(2, |l| l.radius);
+        if let Some(run) = fragments.runs().iter().max_by_key(|r| r.class.len(last))
+            && run.class.len(last) >= MAX_FRAGMENT_TEXELS
+        {
+            return Err(SubdivError::GpuLimit(format!(
+                "a fragment of valence {} at ring radius {last} ({gpu_levels} fragment levels) needs {} \
+                 texels, over the pass's {MAX_FRAGMENT_TEXELS}; use fewer levels or the CPU method",
+                run.class.valence,
+                run.class.len(last)
+            )));
+        }
+        let max_width = if max_side == 0 { 1 } else { 1u32 << max_side.ilog2() };
+        let width = match row_width {
+            Some(w) if w.is_power_of_two() && w <= max_width => w,
+            Some(w) => {
+                return Err(SubdivError::GpuLimit(format!(
+                    "row width {w} is not a power of two up to {max_width}"
+                )));
+            }
+            None => {
+                ((texels as f64).sqrt().ceil() as u64).next_power_of_two().clamp(64, u64::from(max_width))
+                    as u32
+            }
+        };
+        let height = texels.div_ceil(u64::from(width));
+        if texels > MAX_STREAM_TEXELS || height > u64::from(max_side) {
+            return Err(SubdivError::GpuLimit(format!(
+                "{texels} texels per level do not fit a {width}-wide texture of at most {max_side} rows \
+                 (nor {MAX_STREAM_TEXELS} texels); use fewer levels or the CPU method"
+            )));
+        }
+        Ok(Packing { width, log2_width: width.ilog2(), height: height as u32, layouts })
+    }
+
+    /// Rows holding the stream of level `j`.
+    pub fn rows(&self, j: usize) -> u32 {
+        self.layouts[j].total.div_ceil(u64::from(self.width)).max(1) as u32
+    }
+}
+
+/// Options of the GPU path.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Force the texture row width (a power of two); default ≈ √texels.
+    pub row_width: Option<u32>,
+}
+
+/// Where the time of one GPU subdivision went.
+#[derive(Clone, Debug, Default)]
+pub struct Times {
+    /// CPU levels up to the base level (one or two Catmull-Clark levels).
+    pub base: Duration,
+    /// Cutting the base level into fragments and writing their texel stream.
+    pub fragments: Duration,
+    /// GPU: copying the base stream into the first target (timestamps).
+    pub upload: Duration,
+    /// GPU: each fragment pass (timestamps).
+    pub passes: Vec<Duration>,
+    /// GPU: copying the last stream into host memory (timestamps).
+    pub readback: Duration,
+    /// Wall time of the one submission (staging, upload, passes, readback, waiting).
+    pub submit: Duration,
+    /// Discarding support rings and welding the result (CPU).
+    pub assembly: Duration,
+    /// Everything, wall clock.
+    pub total: Duration,
+}
+
+impl Times {
+    pub fn passes_total(&self) -> Duration {
+        self.passes.iter().sum()
+    }
+}
+
+/// What one GPU subdivision did.
+#[derive(Debug)]
+pub struct Run {
+    pub mesh: Mesh,
+    /// Catmull-Clark levels done on the CPU and by fragment passes on the GPU.
+    pub cpu_levels: u32,
+    pub gpu_levels: u32,
+    pub fragments: usize,
+    /// Distinct fragment classes (valence, half-fan).
+    pub classes: usize,
+    /// Size of each of the two targets, texels.
+    pub texture: [u32; 2],
+    pub times: Times,
+}
+
+/// The fragment pass (`glsl/subdiv/refine.frag`) with its two render targets and its
+/// readback buffer, built once and reused: like a texture-era application, which
+/// allocates its FBO textures once, not per frame. Targets grow when a mesh needs more.
+pub struct Subdivider {
+    pipeline: Pipeline,
+    targets: Option<PingPong>,
+    readback: Option<Buffer>,
+}
+
+impl Subdivider {
+    pub fn new(ctx: &Context) -> Result<Subdivider> {
+        let pipeline =
+            Pipeline::quad(ctx, &shaders::subdiv::REFINE_FRAG, &[TexFormat::Rgba32F], Blend::Replace)?;
+        Ok(Subdivider { pipeline, targets: None, readback: None })
+    }
+
+    /// Refines `mesh` `level` times: the base level on the CPU, the rest as fragment
+    /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
+    /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0).
+    pub fn refine(&mut self, ctx: &Context, mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+        let start = Instant::now();
+        let needed = BaseLevel::levels_needed(mesh);
+        if level < needed {
+            let mesh = cpu::refine(mesh, level)?;
+            let total = start.elapsed();
+            let times = Times { base: total, total, ..Times::default() };
+            return Ok(Run {
+                mesh,
+                cpu_levels: level,
+                gpu_levels: 0,
+                fragments: 0,
+                classes: 0,
+                texture: [0, 0],
+                times,
+            });
+        }
+        let base = BaseLevel::new(mesh)?;
+        let base_time = start.elapsed();
+        let t = Instant::now();
+        let fragments = FragmentMesh::from_base(base)?;
+        let mut run = self.refine_fragments(ctx, &fragments, level - needed, options, t)?;
+        run.times.base = base_time;
+        run.times.total = start.elapsed();
+        Ok(run)
+    }
+
+    /// Runs `gpu_levels` fragment passes over `fragments` and assembles the result.
+    /// `fragments_started` is when fragment building began (for [`Times::fragments`]).
+    pub fn refine_fragments(
+        &mut self,
+        ctx: &Context,
+        fragments: &FragmentMesh,
+        gpu_levels: u32,
+        options: &Options,
+        fragments_started: Instant,
+    ) -> Result<Run> {
+        let packing = Packing::new(fragments, gpu_levels, ctx.info().max_image_2d, options.row_width)?;
+        let width = packing.width;
+        let mut stream = fragments.base_stream(|p| [p.x as f32, p.y as f32, p.z as f32, 1.0]);
+        let rows0 = packing.rows(0);
+        stream.resize((rows0 * width) as usize, [0.0; 4]);
+        // One run table per pass: (valence, half-fan, first input texel, first output texel).
+        let tables = packing
+            .layouts
+            .windows(2)
+            .map(|pair| {
+                let mut table = vec![[0i32; 4]; MAX_RUNS];
+                for (r, run) in fragments.runs().iter().enumerate() {
+                    let c = run.class;
+                    table[r] = [
+                        c.valence as i32,
+                        c.boundary as i32,
+                        pair[0].starts[r] as i32,
+                        pair[1].starts[r] as i32,
+                    ];
+                }
+                Buffer::with_data(ctx, &table, "subdiv runs")
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let fragments_time = fragments_started.elapsed();
+
+        let last = packing.layouts.len() - 1;
+        let readback_bytes = u64::from(width) * u64::from(packing.rows(last)) * 16;
+        if !self.targets.as_ref().is_some_and(|t| t.width() == width && t.height() >= packing.height) {
+            self.targets = None;
+            self.targets = Some(PingPong::new(ctx, TexFormat::Rgba32F, width, packing.height, "subdiv")?);
+        }
+        if self.readback.as_ref().is_none_or(|b| b.size() < readback_bytes) {
+            self.readback = None;
+            self.readback = Some(Buffer::readback_for(ctx, readback_bytes)?);
+        }
+        let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
+            return Err(SubdivError::GpuLimit("render targets were not created".into()));
+        };
+        let pipeline = &self.pipeline;
+        let timer = Timestamps::new(ctx, gpu_levels + 3)?;
+        let t = Instant::now();
+        ctx.submit(|rec| {
+            rec.reset_timestamps(&timer);
+            rec.timestamp(&timer, 0)?;
+            rec.upload_region(targets.src(), 0, [0, 0, width, rows0], &stream)?;
+            rec.timestamp(&timer, 1)?;
+            for (j, table) in tables.iter().enumerate() {
+                let (lin, lout) = (&packing.layouts[j], &packing.layouts[j + 1]);
+                let params = [
+                    lin.radius as i32,
+                    lout.radius as i32,
+                    fragments.runs().len() as i32,
+                    lout.total as i32,
+                    packing.log2_width as i32,
+                ];
+                let input = targets.src();
+                let reads = [input];
+                let area = [0, 0, width, packing.rows(j + 1)];
+                rec.render(&[Attachment::new(targets.dst(), Load::Discard)], Some(area), &reads, |pass| {
+                    pass.bind(pipeline)?;
+                    pass.textures(&[(0, input)])?;
+                    pass.uniform(1, table)?;
+                    pass.push(&params)?;
+                    pass.quad()
+                })?;
+                targets.swap();
+                rec.timestamp(&timer, 2 + j as u32)?;
+            }
+            rec.readback_into(targets.src(), 0..1, [0, 0, width, packing.rows(last)], readback, 0)?;
+            rec.timestamp(&timer, gpu_levels + 2)?;
+            Ok(())
+        })?;
+        let submit = t.elapsed();
+        let stamps = timer.read_ms(gpu_levels + 3)?;
+        let ms = |a: usize, b: usize| Duration::from_secs_f64(((stamps[b] - stamps[a]) / 1e3).max(0.0));
+
+        let t = Instant::now();
+        let texels = readback.view::<[f32; 4]>()?;
+        let layout = &packing.layouts[last];
+        let mesh = assemble(fragments, texels, layout.radius, gpu_levels, |p| {
+            DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+        })?;
+        let times = Times {
+            fragments: fragments_time,
+            upload: ms(0, 1),
+            passes: (0..gpu_levels as usize).map(|j| ms(1 + j, 2 + j)).collect(),
+            readback: ms(1 + gpu_levels as usize, 2 + gpu_levels as usize),
+            submit,
+            assembly: t.elapsed(),
+            ..Times::default()
+        };
+        Ok(Run {
+            mesh,
+            cpu_levels: fragments.cpu_levels(),
+            gpu_levels,
+            fragments: fragments.fragments().len(),
+            classes: fragments.runs().len(),
+            texture: [width, packing.height],
+            times,
+        })
+    }
+}
+
+/// Refines `mesh` `level` times on the GPU with a fresh pipeline and targets (see
+/// [`Subdivider`]).
+pub fn refine(ctx: &Context, mesh: &Mesh, level: u32) -> Result<Mesh> {
+    Ok(Subdivider::new(ctx)?.refine(ctx, mesh, level, &Options::default())?.mesh)
+}

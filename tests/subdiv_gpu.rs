@@ -1,0 +1,288 @@
+//! Catmull-Clark with fragment meshes on the GPU (SPEC §5.2–5.4) against live OpenSubdiv
+//! on the named test shapes, watertightness of every output, the fragment layout on the
+//! CPU, fragments spanning rows, and the limits' errors. Runs on the default device
+//! (lavapipe in `tools/test`, with the validation layer on: any validation error fails
+//! the submission that caused it, and so the test).
+
+mod common;
+
+use common::shapes;
+use glam::DVec3;
+use texgeo::gpu::Context;
+use texgeo::mesh::{Mesh, procedural};
+use texgeo::subdiv::compare::Comparison;
+use texgeo::subdiv::fragment::{self, BaseLevel, FragmentMesh};
+use texgeo::subdiv::gpu::{MAX_RUNS, Options, Packing, Subdivider};
+use texgeo::subdiv::topology::Topology;
+use texgeo::subdiv::{SubdivError, cpu, osd};
+
+/// float32 GPU positions against f64 OpenSubdiv, after up to 5 levels (SPEC §5.4).
+const TOLERANCE: f64 = 1e-5;
+
+fn ctx() -> Context {
+    Context::from_env().expect("a Vulkan device (run tools/setup)")
+}
+
+/// Refines with OpenSubdiv; a missing helper fails the test, saying to run tools/setup.
+fn opensubdiv(mesh: &Mesh, level: u32) -> Mesh {
+    osd::refine(mesh, level).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// GPU at every level of `levels` equals OpenSubdiv (counts, positions, faces as cycles),
+/// is watertight by the mesh checks (`mesh::validate`: manifold, oriented, closed — or
+/// with the input's boundary, each edge split 2^level times), keeps the input's Euler
+/// characteristic, and did every level past the base level as a fragment pass.
+fn assert_gpu_matches_opensubdiv(
+    ctx: &Context,
+    sub: &mut Subdivider,
+    name: &str,
+    mesh: &Mesh,
+    levels: std::ops::RangeInclusive<u32>,
+    options: &Options,
+) {
+    let input = mesh.report();
+    let base_levels = BaseLevel::levels_needed(mesh);
+    for level in levels {
+        let run =
+            sub.refine(ctx, mesh, level, options).unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
+        assert_eq!(run.gpu_levels, level.saturating_sub(base_levels), "{name} level {level}");
+        assert_eq!(run.cpu_levels + run.gpu_levels, level, "{name} level {level}");
+        let reference = opensubdiv(mesh, level);
+        let c = Comparison::new(&run.mesh, &reference, TOLERANCE);
+        assert!(c.is_match(), "{name} level {level} (GPU vs OpenSubdiv):\n{c}");
+        let w = run.mesh.report();
+        assert!(w.is_manifold() && w.is_oriented(), "{name} level {level}: {w}");
+        assert_eq!(w.is_closed(), input.is_closed(), "{name} level {level}: {w}");
+        assert_eq!(w.euler_characteristic, input.euler_characteristic, "{name} level {level}: {w}");
+        assert_eq!(w.boundary_edges, input.boundary_edges << level, "{name} level {level}: {w}");
+        assert_eq!((w.non_manifold_edges, w.degenerate_faces), (0, 0), "{name} level {level}: {w}");
+    }
+}
+
+#[test]
+fn cube_valence_3_matches_opensubdiv_to_level_5() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let cube = shapes::cube();
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "cube", &cube, 1..=5, &Options::default());
+    // The thesis' case: 8 fragments, 6·4⁵ faces at level 5.
+    let run = sub.refine(&ctx, &cube, 5, &Options::default()).unwrap();
+    assert_eq!((run.fragments, run.mesh.num_faces(), run.mesh.num_vertices()), (8, 6144, 6146));
+    assert_eq!(run.gpu_levels, 4);
+}
+
+#[test]
+fn triangles_match_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let options = Options::default();
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "tetrahedron", &shapes::tetrahedron(), 1..=5, &options);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "pyramid", &shapes::pyramid(), 1..=5, &options);
+}
+
+#[test]
+fn torus_all_valence_4_matches_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let torus = shapes::torus(8, 6);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "torus", &torus, 1..=5, &Options::default());
+}
+
+#[test]
+fn valences_3_to_8_and_ngon_match_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let mesh = shapes::valences();
+    let run = sub.refine(&ctx, &mesh, 3, &Options::default()).unwrap();
+    // Centres are the level-1 vertices: valences 3…8 (and the 7-gon's face point: 7).
+    assert!(run.classes >= 6, "{} classes", run.classes);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "valences", &mesh, 1..=5, &Options::default());
+}
+
+#[test]
+fn torus_knot_1200_triangles_matches_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let knot = procedural::torus_knot();
+    assert_eq!(knot.num_faces(), 1200);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "torus_knot", &knot, 1..=4, &Options::default());
+}
+
+/// Open meshes run on the GPU too: border centres get half-fan fragments.
+#[test]
+fn open_meshes_match_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let options = Options::default();
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "grid", &shapes::grid(3), 1..=4, &options);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "open_cube", &shapes::open_cube(), 1..=4, &options);
+    assert!(shapes::grid(3).report().boundary_edges > 0);
+}
+
+/// The committed OpenSubdiv outputs (reference/subdiv/README.md) need no helper.
+#[test]
+fn matches_committed_reference_files() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
+    let cases: [(&str, Mesh, u32); 5] = [
+        ("cube", shapes::cube(), 2),
+        ("tetrahedron", shapes::tetrahedron(), 1),
+        ("open_cube", shapes::open_cube(), 1),
+        ("grid", shapes::grid(3), 2),
+        ("valences", shapes::valences(), 2),
+    ];
+    for (name, mesh, level) in cases {
+        let path = dir.join(format!("{name}-level{level}.off"));
+        let reference = texgeo::mesh::formats::read(&path).unwrap_or_else(|e| panic!("{e}"));
+        let run = sub.refine(&ctx, &mesh, level, &Options::default()).unwrap();
+        let c = Comparison::new(&run.mesh, &reference, TOLERANCE);
+        assert!(c.is_match(), "{}:\n{c}", path.display());
+    }
+}
+
+/// The fragment algorithm's arithmetic (layout, stencils, welding) run on the CPU in f64
+/// equals the reference to 1e-12: any GPU difference is float32 rounding, not layout.
+#[test]
+fn fragment_layout_on_the_cpu_equals_the_reference() {
+    for shape in shapes::all() {
+        let levels = if shape.mesh.num_faces() > 500 { 1..=3 } else { 1..=4 };
+        for level in levels {
+            let ours = fragment::refine(&shape.mesh, level).unwrap_or_else(|e| panic!("{}: {e}", shape.name));
+            let reference = cpu::refine(&shape.mesh, level).unwrap();
+            let c = Comparison::new(&ours, &reference, 1e-12);
+            assert!(c.is_match(), "{} level {level}:\n{c}", shape.name);
+        }
+    }
+}
+
+/// A cone over a 40-gon, triangulated: the apex has valence 40. With 64-texel rows every
+/// fragment around it spans several rows (the row split), and the result still matches.
+fn cone(sides: u32) -> Mesh {
+    let mut positions: Vec<DVec3> = (0..sides)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(sides);
+            DVec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    positions.push(DVec3::new(0.0, 0.0, 1.0));
+    let mut faces: Vec<Vec<u32>> = (0..sides).map(|i| vec![i, (i + 1) % sides, sides]).collect();
+    faces.push((0..sides).rev().collect());
+    Mesh::new(positions, faces).unwrap()
+}
+
+#[test]
+fn high_valence_fragments_span_rows() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let mesh = cone(40);
+    let fragments = FragmentMesh::new(&mesh).unwrap();
+    let widest = fragments.runs().iter().map(|r| r.class.len(2)).max().unwrap();
+    assert!(widest > 64 * 3, "the apex fragment ({widest} texels) should span several 64-texel rows");
+    let narrow = Options { row_width: Some(64) };
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "cone(40), 64-texel rows", &mesh, 2..=4, &narrow);
+    assert_gpu_matches_opensubdiv(&ctx, &mut sub, "cone(40)", &mesh, 4..=4, &Options::default());
+}
+
+#[test]
+fn limits_give_clear_errors() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    // One fragment over 2^24 texels: the cone's valence-40 apex at 12 fragment levels.
+    let fragments = FragmentMesh::new(&cone(40)).unwrap();
+    let err = Packing::new(&fragments, 12, 16384, None).unwrap_err();
+    assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("valence 40"), "{err}");
+    let err = sub.refine(&ctx, &cone(40), 14, &Options::default()).unwrap_err();
+    assert!(matches!(err, SubdivError::GpuLimit(_)), "{err}");
+    // More texels than a texture holds.
+    let err = Packing::new(&fragments, 3, 64, None).unwrap_err();
+    assert!(err.to_string().contains("do not fit"), "{err}");
+    // A row width that is not a power of two.
+    assert!(Packing::new(&fragments, 1, 16384, Some(100)).is_err());
+    // More distinct valences than the run table holds: bipyramids over 3…260-gons.
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    for n in 3..=(MAX_RUNS as u32 + 4) {
+        let o = positions.len() as u32;
+        for i in 0..n {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            positions.push(DVec3::new(a.cos(), a.sin(), 3.0 * f64::from(n)));
+        }
+        positions.push(DVec3::new(0.0, 0.0, 3.0 * f64::from(n) + 1.0));
+        positions.push(DVec3::new(0.0, 0.0, 3.0 * f64::from(n) - 1.0));
+        for i in 0..n {
+            faces.push(vec![o + i, o + (i + 1) % n, o + n]);
+            faces.push(vec![o + (i + 1) % n, o + i, o + n + 1]);
+        }
+    }
+    let many = Mesh::new(positions, faces).unwrap();
+    let err = sub.refine(&ctx, &many, 3, &Options::default()).unwrap_err();
+    assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("classes"), "{err}");
+}
+
+#[test]
+fn rejects_non_manifold_input() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let fin = Mesh::new(
+        vec![p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.), p(0., -1., 0.), p(0., 0., 1.)],
+        vec![vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]],
+    )
+    .unwrap();
+    let err = sub.refine(&ctx, &fin, 3, &Options::default()).unwrap_err();
+    assert!(matches!(err, SubdivError::NonManifoldEdge { .. }), "{err}");
+    // Level 0 only checks and copies.
+    let cube = shapes::cube();
+    assert_eq!(sub.refine(&ctx, &cube, 0, &Options::default()).unwrap().mesh, cube);
+    assert!(Topology::new(&cube).is_ok());
+}
+
+/// A vertex no face uses stays where it is, as in OpenSubdiv.
+#[test]
+fn isolated_vertices_stay() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let cube = shapes::cube();
+    let mut positions = cube.positions().to_vec();
+    positions.push(DVec3::new(5.0, 5.0, 5.0));
+    let mesh = Mesh::new(positions, cube.faces().map(<[u32]>::to_vec).collect()).unwrap();
+    assert_gpu_matches_opensubdiv(
+        &ctx,
+        &mut sub,
+        "cube + isolated vertex",
+        &mesh,
+        1..=3,
+        &Options::default(),
+    );
+}
+
+/// `texgeo subdivide`: writes the mesh, `--validate` passes against OpenSubdiv, and a
+/// non-manifold input is a clear error with exit status 2.
+#[test]
+fn subdivide_command() {
+    let exe = env!("CARGO_BIN_EXE_texgeo");
+    let out = std::env::temp_dir().join(format!("texgeo-subdivide-{}.off", std::process::id()));
+    let run = std::process::Command::new(exe)
+        .args(["subdivide", "builtin:pyramid", "-l", "3", "--validate", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(stdout.contains("validation passed") && stdout.contains("position error: max"), "{stdout}");
+    let written = texgeo::mesh::formats::read(&out).unwrap();
+    let _ = std::fs::remove_file(&out);
+    let reference = cpu::refine(&texgeo::mesh::procedural::pyramid(), 3).unwrap();
+    assert_eq!(
+        (written.num_vertices(), written.num_faces()),
+        (reference.num_vertices(), reference.num_faces())
+    );
+    assert!(written.report().is_closed());
+
+    let run =
+        std::process::Command::new(exe).args(["subdivide", "builtin:two-cubes", "-l", "2"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("non-manifold edge") && stderr.contains("manifold"), "{stderr}");
+}
