@@ -24,6 +24,26 @@ pub enum Command {
         #[arg(long, short, default_value = "out/bench")]
         out: PathBuf,
     },
+    /// Voxelization: the thesis' Table 5-2 (64³ … 512³, every method), time split and ratios.
+    Voxelize {
+        #[command(flatten)]
+        models: Models,
+        /// Resolutions N (N³ voxels).
+        #[arg(long, value_delimiter = ',', default_values_t = bench::voxelize::DEFAULT_RESOLUTIONS.to_vec())]
+        sizes: Vec<usize>,
+        /// Methods to measure (default: all).
+        #[arg(long, value_delimiter = ',')]
+        methods: Vec<String>,
+        /// Zone height in slices for `zoned` (default: automatic).
+        #[arg(long)]
+        zone: Option<usize>,
+        /// Timed runs per measurement (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Folder for the Markdown and CSV files.
+        #[arg(long, short, default_value = "out/bench")]
+        out: PathBuf,
+    },
     /// 2×2 ping-pong sum reduction (512², 2048², 4096²) against a plain CPU sum.
     Reduce {
         /// Texture sides to measure.
@@ -125,6 +145,28 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
                 .collect::<Vec<_>>();
             let cfg = bench::inclusion::Config { sets, points, resolutions };
             finish(bench::inclusion::run(&ctx, &models, &cfg)?, &Common { runs: 0, out })
+        }
+        Command::Voxelize { models, sizes, methods, zone, runs, out } => {
+            use texgeo::voxel::Method;
+            let methods = if methods.is_empty() {
+                Method::ALL.to_vec()
+            } else {
+                methods
+                    .iter()
+                    .map(|m| Method::parse(m).ok_or_else(|| anyhow::anyhow!("unknown method '{m}'")))
+                    .collect::<anyhow::Result<_>>()?
+            };
+            for &n in &sizes {
+                texgeo::voxel::grid::check_resolution(n)?;
+            }
+            let models = models
+                .load(bench::voxelize::STAND_INS)?
+                .into_iter()
+                .map(|(thesis, name, mesh)| bench::voxelize::Model { thesis, name, mesh })
+                .collect::<Vec<_>>();
+            anyhow::ensure!(!models.is_empty(), "no models to measure");
+            let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
+            finish(bench::voxelize::run(&ctx, &models, &cfg)?, &Common { runs, out })
         }
         Command::Reduce { sizes, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {

@@ -3,3 +3,4 @@
 pub mod inclusion;
 pub mod reduce;
 pub mod subdiv;
+pub mod voxelize;
