@@ -105,3 +105,52 @@ fn open_meshes_are_refused_unless_allowed() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("warning"), "{}", stderr(&o));
 }
+
+#[test]
+fn voxelize_writes_binvox_slices_and_aspect() {
+    let out = temp("knot.binvox");
+    let slices = temp("knot-slices");
+    let aspect = temp("knot-aspect");
+    let o = texgeo(&[
+        "voxelize",
+        "builtin:knot",
+        "--res",
+        "24",
+        "--method",
+        "pgpu",
+        "-o",
+        out.to_str().unwrap(),
+        "--slices",
+        slices.to_str().unwrap(),
+        "--aspect",
+        "perlin",
+        "--aspect-out",
+        aspect.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("occupied"), "{}", stdout(&o));
+    let (grid, volume) = texgeo::voxel::binvox::read(&out).unwrap();
+    assert_eq!(grid.n, 24);
+    let expected = texgeo::voxel::voxelize(
+        None,
+        &texgeo::mesh::procedural::torus_knot(),
+        24,
+        texgeo::voxel::Method::Cpu,
+    )
+    .unwrap();
+    assert_eq!(volume, expected.volume);
+    assert_eq!(std::fs::read_dir(&slices).unwrap().count(), 24);
+    assert!(aspect.join("front.png").exists());
+    // Too large a grid, an open mesh, an unknown method: one message, status 2.
+    for (args, expect) in [
+        (vec!["voxelize", "builtin:cube", "--res", "5000", "-o", "x.binvox"], "1024"),
+        (
+            vec!["voxelize", "builtin:cube", "--res", "8", "--method", "magic", "-o", "x.binvox"],
+            "unknown method",
+        ),
+    ] {
+        let o = texgeo(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&o).contains(expect), "{args:?}: {}", stderr(&o));
+    }
+}
