@@ -7,6 +7,6 @@ layout(push_constant) uniform Params {
     uint bits;         // 1 << (j mod 32) for a slice; a mask for a Fang slab
 } pc;
 
-// Where culled vertices go: a corner of the viewport's guard band, outside the scissor,
-// so a culled triangle has no area and never needs clipping.
+// Where culled vertices go: the corner of the viewport, in the margin around the voxels
+// and on no texel centre, so a culled triangle has no area and never needs clipping.
 const vec4 CULLED = vec4(-1.0, -1.0, 0.0, 1.0);

@@ -417,32 +417,6 @@ impl<'p> RenderScope<'_, 'p> {
         }
     }
 
-    /// A viewport that may extend beyond the pass's area (a guard band: geometry slightly
-    /// outside the target is then scissored, never clipped into new vertices) and the
-    /// scissor rectangle inside the area that is actually written. Call after `bind`.
-    pub fn viewport_scissor(&mut self, viewport: [f32; 4], scissor: Rect) -> Result<()> {
-        let [x, y, w, h] = viewport;
-        let [sx, sy, sw, sh] = scissor;
-        let [ax, ay, aw, ah] = self.area;
-        if sx < ax || sy < ay || sx + sw > ax + aw || sy + sh > ay + ah || !(w > 0.0 && h > 0.0) {
-            return Err(GpuError::Usage(format!(
-                "viewport {viewport:?} / scissor {scissor:?} outside the pass area {:?}",
-                self.area
-            )));
-        }
-        let vp = [vk::Viewport { x, y, width: w, height: h, min_depth: 0.0, max_depth: 1.0 }];
-        let sc = [vk::Rect2D {
-            offset: vk::Offset2D { x: sx as i32, y: sy as i32 },
-            extent: vk::Extent2D { width: sw, height: sh },
-        }];
-        // SAFETY: recording state; dynamic viewport/scissor are part of every texgeo pipeline.
-        unsafe {
-            self.dev.raw.cmd_set_viewport(self.cmd, 0, &vp);
-            self.dev.raw.cmd_set_scissor(self.cmd, 0, &sc);
-        }
-        Ok(())
-    }
-
     fn bound(&self) -> Result<&'p Pipeline> {
         self.pipeline.ok_or_else(|| GpuError::Usage("bind a pipeline before drawing".into()))
     }
@@ -582,39 +556,6 @@ impl<'p> RenderScope<'_, 'p> {
                 vertices.end - vertices.start,
                 instances.end - instances.start,
                 vertices.start,
-                instances.start,
-            )
-        };
-        Ok(())
-    }
-
-    /// Draws the vertices listed in `indices[range]` (u32 vertex numbers), `instances`
-    /// times: a subset of a static vertex buffer, like a display list of its own.
-    pub fn draw_indexed(
-        &mut self,
-        indices: &Buffer,
-        range: std::ops::Range<u32>,
-        instances: std::ops::Range<u32>,
-    ) -> Result<()> {
-        self.bound()?;
-        if range.end as u64 * 4 > indices.size() {
-            return Err(GpuError::Usage(format!(
-                "indices {range:?} beyond an index buffer of {} bytes",
-                indices.size()
-            )));
-        }
-        if range.is_empty() || instances.is_empty() {
-            return Ok(());
-        }
-        // SAFETY: the buffer outlives the submission; the range was checked above.
-        unsafe {
-            self.dev.raw.cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
-            self.dev.raw.cmd_draw_indexed(
-                self.cmd,
-                range.end - range.start,
-                instances.end - instances.start,
-                range.start,
-                0,
                 instances.start,
             )
         };

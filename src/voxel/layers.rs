@@ -74,7 +74,8 @@ pub(crate) fn params(n: usize, slice: f32, bits: u32) -> [u32; 6] {
     [scale.to_bits(), scale.to_bits(), offset.to_bits(), offset.to_bits(), slice.to_bits(), bits]
 }
 
-/// Checks that the device can draw an N×N presence buffer with its guard band.
+/// Checks that the device can draw an (N + 2)² presence buffer (N voxels and the margin)
+/// with logic op XOR.
 pub(crate) fn check_device(ctx: &Context, n: usize) -> Result<()> {
     let info = ctx.info();
     let max = (info.max_image_2d.min(info.max_viewport[0]).min(info.max_viewport[1]) as usize)

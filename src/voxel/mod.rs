@@ -123,7 +123,7 @@ pub struct Voxelizer {
     slice: Option<crate::gpu::Pipeline>,
     /// Pass-through pipeline (fgpu, fang), made on first use.
     section: Option<crate::gpu::Pipeline>,
-    /// Zone height for `zoned` in slices (None: [`pgpu::DEFAULT_ZONE`]).
+    /// Zone height for `zoned` in slices (None: [`pgpu::default_zone`]).
     pub zone: Option<usize>,
     /// Apply the exact fallback near the surface (on by default; off only to study a
     /// method's raw output — it can then be wrong there).

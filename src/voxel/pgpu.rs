@@ -8,10 +8,11 @@
 //! - `zoned` (PGPU-MP, §5.4.2): the slices are cut into zones of Z consecutive slices and
 //!   each zone gets its own display list: a contiguous copy of the tetras that reach it
 //!   (a tetra spanning several zones is copied into each, the memory the thesis trades
-//!   for speed); a slice draws only its zone's list. Z defaults to [`DEFAULT_ZONE`] = 32,
-//!   one zone per R32UI layer: measured on lavapipe (armadillo, 128³–512³), zones of 4,
-//!   8, 16 and 32 slices draw within ±10 % of each other while smaller zones cost more
-//!   copies to prepare. (Index lists into one shared buffer would avoid the copies, but
+//!   for speed); a slice draws only its zone's list. Z defaults to [`default_zone`]:
+//!   N/8 slices, between 4 and 32 (one R32UI layer). Measured on lavapipe (armadillo,
+//!   128³–512³), zones of 4, 8, 16 and 32 slices draw within ±10 % of each other while
+//!   small zones cost more copies to prepare; at least 8 zones keep small grids from
+//!   drawing most tetras in most slices. (Index lists into one shared buffer would avoid the copies, but
 //!   lavapipe shades every vertex between a draw's lowest and highest index.)
 
 use std::ops::Range;
@@ -34,8 +35,10 @@ type Vertex = [u32; 13];
 
 const VERTEX_BYTES: u64 = std::mem::size_of::<Vertex>() as u64;
 
-/// Zone height used when none is asked for: the slices of one R32UI layer.
-pub const DEFAULT_ZONE: usize = SLICES_PER_LAYER;
+/// Zone height used when none is asked for: N/8 slices, between 4 and 32.
+pub fn default_zone(n: usize) -> usize {
+    (n / 8).clamp(4, SLICES_PER_LAYER)
+}
 
 /// The static vertex buffer of Alg. 5-2, one display list per zone (one zone for pgpu).
 pub(crate) struct Tetras<'a> {
@@ -88,7 +91,7 @@ impl<'a> Tetras<'a> {
         let n = grid.n;
         let tetras = solid.sorted_tetras(grid);
         let zone = match zone {
-            Some(0) => DEFAULT_ZONE,
+            Some(0) => default_zone(n),
             Some(z) => z,
             None => n,
         };

@@ -159,22 +159,28 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
                 ]);
                 eprintln!("{} {n}³ {method}: {} ms", model.name, ms(total));
             }
-            if let (Some(c), Some(p), Some(z)) =
-                (totals.get(&Method::Cpu), totals.get(&Method::Pgpu), totals.get(&Method::Zoned))
-            {
-                let r =
-                    |a: Duration, b: Duration| format!("{:.2}", a.as_secs_f64() / b.as_secs_f64().max(1e-9));
+            let get = |m: Method| totals.get(&m).copied();
+            if get(Method::Cpu).is_some() || (get(Method::Pgpu).is_some() && get(Method::Zoned).is_some()) {
+                let time =
+                    |m: Method, excl: bool| get(m).map_or("–".into(), |t| ms(if excl { t.1 } else { t.0 }));
+                let ratio = |a: Method, b: Method, excl: bool| match (get(a), get(b)) {
+                    (Some(x), Some(y)) => {
+                        let y = if excl { y.1 } else { y.0 };
+                        format!("{:.2}", x.0.as_secs_f64() / y.as_secs_f64().max(1e-9))
+                    }
+                    _ => "–".into(),
+                };
                 ratios.row(vec![
                     model.name.clone(),
                     n.to_string(),
-                    ms(c.0),
-                    ms(p.0),
-                    ms(z.0),
-                    r(c.0, p.0),
-                    r(c.0, z.0),
-                    r(p.0, z.0),
-                    ms(z.1),
-                    r(c.0, z.1),
+                    time(Method::Cpu, false),
+                    time(Method::Pgpu, false),
+                    time(Method::Zoned, false),
+                    ratio(Method::Cpu, Method::Pgpu, false),
+                    ratio(Method::Cpu, Method::Zoned, false),
+                    ratio(Method::Pgpu, Method::Zoned, false),
+                    time(Method::Zoned, true),
+                    ratio(Method::Cpu, Method::Zoned, true),
                 ]);
             }
         }
