@@ -55,6 +55,23 @@ const GROUP_BYTES: u64 = 64 << 20;
 
 /// Colours `volume` with `aspect`: one N×N RGBA8 image per slice (x right, z down).
 pub fn render(ctx: &Context, volume: &Volume, aspect: &Aspect) -> Result<Vec<Vec<u8>>> {
+    check_memory("the aspect slices", volume.n(), (volume.n() as u64).pow(3) * 4)?;
+    let mut slices = Vec::with_capacity(volume.n());
+    render_each(ctx, volume, aspect, |_, pixels| {
+        slices.push(pixels.to_vec());
+        Ok(())
+    })?;
+    Ok(slices)
+}
+
+/// Like [`render`], but hands each slice j to `sink(j, pixels)` as soon as its group is
+/// read back, so only a group of slices is ever in memory.
+pub fn render_each(
+    ctx: &Context,
+    volume: &Volume,
+    aspect: &Aspect,
+    mut sink: impl FnMut(usize, &[u8]) -> Result<()>,
+) -> Result<()> {
     let n = volume.n();
     let side = n as u32;
     if side > ctx.info().max_image_2d {
@@ -65,11 +82,7 @@ pub fn render(ctx: &Context, volume: &Volume, aspect: &Aspect) -> Result<Vec<Vec
         });
     }
     let slice_bytes = (n * n * 4) as u64;
-    check_memory(
-        "the aspect slices",
-        n,
-        slice_bytes * n as u64 + 2 * GROUP_BYTES.min(slice_bytes * n as u64),
-    )?;
+    check_memory("the aspect pass", n, 2 * GROUP_BYTES.min(slice_bytes * n as u64))?;
     let layers = n.div_ceil(SLICES_PER_LAYER);
     let occupancy =
         Texture::new_layered(ctx, TexFormat::R32Ui, side, side, layers as u32, "presence layers")?;
@@ -89,7 +102,6 @@ pub fn render(ctx: &Context, volume: &Volume, aspect: &Aspect) -> Result<Vec<Vec
     let group = ((GROUP_BYTES / slice_bytes) as usize).clamp(1, n).min(ctx.info().max_array_layers as usize);
     let target = Texture::new_layered(ctx, TexFormat::Rgba8, side, side, group as u32, "aspect slices")?;
     let material = Material::ALL.iter().position(|&m| m == aspect.material).unwrap_or(0) as u32;
-    let mut slices = Vec::with_capacity(n);
     for first in (0..n).step_by(group) {
         let count = group.min(n - first);
         let reads = [&occupancy, &perm];
@@ -106,7 +118,9 @@ pub fn render(ctx: &Context, volume: &Volume, aspect: &Aspect) -> Result<Vec<Vec
             rec.readback_region(&target, 0..count as u32, [0, 0, side, side])
         })?;
         let bytes = buffer.bytes()?;
-        slices.extend(bytes.chunks_exact(slice_bytes as usize).map(<[u8]>::to_vec));
+        for (j, pixels) in bytes.chunks_exact(slice_bytes as usize).enumerate() {
+            sink(first + j, pixels)?;
+        }
     }
-    Ok(slices)
+    Ok(())
 }

@@ -97,17 +97,23 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             args.output.with_file_name(format!("{stem}-aspect"))
         });
         let params = Aspect { material: args.material, frequency: args.frequency, ..Aspect::default() };
-        let slices = aspect::render(ctx, &result.volume, &params)?;
-        let files = pictures::write_rgba_slices(args.res, &slices, &dir)?;
-        let picture = dir.join("front.png");
-        pictures::render_front(&result.volume, Some(&slices))
-            .save(&picture)
-            .with_context(|| format!("writing {}", picture.display()))?;
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        // Slices stream to PNG files a group at a time; the front view is built as they pass.
+        let mut picture = pictures::front_canvas(args.res);
+        let mut count = 0;
+        aspect::render_each(ctx, &result.volume, &params, |j, pixels| {
+            pictures::write_rgba_slice(args.res, j, pixels, &dir)?;
+            pictures::front_row(&result.volume, j, Some(pixels), &mut picture);
+            count += 1;
+            Ok(())
+        })?;
+        let front = dir.join("front.png");
+        picture.save(&front).with_context(|| format!("writing {}", front.display()))?;
         println!(
             "wrote {} {} aspect slices and a rendered view {} into {}",
-            files.len(),
+            count,
             args.material.name(),
-            picture.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(),
+            front.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(),
             dir.display()
         );
     }
