@@ -8,6 +8,12 @@
 //! error bound of the surface to the exact classifier ([`band`]), so none of them is ever
 //! silently wrong (SPEC §0).
 //!
+//! "Inside" is the parity of the XOR accumulation (§5.3.1): an odd number of covering
+//! tetras, i.e. an odd winding number. For a valid solid that is the same as `inclusion`'s
+//! non-zero rule; they differ only for self-overlapping shells (winding 2: `inclusion`
+//! says Inside, a voxelization Outside). Where `inclusion` answers OnBoundary, the tie
+//! rule gives the voxel's value.
+//!
 //! | method | what it is |
 //! |---|---|
 //! | `cpu` | tetra slicing (Table 5-1) + scanline XOR rasterizer (§5.3.2) |
