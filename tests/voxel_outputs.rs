@@ -9,7 +9,7 @@ use texgeo::gpu::Context;
 use texgeo::mesh::procedural;
 use texgeo::random::Rng;
 use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::tetragrid::{self, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
+use texgeo::voxel::tetragrid::{self, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::{Grid, Method, binvox, pictures, voxelize};
 
 fn temp_dir(name: &str) -> std::path::PathBuf {
@@ -138,9 +138,13 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
         let h = grid.h();
         for _ in 0..60 {
             let t = random_tetra(&mut rng);
-            for offset in [MIN_OFFSET, SPEC_OFFSET] {
+            for growth in [
+                Growth::Diagonals(MIN_OFFSET),
+                Growth::Diagonals(SPEC_OFFSET),
+                Growth::CellBox { extra: 0.0 },
+            ] {
                 let mut cells = Vec::new();
-                tetragrid::cells(&grid, &t, offset, &mut cells);
+                tetragrid::cells(&grid, &t, growth, &mut cells);
                 let listed: std::collections::HashSet<u32> = cells.iter().copied().collect();
                 assert_eq!(listed.len(), cells.len(), "no duplicates");
                 let mut touched = 0;
@@ -151,10 +155,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                             if tetra_box_overlap(&t, lo, lo + DVec3::splat(h)) {
                                 touched += 1;
                                 let c = tetragrid::cell_index(n, i, j, k) as u32;
-                                assert!(
-                                    listed.contains(&c),
-                                    "n {n} offset {offset}: cell ({i},{j},{k}) of {t:?}"
-                                );
+                                assert!(listed.contains(&c), "n {n} {growth:?}: cell ({i},{j},{k}) of {t:?}");
                             }
                         }
                     }
@@ -166,6 +167,10 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                     t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p)),
                     t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p)),
                 );
+                let offset = match growth {
+                    Growth::Diagonals(d) => d,
+                    Growth::CellBox { .. } => 0.5,
+                };
                 let reach = (offset + 1.0) * h * 3f64.sqrt();
                 for &c in &cells {
                     let c = c as usize;
@@ -198,8 +203,10 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
     let solid = texgeo::voxel::Solid::new(&mesh).unwrap();
     let grid = Grid::for_mesh(&mesh, 16).unwrap();
     let tetras = solid.tetras();
-    for offset in [MIN_OFFSET, SPEC_OFFSET] {
-        let tg = TetraGrid::build(&grid, &tetras, offset).unwrap();
+    for growth in
+        [Growth::CellBox { extra: 0.0 }, Growth::Diagonals(MIN_OFFSET), Growth::Diagonals(SPEC_OFFSET)]
+    {
+        let tg = TetraGrid::build(&grid, &tetras, growth).unwrap();
         assert_eq!(tg.offsets.len(), 16 * 16 * 16 + 1);
         assert_eq!(*tg.offsets.last().unwrap() as usize, tg.tetras.len());
         let mut rng = Rng::new(3);
@@ -213,7 +220,43 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
             assert!(tg.tetras_at(p).binary_search(&(id as u32)).is_ok(), "tetra {id} at {p}");
         }
     }
-    let small = TetraGrid::build(&grid, &tetras, MIN_OFFSET).unwrap().tetras.len();
-    let spec = TetraGrid::build(&grid, &tetras, SPEC_OFFSET).unwrap().tetras.len();
-    assert!(small < spec, "{small} vs {spec}");
+    let size = |g| TetraGrid::build(&grid, &tetras, g).unwrap().tetras.len();
+    let (tight, small, spec) = (
+        size(Growth::CellBox { extra: 0.0 }),
+        size(Growth::Diagonals(MIN_OFFSET)),
+        size(Growth::Diagonals(SPEC_OFFSET)),
+    );
+    assert!(tight <= small && small < spec, "{tight} {small} {spec}");
+}
+
+#[test]
+fn the_inclusion_tetragrid_can_use_the_conservative_rasterizer() {
+    use texgeo::inclusion::tetragrid::TetraGrid as InclusionGrid;
+    use texgeo::inclusion::{Classifier, FeitoTorres};
+    for mesh in
+        [procedural::torus_knot(), procedural::cube_with_cavity(), procedural::two_cubes_sharing_edge()]
+    {
+        let reference = FeitoTorres::new(&mesh).unwrap();
+        let boxes = InclusionGrid::new(FeitoTorres::new(&mesh).unwrap(), 16).unwrap();
+        let raster =
+            InclusionGrid::with_cover(FeitoTorres::new(&mesh).unwrap(), 16, tetragrid::inclusion_cover)
+                .unwrap();
+        let (lo, hi) = mesh.bounds();
+        let mut rng = Rng::new(8);
+        let mut points = rng.points_in_box(4000, lo - (hi - lo) * 0.05, hi + (hi - lo) * 0.05);
+        // Points on the covering's vertices, edges and faces too.
+        for f in mesh.faces().take(200) {
+            let p = mesh.positions();
+            points.push(p[f[0] as usize]);
+            points.push((p[f[0] as usize] + p[f[1] as usize]) * 0.5);
+            points.push((p[f[0] as usize] + p[f[1] as usize] + p[f[2] as usize]) / 3.0);
+        }
+        for &p in &points {
+            let expected = reference.classify(p);
+            assert_eq!(raster.classify(p), expected, "{p}");
+            assert_eq!(boxes.classify(p), expected, "{p}");
+        }
+        let (_, ids) = raster.cell_lists();
+        assert!(!ids.is_empty());
+    }
 }

@@ -11,7 +11,11 @@
 //! diagonal (h√3/2) of the cell's centre, so the centre lies in the tetra grown by that
 //! distance, which the moved planes contain. The thesis (and SPEC §4.4) move the planes
 //! by twice the voxel diagonal ([`SPEC_OFFSET`]); half a diagonal ([`MIN_OFFSET`]) is
-//! already enough when cells are sampled at their centres, and gives shorter lists.
+//! already enough when cells are sampled at their centres. Tighter still,
+//! [`Growth::CellBox`] moves each plane by the cell's half extent along that plane's
+//! normal (h/2·(|nx|+|ny|+|nz|)): a cell meets a half-space exactly when its centre is
+//! inside the half-space moved that much, so no touched cell is lost and cells beside
+//! axis-aligned faces are not added.
 //!
 //! Cells are numbered like the voxel volume: (j·N + k)·N + i.
 
@@ -25,6 +29,26 @@ pub const SPEC_OFFSET: f64 = 2.0;
 
 /// The smallest offset that is conservative for centre sampling, in voxel diagonals.
 pub const MIN_OFFSET: f64 = 0.5;
+
+/// How far the rasterized tetra is grown beyond the real one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Growth {
+    /// Every plane (and the bounding box) moved by this many cell diagonals (§5.5.1).
+    Diagonals(f64),
+    /// Every plane moved by the cell's half extent along its normal, plus `extra` (world
+    /// units); the box by half a cell plus `extra`.
+    CellBox { extra: f64 },
+}
+
+impl Growth {
+    /// (offset of a plane with unit normal `n`, growth of the box), world units.
+    fn amounts(self, cell: f64, n: DVec3) -> (f64, f64) {
+        match self {
+            Growth::Diagonals(d) => (d * cell * 3f64.sqrt(), d * cell * 3f64.sqrt()),
+            Growth::CellBox { extra } => (0.5 * cell * n.abs().element_sum() + extra, 0.5 * cell + extra),
+        }
+    }
+}
 
 /// The index of cell (i, j, k).
 pub fn cell_index(n: usize, i: usize, j: usize, k: usize) -> usize {
@@ -85,32 +109,50 @@ pub fn enlarge(t: &[DVec3; 4], offset: f64) -> Option<[DVec3; 4]> {
 }
 
 /// Appends to `out` every cell the tetra `t` (world coordinates) may touch: the cells
-/// whose centres the enlarged tetra (planes moved by `offset_diagonals` voxel diagonals)
-/// covers. A flat tetra gets the cells of its grown bounding box.
-pub fn cells(grid: &Grid, t: &[DVec3; 4], offset_diagonals: f64, out: &mut Vec<u32>) {
+/// whose centres the enlarged tetra covers. A flat tetra gets the cells of its grown
+/// bounding box.
+pub fn cells(grid: &Grid, t: &[DVec3; 4], growth: Growth, out: &mut Vec<u32>) {
     let n = grid.n;
-    let offset = offset_diagonals * grid.h() * 3f64.sqrt();
-    for_each_cell(grid.min, grid.h(), n, t, offset, |i, j, k| out.push(cell_index(n, i, j, k) as u32));
+    for_each_cell(grid.min, grid.h(), n, t, growth, |i, j, k| out.push(cell_index(n, i, j, k) as u32));
 }
 
 /// The conservative rasterizer itself, for any n³ grid of cubic cells of side `cell`
 /// whose minimum corner is `origin` (so other grids, like the inclusion TetraGrid's, can
-/// use it): calls `f(i, j, k)` for every cell whose centre lies inside the tetra `t` with
-/// its face planes moved outward by `offset` (world units) and inside its bounding box
-/// grown by `offset`. With `offset` ≥ cell·√3/2 every cell `t` touches is visited.
+/// use it): calls `f(i, j, k)` for every cell whose centre lies inside the tetra `t` grown
+/// by `growth` (its face planes moved outward) and inside its grown bounding box. With
+/// [`Growth::CellBox`] or at least [`MIN_OFFSET`] diagonals every cell `t` touches is
+/// visited.
 pub fn for_each_cell(
     origin: DVec3,
     cell: f64,
     n: usize,
     t: &[DVec3; 4],
-    offset: f64,
+    growth: Growth,
+    f: impl FnMut(usize, usize, usize),
+) {
+    let lo = t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p));
+    let hi = t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p));
+    for_each_cell_planes(origin, cell, n, face_planes(t).as_ref(), (lo, hi), growth, f);
+}
+
+/// The same rasterizer for a tetra given by its four face planes — (outward unit normal,
+/// d), inside n·x ≤ d, `None` for a flat tetra — and its bounding box: the form other
+/// modules keep their tetras in.
+pub fn for_each_cell_planes(
+    origin: DVec3,
+    cell: f64,
+    n: usize,
+    planes: Option<&[(DVec3, f64); 4]>,
+    (lo, hi): (DVec3, DVec3),
+    growth: Growth,
     mut f: impl FnMut(usize, usize, usize),
 ) {
-    let lo = t.iter().fold(DVec3::INFINITY, |m, &p| m.min(p)) - DVec3::splat(offset);
-    let hi = t.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p)) + DVec3::splat(offset);
+    let grow = growth.amounts(cell, DVec3::ZERO).1;
+    let lo = lo - DVec3::splat(grow);
+    let hi = hi + DVec3::splat(grow);
     // Rounding slack, far below any cell size.
     let slack = 1e-9 * (hi - lo).max_element().max(cell);
-    let planes = face_planes(t).map(|p| p.map(|(nrm, d)| (nrm, d + offset + slack)));
+    let planes = planes.map(|p| p.map(|(nrm, d)| (nrm, d + growth.amounts(cell, nrm).0 + slack)));
     let range = |min: f64, a: f64, b: f64| -> std::ops::Range<usize> {
         let first = ((a - slack - min) / cell - 0.5).ceil().max(0.0);
         let last = ((b + slack - min) / cell - 0.5).floor().min(n as f64 - 1.0);
@@ -143,6 +185,28 @@ pub fn for_each_cell(
     }
 }
 
+/// A cover for the inclusion TetraGrid (`inclusion::tetragrid::TetraGrid::with_cover`):
+/// the tetra's planes moved out by the cell's half extent along each normal plus 2ε
+/// ([`Growth::CellBox`]), so every cell holding a point for which the tetra's verdict is
+/// not Outside (within ε of it) is listed. Flat and degenerate tetras get their grown
+/// box, as with `box_cover`.
+pub fn inclusion_cover(
+    grid: &crate::inclusion::tetragrid::GridGeometry,
+    t: &crate::inclusion::tetra::TetraPlanes,
+    eps: f64,
+    out: &mut Vec<u32>,
+) {
+    use crate::inclusion::tetra::Kind;
+    // The inclusion planes are inward with q relative to the apex: side faces through the
+    // origin (n·q ≥ 0), base n·q ≥ base_offset.
+    let planes = (t.kind == Kind::Regular)
+        .then(|| [(-t.side[0], 0.0), (-t.side[1], 0.0), (-t.side[2], 0.0), (-t.base, -t.base_offset)]);
+    let growth = Growth::CellBox { extra: 2.0 * eps };
+    for_each_cell_planes(grid.lo, grid.cell, grid.n, planes.as_ref(), (t.lo, t.hi), growth, |i, j, k| {
+        out.push(grid.index([i, j, k]) as u32)
+    });
+}
+
 /// The cell → tetras lists (CSR) of a grid.
 #[derive(Clone, Debug)]
 pub struct TetraGrid {
@@ -153,8 +217,9 @@ pub struct TetraGrid {
 }
 
 impl TetraGrid {
-    /// Conservatively rasterizes every tetra (world coordinates) into `grid`'s cells.
-    pub fn build(grid: &Grid, tetras: &[[DVec3; 4]], offset_diagonals: f64) -> Result<TetraGrid> {
+    /// Conservatively rasterizes every tetra (world coordinates) into `grid`'s cells
+    /// (`Growth::Diagonals(SPEC_OFFSET)` is SPEC §4.4's choice).
+    pub fn build(grid: &Grid, tetras: &[[DVec3; 4]], growth: Growth) -> Result<TetraGrid> {
         let cells_total = grid.voxels();
         check_memory("the TetraGrid cell offsets", grid.n, (cells_total + 1) * 4)?;
         let mut counts = vec![0u32; cells_total as usize + 1];
@@ -162,7 +227,7 @@ impl TetraGrid {
         let mut total = 0u64;
         for t in tetras {
             buf.clear();
-            cells(grid, t, offset_diagonals, &mut buf);
+            cells(grid, t, growth, &mut buf);
             total += buf.len() as u64;
             for &c in &buf {
                 counts[c as usize + 1] += 1;
@@ -181,7 +246,7 @@ impl TetraGrid {
         let mut lists = vec![0u32; total as usize];
         for (id, t) in tetras.iter().enumerate() {
             buf.clear();
-            cells(grid, t, offset_diagonals, &mut buf);
+            cells(grid, t, growth, &mut buf);
             for &c in &buf {
                 lists[counts[c as usize] as usize] = id as u32;
                 counts[c as usize] += 1;
