@@ -230,17 +230,20 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
 }
 
 #[test]
-fn the_inclusion_tetragrid_can_use_the_conservative_rasterizer() {
+fn the_inclusion_tetragrid_uses_the_conservative_rasterizer() {
     use texgeo::inclusion::tetragrid::TetraGrid as InclusionGrid;
     use texgeo::inclusion::{Classifier, FeitoTorres};
     for mesh in
         [procedural::torus_knot(), procedural::cube_with_cavity(), procedural::two_cubes_sharing_edge()]
     {
         let reference = FeitoTorres::new(&mesh).unwrap();
-        let boxes = InclusionGrid::new(FeitoTorres::new(&mesh).unwrap(), 16).unwrap();
-        let raster =
-            InclusionGrid::with_cover(FeitoTorres::new(&mesh).unwrap(), 16, tetragrid::inclusion_cover)
-                .unwrap();
+        let boxes = InclusionGrid::with_cover(
+            FeitoTorres::new(&mesh).unwrap(),
+            16,
+            texgeo::inclusion::tetragrid::box_cover,
+        )
+        .unwrap();
+        let raster = InclusionGrid::new(FeitoTorres::new(&mesh).unwrap(), 16).unwrap();
         let (lo, hi) = mesh.bounds();
         let mut rng = Rng::new(8);
         let mut points = rng.points_in_box(4000, lo - (hi - lo) * 0.05, hi + (hi - lo) * 0.05);

@@ -3,11 +3,12 @@
 //! and a point outside the cube is Outside at once.
 //!
 //! Two separate parts: [`GridGeometry`] + CSR cell lists (the storage a GPU pass groups
-//! points by), and a *cover* function saying which cells a tetra touches. The cover used
-//! for now is [`box_cover`] (the tetra's grown box, minus cells clearly beyond one of its
-//! planes); the conservative tetra rasterization of §4.4/§5.5.1 plugs in through
-//! [`TetraGrid::with_cover`]. A cover may list extra cells, never miss one: it must list
-//! every cell holding a point for which the tetra's verdict is not `Outside`.
+//! points by), and a *cover* function saying which cells a tetra touches. The default is
+//! [`conservative_cover`], the conservative tetra rasterization of §4.4/§5.5.1; the first
+//! cover, [`box_cover`] (the tetra's grown box, minus cells clearly beyond one of its
+//! planes), stays available through [`TetraGrid::with_cover`]. A cover may list extra
+//! cells, never miss one: it must list every cell holding a point for which the tetra's
+//! verdict is not `Outside`.
 
 use std::ops::Range;
 use std::time::Instant;
@@ -118,6 +119,23 @@ pub fn box_cover(grid: &GridGeometry, t: &TetraPlanes, eps: f64, out: &mut Vec<u
     }
 }
 
+/// The default cover: conservative rasterization of the tetra (§5.5.1, SPEC §4.4, the
+/// voxelization module's rasterizer): its planes moved out by the cell's half extent along
+/// each normal plus 2ε, so every cell holding a point whose verdict for this tetra is not
+/// Outside (within ε) is listed. Flat and degenerate tetras get their grown box, as with
+/// [`box_cover`].
+pub fn conservative_cover(grid: &GridGeometry, t: &TetraPlanes, eps: f64, out: &mut Vec<u32>) {
+    use crate::voxel::tetragrid::{Growth, for_each_cell_planes};
+    // The rasterizer takes outward planes (inside n·x ≤ d); these are inward, with the
+    // side faces through the apex (the origin of `grid`'s coordinates).
+    let planes = (t.kind == Kind::Regular)
+        .then(|| [(-t.side[0], 0.0), (-t.side[1], 0.0), (-t.side[2], 0.0), (-t.base, -t.base_offset)]);
+    let growth = Growth::CellBox { extra: 2.0 * eps };
+    for_each_cell_planes(grid.lo, grid.cell, grid.n, planes.as_ref(), (t.lo, t.hi), growth, |i, j, k| {
+        out.push(grid.index([i, j, k]) as u32)
+    });
+}
+
 /// Feito-Torres over the tetras of the point's grid cell.
 #[derive(Clone, Debug)]
 pub struct TetraGrid {
@@ -132,9 +150,9 @@ pub struct TetraGrid {
 }
 
 impl TetraGrid {
-    /// An n³ grid (n in 2..=64) filled with [`box_cover`].
+    /// An n³ grid (n in 2..=64) filled by conservative rasterization ([`conservative_cover`]).
     pub fn new(ft: FeitoTorres, n: usize) -> Result<TetraGrid> {
-        TetraGrid::with_cover(ft, n, box_cover)
+        TetraGrid::with_cover(ft, n, conservative_cover)
     }
 
     /// An n³ grid filled by `cover(grid, tetra, ε, out)`, which appends the indices of the

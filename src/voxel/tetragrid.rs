@@ -185,28 +185,6 @@ pub fn for_each_cell_planes(
     }
 }
 
-/// A cover for the inclusion TetraGrid (`inclusion::tetragrid::TetraGrid::with_cover`):
-/// the tetra's planes moved out by the cell's half extent along each normal plus 2ε
-/// ([`Growth::CellBox`]), so every cell holding a point for which the tetra's verdict is
-/// not Outside (within ε of it) is listed. Flat and degenerate tetras get their grown
-/// box, as with `box_cover`.
-pub fn inclusion_cover(
-    grid: &crate::inclusion::tetragrid::GridGeometry,
-    t: &crate::inclusion::tetra::TetraPlanes,
-    eps: f64,
-    out: &mut Vec<u32>,
-) {
-    use crate::inclusion::tetra::Kind;
-    // The inclusion planes are inward with q relative to the apex: side faces through the
-    // origin (n·q ≥ 0), base n·q ≥ base_offset.
-    let planes = (t.kind == Kind::Regular)
-        .then(|| [(-t.side[0], 0.0), (-t.side[1], 0.0), (-t.side[2], 0.0), (-t.base, -t.base_offset)]);
-    let growth = Growth::CellBox { extra: 2.0 * eps };
-    for_each_cell_planes(grid.lo, grid.cell, grid.n, planes.as_ref(), (t.lo, t.hi), growth, |i, j, k| {
-        out.push(grid.index([i, j, k]) as u32)
-    });
-}
-
 /// The cell → tetras lists (CSR) of a grid.
 #[derive(Clone, Debug)]
 pub struct TetraGrid {
