@@ -179,3 +179,30 @@ fn narrow_tiles_reduce_along_one_axis() {
         check_tiles(&ctx, &mut rng, shape);
     }
 }
+
+#[test]
+fn xor_raster_equals_the_cpu_scanline_rasterizer() {
+    // Random triangles with vertices on the 1/256 sub-pixel grid, many sharing edges
+    // through texel centres (a fan around lattice points): the GPU's top-left rule and
+    // the CPU's half-open rule must flip exactly the same centres.
+    let ctx = ctx();
+    let n = 64u32;
+    let mut rng = Rng::new(3);
+    let snap = |v: f64| ((v * 256.0).round() / 256.0) as f32;
+    let mut tris: Vec<[[f32; 2]; 3]> = (0..1500)
+        .map(|_| std::array::from_fn(|_| [snap(rng.range_f64(0.0, 64.0)), snap(rng.range_f64(0.0, 64.0))]))
+        .collect();
+    for k in 0..40 {
+        let c = [10.5 + k as f32, 20.5];
+        let a = [c[0] - 3.0, c[1] - 7.0];
+        let b = [c[0] + 4.0, c[1] + 5.0];
+        tris.push([c, a, b]);
+        tris.push([c, b, [c[0] - 6.0, c[1] + 6.0]]);
+    }
+    let xor = XorRaster::new(&ctx, TexFormat::R32Ui).unwrap();
+    let gpu = xor.rasterize(&ctx, n, n, &tris, 1).unwrap();
+    let cpu = texgeo::report::bench::xor::cpu_xor(n, &tris);
+    let differing: Vec<usize> = (0..gpu.len()).filter(|&i| gpu[i] != cpu[i]).take(5).collect();
+    assert!(differing.is_empty(), "texels {differing:?} differ");
+    assert!(cpu.contains(&1) && cpu.contains(&0));
+}

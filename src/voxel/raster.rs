@@ -19,6 +19,12 @@ fn first_centre(v: f64, n: usize) -> usize {
 /// Flips every voxel centre of slice `j` that the triangle (grid units (x, z)) covers.
 pub fn xor_triangle(volume: &mut Volume, j: usize, tri: [[f64; 2]; 3]) {
     let n = volume.n();
+    triangle_spans(tri, n, |k, first, end| volume.xor_span(j, k, first, end));
+}
+
+/// The texel centres of an n×n grid that the triangle covers, row by row with the
+/// half-open rule: `span(row, first, end)` for the centres `first..end` of each row.
+pub fn triangle_spans(tri: [[f64; 2]; 3], n: usize, mut span: impl FnMut(usize, usize, usize)) {
     let mut v = tri;
     v.sort_by(|p, q| p[1].total_cmp(&q[1]).then(p[0].total_cmp(&q[0])));
     let [p0, p1, p2] = v;
@@ -29,6 +35,6 @@ pub fn xor_triangle(volume: &mut Volume, j: usize, tri: [[f64; 2]; 3]) {
         let long = edge_x(p0, p2, z);
         let short = if k < k1 { edge_x(p0, p1, z) } else { edge_x(p1, p2, z) };
         let (lo, hi) = if long < short { (long, short) } else { (short, long) };
-        volume.xor_span(j, k, first_centre(lo, n), first_centre(hi, n));
+        span(k, first_centre(lo, n), first_centre(hi, n));
     }
 }

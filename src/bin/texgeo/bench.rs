@@ -44,6 +44,17 @@ pub enum Command {
         #[arg(long, short, default_value = "out/bench")]
         out: PathBuf,
     },
+    /// XOR rasterization (logic op) of random triangles against the CPU scanline rasterizer.
+    Xor {
+        /// Target sides to measure.
+        #[arg(long, value_delimiter = ',', default_values_t = bench::xor::DEFAULT_SIDES.to_vec())]
+        sizes: Vec<u32>,
+        /// Triangles per target.
+        #[arg(long, default_value_t = 20_000)]
+        triangles: usize,
+        #[command(flatten)]
+        common: Common,
+    },
     /// 2×2 ping-pong sum reduction (512², 2048², 4096²) against a plain CPU sum.
     Reduce {
         /// Texture sides to measure.
@@ -167,6 +178,13 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             anyhow::ensure!(!models.is_empty(), "no models to measure");
             let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
             finish(bench::voxelize::run(&ctx, &models, &cfg)?, &Common { runs, out })
+        }
+        Command::Xor { sizes, triangles, common } => {
+            if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
+                anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
+            }
+            anyhow::ensure!(triangles > 0, "--triangles must be positive");
+            finish(bench::xor::run(&ctx, &sizes, triangles, common.runs)?, &common)
         }
         Command::Reduce { sizes, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {

@@ -4,3 +4,4 @@ pub mod inclusion;
 pub mod reduce;
 pub mod subdiv;
 pub mod voxelize;
+pub mod xor;
