@@ -4,6 +4,7 @@
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top.
 
 pub mod gpu;
+pub mod host;
 pub mod inclusion;
 pub mod mesh;
 pub mod random;

@@ -20,14 +20,7 @@ pub struct Environment {
 
 impl Environment {
     pub fn new(device: String) -> Environment {
-        let cpu = std::fs::read_to_string("/proc/cpuinfo")
-            .ok()
-            .and_then(|s| {
-                s.lines()
-                    .find(|l| l.starts_with("model name"))
-                    .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
-            })
-            .unwrap_or_else(|| "unknown CPU".to_string());
+        let cpu = crate::host::cpu_model();
         let date = std::process::Command::new("date")
             .arg("-u")
             .arg("+%Y-%m-%d %H:%M UTC")

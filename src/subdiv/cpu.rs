@@ -100,7 +100,14 @@ impl Level {
         if vertices >= u64::from(u32::MAX) || edges >= 1 << 31 || corners >= u64::from(u32::MAX) {
             return Err(SubdivError::TooLarge { level, vertices });
         }
-        Ok(())
+        // The child level (positions, quads with their edges, edge ends) and the output
+        // mesh built from it, checked before anything is allocated.
+        let bytes = 48 * vertices + 64 * (corners / 4) + 9 * edges;
+        crate::host::check_available(bytes).map_err(|(need_mib, have_mib)| SubdivError::Memory {
+            level,
+            need_mib,
+            have_mib,
+        })
     }
 
     /// One Catmull-Clark step. Without `with_topology` only the child's faces are built

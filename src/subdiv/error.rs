@@ -25,6 +25,11 @@ pub enum SubdivError {
     /// The mesh has more elements than 32-bit indices can address at the requested level.
     #[error("level {level} would be too large for 32-bit indices ({vertices} vertices)")]
     TooLarge { level: u32, vertices: u64 },
+    /// The level would not fit the memory the system has available.
+    #[error(
+        "level {level} needs about {need_mib} MiB but only {have_mib} MiB are available; use a lower level"
+    )]
+    Memory { level: u32, need_mib: u64, have_mib: u64 },
     /// The fragment-mesh path cannot represent this input or stream (SPEC §5.2).
     #[error("fragment mesh: {0}")]
     Fragment(String),

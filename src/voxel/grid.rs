@@ -98,26 +98,13 @@ pub fn check_resolution(n: usize) -> Result<()> {
     Ok(())
 }
 
-/// Memory the system reports as available (MemAvailable), in bytes; `None` if unknown.
-pub fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
 /// Fails with a clear error, before anything is allocated, when `bytes` for `what` at
 /// resolution `n` exceed the available memory.
 pub fn check_memory(what: &str, n: usize, bytes: u64) -> Result<()> {
-    if let Some(have) = available_memory() {
-        if bytes > have {
-            return Err(VoxelError::Memory {
-                what: what.to_string(),
-                res: n,
-                need_mib: bytes.div_ceil(1 << 20),
-                have_mib: have / (1 << 20),
-            });
-        }
-    }
-    Ok(())
+    crate::host::check_available(bytes).map_err(|(need_mib, have_mib)| VoxelError::Memory {
+        what: what.to_string(),
+        res: n,
+        need_mib,
+        have_mib,
+    })
 }

@@ -1,0 +1,31 @@
+//! The machine texgeo runs on: what reports name and what large requests are checked
+//! against, so a too-large job fails with a clear error instead of an allocation failure.
+
+/// Memory the system reports as available (`MemAvailable`), in bytes; `None` if unknown.
+pub fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// `Err((need MiB, have MiB))` when `bytes` exceed the available memory.
+pub fn check_available(bytes: u64) -> Result<(), (u64, u64)> {
+    match available_memory() {
+        Some(have) if bytes > have => Err((bytes.div_ceil(1 << 20), have / (1 << 20))),
+        _ => Ok(()),
+    }
+}
+
+/// The CPU's model name, for reports.
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_string())
+}
