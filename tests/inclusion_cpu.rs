@@ -16,23 +16,10 @@ use Class::{Inside, OnBoundary, Outside};
 
 // ---------------------------------------------------------------- test solids
 
-/// A prism of height `h` over the counter-clockwise polygon `xy`, caps kept as n-gons.
-fn prism(xy: &[(f64, f64)], h: f64) -> Mesh {
-    let n = xy.len() as u32;
-    let mut p: Vec<DVec3> = xy.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
-    p.extend(xy.iter().map(|&(x, y)| DVec3::new(x, y, h)));
-    let mut f = vec![(0..n).rev().collect::<Vec<_>>(), (n..2 * n).collect()];
-    for i in 0..n {
-        let j = (i + 1) % n;
-        f.push(vec![i, j, n + j, n + i]);
-    }
-    Mesh::new(p, f).unwrap()
-}
-
 /// L = [0,4]×[0,1] ∪ [0,1]×[1,3], height 1. The caps' vertex centroid (5/3, 4/3) is in the
 /// notch, outside the L: each cap has two negative covering triangles.
 fn l_prism() -> Mesh {
-    prism(&[(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)], 1.0)
+    procedural::l_prism()
 }
 
 /// A hexagonal prism (radius 1, height 1) whose top is a monkey saddle: the fan from

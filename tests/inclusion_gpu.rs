@@ -99,24 +99,7 @@ fn gpu_equals_cpu_on_builtin_models() {
 #[test]
 fn gpu_equals_cpu_on_polygon_faces() {
     // An L-shaped prism with non-convex 6-gon caps: negative covering triangles.
-    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-    let outline = [
-        p(0.0, 0.0, 0.0),
-        p(2.0, 0.0, 0.0),
-        p(2.0, 1.0, 0.0),
-        p(1.0, 1.0, 0.0),
-        p(1.0, 2.0, 0.0),
-        p(0.0, 2.0, 0.0),
-    ];
-    let mut positions: Vec<DVec3> = outline.to_vec();
-    positions.extend(outline.iter().map(|q| *q + DVec3::Z));
-    let n = outline.len() as u32;
-    let mut faces = vec![(0..n).rev().collect::<Vec<u32>>(), (n..2 * n).collect()];
-    for i in 0..n {
-        let j = (i + 1) % n;
-        faces.push(vec![i, j, j + n, i + n]);
-    }
-    let mesh = Mesh::new(positions, faces).unwrap();
+    let mesh = procedural::l_prism();
     check(&mesh, "L-prism", &query_points(&mesh, 3000, 5));
 }
 

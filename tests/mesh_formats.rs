@@ -19,19 +19,13 @@ fn models() -> Vec<(&'static str, Mesh)> {
 
 /// An n-gon prism: two n-gon caps and n quads.
 fn prism(n: u32) -> Mesh {
-    let mut positions = Vec::new();
-    for z in [0.0, 1.0] {
-        for i in 0..n {
+    let outline: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
             let t = std::f64::consts::TAU * f64::from(i) / f64::from(n);
-            positions.push(DVec3::new(t.cos(), t.sin(), z));
-        }
-    }
-    let mut faces = vec![(0..n).rev().collect::<Vec<_>>(), (n..2 * n).collect()];
-    for i in 0..n {
-        let j = (i + 1) % n;
-        faces.push(vec![i, j, n + j, n + i]);
-    }
-    Mesh::new(positions, faces).unwrap()
+            (t.cos(), t.sin())
+        })
+        .collect();
+    procedural::prism(&outline, 1.0).unwrap()
 }
 
 fn path(name: &str) -> PathBuf {

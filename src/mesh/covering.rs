@@ -241,17 +241,8 @@ mod tests {
         Mesh::new(p, f).unwrap()
     }
 
-    /// A prism of height `h` over the polygon `xy` (counter-clockwise), polygon caps kept whole.
     fn prism(xy: &[(f64, f64)], h: f64) -> Mesh {
-        let n = xy.len() as u32;
-        let mut p: Vec<DVec3> = xy.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
-        p.extend(xy.iter().map(|&(x, y)| DVec3::new(x, y, h)));
-        let mut f = vec![(0..n).rev().collect::<Vec<_>>(), (n..2 * n).collect()];
-        for i in 0..n {
-            let j = (i + 1) % n;
-            f.push(vec![i, j, n + j, n + i]);
-        }
-        Mesh::new(p, f).unwrap()
+        crate::mesh::procedural::prism(xy, h).unwrap()
     }
 
     fn torus(big: f64, small: f64, nu: u32, nv: u32) -> Mesh {

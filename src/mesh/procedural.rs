@@ -11,7 +11,7 @@ use super::Mesh;
 
 /// The names [`by_name`] knows.
 pub const BUILTIN_NAMES: &[&str] =
-    &["cube", "tetrahedron", "pyramid", "sphere", "torus", "knot", "two-cubes", "cavity"];
+    &["cube", "tetrahedron", "pyramid", "sphere", "torus", "knot", "two-cubes", "cavity", "l-prism"];
 
 /// A built-in model by name (see [`BUILTIN_NAMES`]), with default parameters:
 /// `sphere` = `sphere(16, 32)`, `torus` = `torus(1.0, 0.4, 32, 16)`.
@@ -25,8 +25,32 @@ pub fn by_name(name: &str) -> Option<Mesh> {
         "knot" => torus_knot(),
         "two-cubes" => two_cubes_sharing_edge(),
         "cavity" => cube_with_cavity(),
+        "l-prism" => l_prism(),
         _ => return None,
     })
+}
+
+/// A prism of height `height` over the counter-clockwise polygon `outline` (in the xy
+/// plane, extruded along +z), its two caps kept as whole n-gons: the solid for tests of
+/// polygon faces (a non-convex outline gives negative covering triangles). `None` for an
+/// outline of fewer than 3 points or a non-finite coordinate.
+pub fn prism(outline: &[(f64, f64)], height: f64) -> Option<Mesh> {
+    let n = u32::try_from(outline.len()).ok().filter(|&n| n >= 3)?;
+    let mut positions: Vec<DVec3> = outline.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+    positions.extend(outline.iter().map(|&(x, y)| DVec3::new(x, y, height)));
+    let mut faces = vec![(0..n).rev().collect::<Vec<_>>(), (n..2 * n).collect()];
+    for i in 0..n {
+        let j = (i + 1) % n;
+        faces.push(vec![i, j, n + j, n + i]);
+    }
+    Mesh::new(positions, faces).ok()
+}
+
+/// The L-shaped prism [0,4]×[0,1] ∪ [0,1]×[1,3], height 1, with its two non-convex
+/// hexagon caps kept whole (their covering fans have negative triangles).
+pub fn l_prism() -> Mesh {
+    let outline = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)];
+    prism(&outline, 1.0).unwrap_or_else(|| unreachable!("the L outline is a valid polygon"))
 }
 
 /// Builds a mesh from data this module made (always valid).
