@@ -206,3 +206,33 @@ fn xor_raster_equals_the_cpu_scanline_rasterizer() {
     assert!(differing.is_empty(), "texels {differing:?} differ");
     assert!(cpu.contains(&1) && cpu.contains(&0));
 }
+
+#[test]
+fn point_pass_puts_each_datum_on_its_own_texel() {
+    use texgeo::gpu::{Blend, Datum, Scatter};
+    let ctx = ctx();
+    // Non-square, non-power-of-two target; every texel gets its own index as value.
+    let (w, h) = (37u32, 11u32);
+    let data: Vec<Datum> =
+        (0..w * h).rev().map(|i| Datum { texel: i, value: [i as f32, -(i as f32), 1.0, 0.5] }).collect();
+    let out = Scatter::new(&ctx, Blend::Replace).unwrap().scatter(&ctx, w, h, &data).unwrap();
+    for (i, v) in out.iter().enumerate() {
+        assert_eq!(*v, [i as f32, -(i as f32), 1.0, 0.5], "texel {i}");
+    }
+    // With additive blending, data on the same texel are summed (exactly, for integers).
+    let data: Vec<Datum> =
+        (0..1000).map(|k| Datum { texel: k % 7, value: [1.0, k as f32, 0.0, 0.0] }).collect();
+    let out = Scatter::new(&ctx, Blend::Add).unwrap().scatter(&ctx, 4, 2, &data).unwrap();
+    for t in 0..7usize {
+        let expect: f32 = (0..1000).filter(|k| k % 7 == t).map(|k| k as f32).sum();
+        assert_eq!(out[t][0], (0..1000).filter(|k| k % 7 == t).count() as f32);
+        assert_eq!(out[t][1], expect, "texel {t}");
+    }
+    assert_eq!(out[7], [0.0; 4]);
+    assert!(
+        Scatter::new(&ctx, Blend::Replace)
+            .unwrap()
+            .scatter(&ctx, 4, 2, &[Datum { texel: 8, value: [0.0; 4] }])
+            .is_err()
+    );
+}
