@@ -223,10 +223,10 @@ fn point_pass_puts_each_datum_on_its_own_texel() {
     let data: Vec<Datum> =
         (0..1000).map(|k| Datum { texel: k % 7, value: [1.0, k as f32, 0.0, 0.0] }).collect();
     let out = Scatter::new(&ctx, Blend::Add).unwrap().scatter(&ctx, 4, 2, &data).unwrap();
-    for t in 0..7usize {
+    for (t, texel) in out.iter().enumerate().take(7) {
         let expect: f32 = (0..1000).filter(|k| k % 7 == t).map(|k| k as f32).sum();
-        assert_eq!(out[t][0], (0..1000).filter(|k| k % 7 == t).count() as f32);
-        assert_eq!(out[t][1], expect, "texel {t}");
+        assert_eq!(texel[0], (0..1000).filter(|k| k % 7 == t).count() as f32);
+        assert_eq!(texel[1], expect, "texel {t}");
     }
     assert_eq!(out[7], [0.0; 4]);
     assert!(
