@@ -82,15 +82,7 @@ fn matches_opensubdiv_torus_knot_1200() {
 #[test]
 fn matches_committed_reference_files() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
-    let cases: [(&str, Mesh, u32); 6] = [
-        ("cube", shapes::cube(), 1),
-        ("cube", shapes::cube(), 2),
-        ("tetrahedron", shapes::tetrahedron(), 1),
-        ("open_cube", shapes::open_cube(), 1),
-        ("grid", shapes::grid(3), 2),
-        ("valences", shapes::valences(), 2),
-    ];
-    for (name, mesh, level) in cases {
+    for (name, mesh, level) in shapes::committed_references() {
         let input = texgeo::mesh::formats::read(dir.join(format!("{name}.off"))).unwrap();
         assert_eq!(input, mesh, "reference/subdiv/{name}.off is not the test shape {name}");
         let path = dir.join(format!("{name}-level{level}.off"));

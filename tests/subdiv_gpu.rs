@@ -125,14 +125,7 @@ fn matches_committed_reference_files() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
-    let cases: [(&str, Mesh, u32); 5] = [
-        ("cube", shapes::cube(), 2),
-        ("tetrahedron", shapes::tetrahedron(), 1),
-        ("open_cube", shapes::open_cube(), 1),
-        ("grid", shapes::grid(3), 2),
-        ("valences", shapes::valences(), 2),
-    ];
-    for (name, mesh, level) in cases {
+    for (name, mesh, level) in shapes::committed_references() {
         let path = dir.join(format!("{name}-level{level}.off"));
         let reference = texgeo::mesh::formats::read(&path).unwrap_or_else(|e| panic!("{e}"));
         let run = sub.refine(&ctx, &mesh, level, &Options::default()).unwrap();

@@ -45,6 +45,12 @@ impl<'a> Attachment<'a> {
     pub fn layer(texture: &'a Texture, layer: u32, load: Load) -> Attachment<'a> {
         Attachment { texture, layer, load }
     }
+
+    /// One attachment per layer of `texture` (MRT over a layered target: layer l is
+    /// colour attachment l, fragment output `location = l`).
+    pub fn each_layer(texture: &'a Texture, load: Load) -> Vec<Attachment<'a>> {
+        (0..texture.layers()).map(|l| Attachment::layer(texture, l, load)).collect()
+    }
 }
 
 /// A texel rectangle: x, y, width, height.
@@ -358,8 +364,7 @@ impl<'d> Recorder<'d> {
         let info = vk::RenderingInfo::default().render_area(rect).layer_count(1).color_attachments(&infos);
         // SAFETY: attachments transitioned above; they outlive the submission.
         unsafe { self.dev.raw.cmd_begin_rendering(self.cmd, &info) };
-        let formats: Vec<TexFormat> = targets.iter().map(|a| a.texture.format()).collect();
-        let mut scope = RenderScope { dev: self.dev, cmd: self.cmd, area, formats, reads, pipeline: None };
+        let mut scope = RenderScope { dev: self.dev, cmd: self.cmd, area, targets, reads, pipeline: None };
         let result = draw(&mut scope);
         // SAFETY: matches the begin above, also when `draw` failed.
         unsafe { self.dev.raw.cmd_end_rendering(self.cmd) };
@@ -372,7 +377,7 @@ pub struct RenderScope<'r, 'p> {
     dev: &'r Arc<Device>,
     cmd: vk::CommandBuffer,
     area: Rect,
-    formats: Vec<TexFormat>,
+    targets: &'r [Attachment<'r>],
     reads: &'p [&'p Texture],
     pipeline: Option<&'p Pipeline>,
 }
@@ -380,10 +385,11 @@ pub struct RenderScope<'r, 'p> {
 impl<'p> RenderScope<'_, 'p> {
     /// Binds `pipeline` and sets the viewport to the pass's area.
     pub fn bind(&mut self, pipeline: &'p Pipeline) -> Result<()> {
-        if pipeline.targets != self.formats {
+        if !pipeline.targets.iter().copied().eq(self.targets.iter().map(|a| a.texture.format())) {
+            let formats: Vec<TexFormat> = self.targets.iter().map(|a| a.texture.format()).collect();
             return Err(GpuError::Usage(format!(
-                "pipeline {} renders {:?} but the pass targets are {:?}",
-                pipeline.name, pipeline.targets, self.formats
+                "pipeline {} renders {:?} but the pass targets are {formats:?}",
+                pipeline.name, pipeline.targets
             )));
         }
         // SAFETY: recording inside a compatible dynamic-rendering pass.

@@ -116,15 +116,7 @@ impl Reducer {
             let out = [cur[0].div_ceil(step[0]), cur[1].div_ceil(step[1])];
             let input = if first { src } else { self.pair.src() };
             let dst = self.pair.dst();
-            let attachments: Vec<Attachment> = (0..self.layers)
-                .map(|l| {
-                    if self.layers == 1 {
-                        Attachment::new(dst, Load::Discard)
-                    } else {
-                        Attachment::layer(dst, l, Load::Discard)
-                    }
-                })
-                .collect();
+            let attachments = Attachment::each_layer(dst, Load::Discard);
             let reads = [input];
             let params = [cur[0] as i32, cur[1] as i32, step[0] as i32, step[1] as i32, self.layers as i32];
             rec.render(&attachments, Some([0, 0, out[0], out[1]]), &reads, |pass| {

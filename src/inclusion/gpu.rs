@@ -338,6 +338,8 @@ pub struct GpuInclusion {
     target: Texture,
     reducer: Option<Reducer>,
     points: Buffer,
+    /// Phase-2 sums (or, for `cpu+gpu`, the whole phase-1 target) copied to the host.
+    readback: Buffer,
     /// Exact answers for flagged points (same apex and tolerance as the CPU methods).
     exact: TetraGrid,
     stats: GpuStats,
@@ -367,9 +369,14 @@ impl GpuInclusion {
             Phase2::Gpu => Some(Reducer::for_tiles(ctx, [tile[0], tile[1] * groups], tile, LAYERS)?),
             Phase2::Host => None,
         };
+        let read_texels = match options.phase2 {
+            Phase2::Gpu => u64::from(groups),
+            Phase2::Host => u64::from(tile[0] * tile[1] * groups),
+        };
         Ok(GpuInclusion {
             ctx: ctx.clone(),
             points: Buffer::host(ctx, (MAX_POINTS * 16) as u64, "query points")?,
+            readback: Buffer::readback_for(ctx, u64::from(LAYERS) * read_texels * 16)?,
             set,
             pipeline: classify_pipeline(ctx, false)?,
             options,
@@ -433,12 +440,17 @@ impl GpuInclusion {
         let vertices = self.set.count.div_ceil(self.options.batch);
         let push = self.set.params(size, th, self.options.batch, 0);
         let t = Instant::now();
-        let attachments: Vec<Attachment> =
-            (0..LAYERS).map(|l| Attachment::layer(&self.target, l, Load::Zero)).collect();
+        let attachments = Attachment::each_layer(&self.target, Load::Zero);
         let reads = [&self.set.texture];
-        let (pipeline, target, tetras, ubo, reducer) =
-            (&self.pipeline, &self.target, &self.set.texture, &self.points, &mut self.reducer);
-        let readback = self.ctx.submit(|rec| {
+        let (pipeline, target, tetras, ubo, readback, reducer) = (
+            &self.pipeline,
+            &self.target,
+            &self.set.texture,
+            &self.points,
+            &self.readback,
+            &mut self.reducer,
+        );
+        self.ctx.submit(|rec| {
             rec.render(&attachments, Some([0, 0, size[0], size[1]]), &reads, |pass| {
                 pass.bind(pipeline)?;
                 pass.textures(&[(0, tetras)])?;
@@ -449,15 +461,15 @@ impl GpuInclusion {
             match reducer {
                 Some(r) => {
                     let sums = r.record_tiles(rec, target, size, [tw, th])?;
-                    rec.readback_region(sums, 0..LAYERS, [0, 0, 1, groups])
+                    rec.readback_into(sums, 0..LAYERS, [0, 0, 1, groups], readback, 0)
                 }
-                None => rec.readback_region(target, 0..LAYERS, [0, 0, tw, th * groups]),
+                None => rec.readback_into(target, 0..LAYERS, [0, 0, tw, th * groups], readback, 0),
             }
         })?;
         stats.gpu += t.elapsed();
         stats.draws += 1;
         let t = Instant::now();
-        let texels = readback.to_vec::<[f32; 4]>()?;
+        let texels = self.readback.view::<[f32; 4]>()?;
         let tile_texels = (tw * th) as usize;
         let per_layer = match self.options.phase2 {
             Phase2::Gpu => groups as usize,

@@ -37,6 +37,10 @@ pub struct GpuGridInclusion {
     reducer: Reducer,
     points: Buffer,
     jobs: Buffer,
+    /// The point-vertices of a submission, and its tile sums copied to the host; both
+    /// sized for a full target.
+    items: Buffer,
+    readback: Buffer,
     stats: GpuStats,
 }
 
@@ -69,6 +73,12 @@ impl GpuGridInclusion {
             reducer: Reducer::for_tiles(ctx, size, [TILE, TILE], LAYERS)?,
             points: Buffer::host(ctx, (MAX_POINTS * 16) as u64, "query points")?,
             jobs: Buffer::host(ctx, (MAX_POINTS * 16) as u64, "grid jobs")?,
+            items: Buffer::host(
+                ctx,
+                u64::from(TILES_WIDE * TILES_HIGH * TILE * TILE) * 16,
+                "grid point-vertices",
+            )?,
+            readback: Buffer::readback_for(ctx, u64::from(LAYERS * TILES_WIDE * TILES_HIGH) * 16)?,
             grid,
             set,
             lists,
@@ -178,42 +188,43 @@ impl GpuGridInclusion {
             job_tiles.push(tile..tile + batches.div_ceil(per_tile));
             tile += batches.div_ceil(per_tile);
         }
-        let vertices = Buffer::with_data(&self.ctx, &items, "grid point-vertices")?;
+        self.items.write_slice(0, &items)?;
         let tiles = tile.max(1);
         let (tx, ty) = (TILES_WIDE.min(tiles), tiles.div_ceil(TILES_WIDE));
         let size = [tx * TILE, ty * TILE];
         let push = self.set.params(size, 0, self.batch, self.lists_width);
         let count = items.len() as u32;
         let t = Instant::now();
-        let attachments: Vec<Attachment> =
-            (0..LAYERS).map(|l| Attachment::layer(&self.target, l, Load::Zero)).collect();
+        let attachments = Attachment::each_layer(&self.target, Load::Zero);
         let reads = [&self.set.texture, &self.lists];
-        let (pipeline, target, tetras, lists, ubo, job_ubo, reducer) = (
+        let (pipeline, target, tetras, lists, ubo, job_ubo, vertices, readback, reducer) = (
             &self.pipeline,
             &self.target,
             &self.set.texture,
             &self.lists,
             &self.points,
             &self.jobs,
+            &self.items,
+            &self.readback,
             &mut self.reducer,
         );
-        let readback = self.ctx.submit(|rec| {
+        self.ctx.submit(|rec| {
             rec.render(&attachments, Some([0, 0, size[0], size[1]]), &reads, |pass| {
                 pass.bind(pipeline)?;
                 pass.textures(&[(0, tetras), (2, lists)])?;
                 pass.uniform(1, ubo)?;
                 pass.uniform(3, job_ubo)?;
                 pass.push(&push)?;
-                pass.vertex_buffers(&vertices, None)?;
+                pass.vertex_buffers(vertices, None)?;
                 pass.draw(0..count, 0..1)
             })?;
             let sums = reducer.record_tiles(rec, target, size, [TILE, TILE])?;
-            rec.readback_region(sums, 0..LAYERS, [0, 0, tx, ty])
+            rec.readback_into(sums, 0..LAYERS, [0, 0, tx, ty], readback, 0)
         })?;
         stats.gpu += t.elapsed();
         stats.draws += 1;
         let t = Instant::now();
-        let texels = readback.to_vec::<[f32; 4]>()?;
+        let texels = self.readback.view::<[f32; 4]>()?;
         let per_layer = (tx * ty) as usize;
         let mut sums = vec![0.0f32; order.len()];
         for (job, tiles) in jobs.iter().zip(&job_tiles) {

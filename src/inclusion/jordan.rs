@@ -127,6 +127,24 @@ pub fn directions() -> impl Iterator<Item = DVec3> {
     }))
 }
 
+/// Casts rays from `p` in the fixed directions until one hits no edge, vertex or face
+/// plane (`crossings(p, d, reach)` returns its signed crossing count, `None` to re-cast),
+/// and answers by that count; after [`MAX_CASTS`] failures the winding number decides.
+pub(crate) fn cast(
+    surface: &Surface,
+    p: DVec3,
+    crossings: impl Fn(DVec3, DVec3, f64) -> Option<i32>,
+) -> Class {
+    // Any ray from inside the box leaves it within two diagonals.
+    let reach = 2.0 * surface.scale() + surface.eps();
+    for d in directions().take(MAX_CASTS) {
+        if let Some(w) = crossings(p, d, reach) {
+            return if w != 0 { Class::Inside } else { Class::Outside };
+        }
+    }
+    winding::classify(surface, p)
+}
+
 /// Ray crossings over every covering triangle.
 #[derive(Clone, Debug)]
 pub struct Jordan {
@@ -182,14 +200,7 @@ impl Classifier for Jordan {
             return Class::OnBoundary;
         }
         let p = surface.off_polygon_planes(p, 0..n);
-        // Any ray from inside the box leaves it within two diagonals.
-        let reach = 2.0 * surface.scale() + surface.eps();
-        for d in directions().take(MAX_CASTS) {
-            if let Some(w) = self.crossings(p, d, reach) {
-                return if w != 0 { Class::Inside } else { Class::Outside };
-            }
-        }
-        winding::classify(surface, p)
+        cast(surface, p, |p, d, reach| self.crossings(p, d, reach))
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::jordan::{Hit, MAX_CASTS, directions, ray_hit, segment_meets_box};
+use super::jordan::{Hit, cast, ray_hit, segment_meets_box};
 use super::surface::Surface;
-use super::{BuildStats, Class, Classifier, InclusionError, Result, vec_bytes, winding};
+use super::{BuildStats, Class, Classifier, InclusionError, Result, vec_bytes};
 use crate::mesh::Mesh;
 
 /// Triangles a leaf may hold before it is split (when the depth allows).
@@ -218,13 +218,7 @@ impl Classifier for JordanOctree {
             }
             None => p,
         };
-        let reach = 2.0 * surface.scale() + surface.eps();
-        for d in directions().take(MAX_CASTS) {
-            if let Some(w) = self.crossings(p, d, reach) {
-                return if w != 0 { Class::Inside } else { Class::Outside };
-            }
-        }
-        winding::classify(surface, p)
+        cast(surface, p, |p, d, reach| self.crossings(p, d, reach))
     }
 
     fn build_stats(&self) -> BuildStats {

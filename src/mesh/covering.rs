@@ -245,23 +245,6 @@ mod tests {
         crate::mesh::procedural::prism(xy, h).unwrap()
     }
 
-    fn torus(big: f64, small: f64, nu: u32, nv: u32) -> Mesh {
-        let mut p = Vec::new();
-        for i in 0..nu {
-            let t = TAU * i as f64 / nu as f64;
-            for j in 0..nv {
-                let s = TAU * j as f64 / nv as f64;
-                let r = big + small * s.cos();
-                p.push(DVec3::new(r * t.cos(), r * t.sin(), small * s.sin()));
-            }
-        }
-        let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
-        let f = (0..nu)
-            .flat_map(|i| (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
-            .collect();
-        Mesh::new(p, f).unwrap()
-    }
-
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol * (1.0 + b.abs())
     }
@@ -328,7 +311,7 @@ mod tests {
         // whose centroid is at distance R from the axis; the slice's volume is
         // sin(2π/nu) · R · A (its planar trapezoid faces interpolate linearly).
         let (big, small, nu, nv) = (2.0, 0.5, 24, 12);
-        let c = Covering::new(&torus(big, small, nu, nv));
+        let c = Covering::new(&crate::mesh::procedural::torus(big, small, nu, nv));
         assert_eq!(c.unbalanced_edge(), None);
         let a = nv as f64 / 2.0 * small * small * (TAU / nv as f64).sin();
         let want = nu as f64 * (TAU / nu as f64).sin() * big * a;

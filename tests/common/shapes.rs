@@ -122,6 +122,19 @@ pub fn torus_knot(along: usize, around: usize) -> Mesh {
     procedural::torus_knot_tube(along, around)
 }
 
+/// The committed OpenSubdiv outputs (`reference/subdiv/<name>-level<level>.off`, see its
+/// README): shape name, shape, level.
+pub fn committed_references() -> Vec<(&'static str, Mesh, u32)> {
+    vec![
+        ("cube", cube(), 1),
+        ("cube", cube(), 2),
+        ("tetrahedron", tetrahedron(), 1),
+        ("open_cube", open_cube(), 1),
+        ("grid", grid(3), 2),
+        ("valences", valences(), 2),
+    ]
+}
+
 /// The named set, small enough for every level the tests use.
 pub fn all() -> Vec<Shape> {
     vec![

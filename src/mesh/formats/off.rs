@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::text::{Lines, parse_coord, parse_index};
+use super::text::{Lines, parse_coord, parse_index, write_vertices_and_faces};
 use crate::mesh::{Mesh, Result};
 
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
@@ -89,15 +89,6 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     writeln!(w, "OFF")?;
     writeln!(w, "{} {} 0", mesh.num_vertices(), mesh.num_faces())?;
-    for p in mesh.positions() {
-        writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-    }
-    for f in mesh.faces() {
-        write!(w, "{}", f.len())?;
-        for i in f {
-            write!(w, " {i}")?;
-        }
-        writeln!(w)?;
-    }
+    write_vertices_and_faces(&mut w, mesh)?;
     w.flush()
 }

@@ -702,16 +702,7 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
 pub fn write_ascii(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     write_header(&mut w, mesh, "ascii")?;
-    for p in mesh.positions() {
-        writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-    }
-    for f in mesh.faces() {
-        write!(w, "{}", f.len())?;
-        for i in f {
-            write!(w, " {i}")?;
-        }
-        writeln!(w)?;
-    }
+    super::text::write_vertices_and_faces(&mut w, mesh)?;
     w.flush()
 }
 

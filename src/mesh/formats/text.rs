@@ -69,3 +69,22 @@ pub(crate) fn parse_coord(token: &str) -> Result<f64, String> {
 pub(crate) fn parse_index(token: &str, what: &str) -> Result<u64, String> {
     token.parse::<u64>().map_err(|_| format!("{what} '{token}' is not a non-negative integer"))
 }
+
+/// The body OFF and ASCII PLY share: one `x y z` line per vertex (shortest round-trip
+/// decimals, so reading back is exact), then one `n i0 … in-1` line per face.
+pub(crate) fn write_vertices_and_faces(
+    w: &mut impl std::io::Write,
+    mesh: &crate::mesh::Mesh,
+) -> std::io::Result<()> {
+    for p in mesh.positions() {
+        writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
+    }
+    for f in mesh.faces() {
+        write!(w, "{}", f.len())?;
+        for i in f {
+            write!(w, " {i}")?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}

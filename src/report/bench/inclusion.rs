@@ -121,8 +121,8 @@ struct Measured {
     faces: usize,
     triangles: usize,
     grid_builds: Vec<(Duration, usize)>,
-    /// Method name → (mean time per set, build time, bytes).
-    times: Vec<(String, Duration, Duration, usize)>,
+    /// Method name → mean time per set.
+    times: Vec<(String, Duration)>,
     grid_times: Vec<Duration>,
     gpu_split: Vec<String>,
     disagreements: Vec<String>,
@@ -199,10 +199,7 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
         Method::JordanOctree,
     ];
     for method in methods {
-        let t = Instant::now();
         let mut solver = Solver::new(method, mesh, &Options::default(), Some(ctx), None)?;
-        let build = t.elapsed();
-        let stats = solver.build_stats();
         let (time, ok) = mean_time(&mut |p| solver.classify_all(p), &sets, &want)?;
         if !ok {
             m.disagreements.push(method.name().to_string());
@@ -219,9 +216,7 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
                 g.fallback.as_secs_f64() * 1e3
             ));
         }
-        // CPU methods report their own build; GPU ones add texture uploads to the grid's.
-        let build = if method.is_cpu() { stats.build_time } else { build };
-        m.times.push((method.name().to_string(), time, build, stats.bytes));
+        m.times.push((method.name().to_string(), time));
     }
     // Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
     // covering and per-tetra planes every Feito-Torres variant shares.
@@ -238,7 +233,7 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
     if !ok {
         m.disagreements.push("gpu (batch 1)".into());
     }
-    m.times.push(("gpu-batch-1".into(), time, Duration::ZERO, 0));
+    m.times.push(("gpu-batch-1".into(), time));
     Ok(m)
 }
 
