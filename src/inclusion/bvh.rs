@@ -28,12 +28,7 @@ struct Node {
 impl Node {
     #[inline]
     fn holds(&self, q: DVec3) -> bool {
-        q.x >= self.lo.x
-            && q.y >= self.lo.y
-            && q.z >= self.lo.z
-            && q.x <= self.hi.x
-            && q.y <= self.hi.y
-            && q.z <= self.hi.z
+        q.cmpge(self.lo).all() && q.cmple(self.hi).all()
     }
 }
 

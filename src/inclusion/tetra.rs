@@ -155,12 +155,7 @@ impl TetraPlanes {
 
     #[inline]
     fn in_box(&self, q: DVec3) -> bool {
-        q.x >= self.lo.x
-            && q.y >= self.lo.y
-            && q.z >= self.lo.z
-            && q.x <= self.hi.x
-            && q.y <= self.hi.y
-            && q.z <= self.hi.z
+        q.cmpge(self.lo).all() && q.cmple(self.hi).all()
     }
 
     /// Classifies `q` (relative to the apex, in octant `octant` = [`octant_bit`]) against
