@@ -202,7 +202,8 @@ pub fn summary(merged: &Merged) -> String {
     let info = &merged.info;
     let mut s = String::new();
     let _ = writeln!(s, "# Sweep: {}\n", info.task);
-    let options: Vec<String> = info.options.iter().map(|(k, v)| format!("{k}={}", cell(v))).collect();
+    let options: Vec<String> =
+        info.options.iter().filter(|(_, v)| !v.is_null()).map(|(k, v)| format!("{k}={}", cell(v))).collect();
     let _ = writeln!(s, "Options: {}.", if options.is_empty() { "none".into() } else { options.join(", ") });
     let _ = writeln!(
         s,

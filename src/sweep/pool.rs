@@ -318,8 +318,11 @@ fn explain(status: ExitStatus, stderr: &[String]) -> Death {
     if let Some(line) = oom {
         return (Outcome::Crashed, "out-of-memory".into(), format!("worker aborted: {line}"));
     }
-    if let Some(i) = stderr.iter().position(|l| l.contains("panicked at")) {
-        let mut msg = stderr[i].trim().to_string();
+    if let Some((i, at)) =
+        stderr.iter().enumerate().find_map(|(i, l)| l.find("panicked at").map(|at| (i, at)))
+    {
+        // From "panicked at": the thread's name and id before it vary from run to run.
+        let mut msg = stderr[i][at..].trim().to_string();
         if let Some(next) = stderr.get(i + 1).filter(|l| !l.starts_with("note:")) {
             msg = format!("{msg} {}", next.trim());
         }

@@ -251,8 +251,10 @@ impl Faults {
         match kind.as_str() {
             "panic" => panic!("test-only fault: panic on {mesh}"),
             "abort" => std::process::abort(),
-            // SAFETY: raising a signal at ourselves; the default action ends the process.
+            // SAFETY: restoring the default action (std installs a handler for stack
+            // overflows) and raising the signal at ourselves: the process ends.
             "segv" => unsafe {
+                libc::signal(libc::SIGSEGV, libc::SIG_DFL);
                 libc::raise(libc::SIGSEGV);
             },
             "exit" => std::process::exit(3),
