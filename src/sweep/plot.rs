@@ -17,6 +17,12 @@ fn colour(o: Outcome) -> RGBColor {
     }
 }
 
+/// A tick label without trailing zeros: 1, 10, 0.1.
+fn label(v: f64) -> String {
+    let s = format!("{v:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// The SVG text of the plot.
 pub fn time_vs_size(merged: &Merged) -> Result<String> {
     let points: Vec<(Outcome, f64, f64)> = merged
@@ -53,6 +59,8 @@ pub fn time_vs_size(merged: &Merged) -> Result<String> {
             .configure_mesh()
             .x_desc("faces")
             .y_desc("total time per mesh (ms)")
+            .x_label_formatter(&|x| label(*x))
+            .y_label_formatter(&|y| label(*y))
             .draw()
             .map_err(|e| err(&e))?;
         for o in Outcome::ALL {
