@@ -121,7 +121,14 @@ fn slot(
             r.time("total", start.elapsed());
             r
         });
-        worker = survivor;
+        // A device error may leave the worker's device unusable: start afresh.
+        worker = match survivor {
+            Some(w) if matches!(record.reason.as_str(), "gpu" | "device") => {
+                w.finish();
+                None
+            }
+            other => other,
+        };
         let mut sink = sink.lock().map_err(|_| SweepError::Worker("a results writer panicked".into()))?;
         (*sink)(record)?;
     }

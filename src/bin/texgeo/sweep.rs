@@ -176,7 +176,7 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
         args: vec!["sweep".into(), "worker".into()],
     };
     // Every entry's options are checked now, not when its turn comes.
-    plan.jobs(&manifest.entries).map_err(|(line, message)| SweepError::Manifest {
+    plan.jobs_for(&manifest.entries).map_err(|(line, message)| SweepError::Manifest {
         path: manifest_path.clone(),
         line,
         message,
@@ -191,7 +191,7 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
     let done = texgeo::sweep::record::indices(&done);
     let mine: Vec<_> = manifest.shard(a.shard).collect();
     let pending: Vec<_> = mine.iter().copied().filter(|e| !done.contains(&e.index)).collect();
-    let jobs = plan.jobs(pending.iter().copied()).map_err(|(_, m)| SweepError::Options(m))?;
+    let jobs = plan.jobs_for(pending.iter().copied()).map_err(|(_, m)| SweepError::Options(m))?;
     println!(
         "sweep {task} over {}: shard {} has {} meshes, {} already recorded, {} to run on {} worker(s)",
         manifest_path.display(),
