@@ -48,7 +48,7 @@ pub struct Plan {
 
 impl Plan {
     /// The jobs for `entries`: each entry's options over the sweep's, checked.
-    pub fn jobs<'a>(
+    pub fn jobs_for<'a>(
         &self,
         entries: impl IntoIterator<Item = &'a Entry>,
     ) -> Result<Vec<Job>, (Option<usize>, String)> {
