@@ -282,6 +282,19 @@ mod tests {
     }
 
     #[test]
+    fn a_folder_lists_its_mesh_files_in_path_order() {
+        let dir = temp("folder.txt", "").with_file_name("folder");
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        for f in ["b.off", "a.STL", "notes.txt", "sub/c.ply"] {
+            std::fs::write(dir.join(f), "").unwrap();
+        }
+        let m = Manifest::read(&dir).unwrap();
+        let names: Vec<_> = m.entries.iter().map(|e| (e.index, e.mesh.as_str())).collect();
+        assert_eq!(names, [(0, "a.STL"), (1, "b.off"), (2, "sub/c.ply")]);
+        assert!(m.entries[2].path.ends_with("folder/sub/c.ply"));
+    }
+
+    #[test]
     fn shards_partition_the_entries() {
         assert_eq!("1/4".parse::<Shard>(), Ok(Shard { index: 1, count: 4 }));
         for bad in ["4/4", "1", "a/2", "0/0"] {
