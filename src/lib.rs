@@ -1,7 +1,8 @@
 //! texgeo: geometry algorithms of the GPGPU texture era on raw Vulkan.
 //!
 //! `gpu` owns every Vulkan object; `mesh` is the polygon mesh and its formats;
-//! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top.
+//! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top; `sweep`
+//! runs one of them over a whole mesh collection.
 
 pub mod gpu;
 pub mod host;
@@ -10,4 +11,5 @@ pub mod mesh;
 pub mod random;
 pub mod report;
 pub mod subdiv;
+pub mod sweep;
 pub mod voxel;

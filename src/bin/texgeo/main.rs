@@ -7,6 +7,7 @@ mod inclusion;
 mod info;
 mod mesh;
 mod subdivide;
+mod sweep;
 mod voxelize;
 
 use clap::{Parser, Subcommand};
@@ -45,6 +46,8 @@ enum Command {
     Demo(demo::Args),
     /// Solid voxelization by slicing tetrahedra with XOR; writes .binvox (+ PNG slices).
     Voxelize(voxelize::Args),
+    /// Run a task over a mesh collection: each mesh isolated, resumable, shardable; `sweep merge DIR`.
+    Sweep(sweep::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -64,6 +67,7 @@ fn main() {
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
+        Command::Sweep(a) => sweep::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");

@@ -1,0 +1,149 @@
+//! `--task inclusion`: classify seeded random points in the mesh's bounding box with the
+//! method under test and compare every answer with an exact CPU method.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::gpu::Context;
+use crate::inclusion::solver::Solver;
+use crate::inclusion::{self, Class, InclusionError, Method};
+use crate::mesh::{Mesh, Report};
+use crate::random::Rng;
+use crate::sweep::record::{Fnv, Record};
+use crate::sweep::task::{Failure, Task};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Options {
+    /// The method under test (`texgeo inclusion --method`).
+    pub method: String,
+    /// Uniform random points in the bounding box.
+    pub points: usize,
+    pub seed: u64,
+    /// TetraGrid resolution (tetragrid, gpu+tetragrid, and the GPU paths' exact fallback).
+    pub grid: usize,
+    /// GPU methods: tetrahedra per point-vertex.
+    pub batch: Option<u32>,
+    /// A CPU method every answer is compared with, or `none`.
+    pub reference: String,
+    /// Accept surfaces that are not closed (answers follow the winding number).
+    pub allow_open: bool,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            method: "gpu".into(),
+            points: 1000,
+            seed: 1,
+            grid: inclusion::tetragrid::DEFAULT_RESOLUTION,
+            batch: None,
+            reference: "cpu".into(),
+            allow_open: false,
+        }
+    }
+}
+
+/// Point in solid (Feito-Torres and its optimizers, GPU paths, baselines).
+#[derive(Default)]
+pub struct Inclusion;
+
+impl Options {
+    fn reference(&self) -> Result<Option<Method>, String> {
+        if self.reference == "none" {
+            return Ok(None);
+        }
+        let m: Method = self.reference.parse().map_err(|e: InclusionError| e.to_string())?;
+        if !m.is_cpu() {
+            return Err(format!("reference '{m}' must be a CPU method (or none)"));
+        }
+        Ok(Some(m))
+    }
+}
+
+impl Task for Inclusion {
+    const NAME: &'static str = "inclusion";
+    type Options = Options;
+
+    fn validate(o: &Options) -> Result<(), String> {
+        o.method.parse::<Method>().map_err(|e| e.to_string())?;
+        o.reference()?;
+        if o.points == 0 || o.points > 100_000_000 {
+            return Err(format!("points {} is outside 1..=100000000", o.points));
+        }
+        Ok(())
+    }
+
+    fn needs_device(o: &Options) -> bool {
+        o.method.parse::<Method>().is_ok_and(|m| !m.is_cpu())
+    }
+
+    fn run(
+        &mut self,
+        ctx: Option<&Context>,
+        mesh: &Mesh,
+        _report: &Report,
+        o: &Options,
+        out: &mut Record,
+    ) -> Result<(), Failure> {
+        let method: Method = o.method.parse().map_err(|e| Failure::failed("options", e))?;
+        let (lo, hi) = mesh.bounds();
+        let points = Rng::new(o.seed).points_in_box(o.points, lo, hi);
+        out.size("points", points.len());
+        let options = inclusion::Options {
+            tetragrid_resolution: o.grid,
+            allow_open: o.allow_open,
+            ..Default::default()
+        };
+
+        let t = Instant::now();
+        let mut solver = Solver::new(method, mesh, &options, ctx, o.batch).map_err(refusal)?;
+        out.time("build", t.elapsed());
+        let t = Instant::now();
+        let classes = solver.classify_all(&points).map_err(refusal)?;
+        out.time("classify", t.elapsed());
+
+        let count = |c: Class| classes.iter().filter(|&&x| x == c).count();
+        out.size("inside", count(Class::Inside));
+        out.size("outside", count(Class::Outside));
+        out.size("boundary", count(Class::OnBoundary));
+        if let Some(g) = solver.gpu_stats() {
+            out.size("flagged", g.flagged);
+        }
+        let mut h = Fnv::default();
+        h.bytes(&classes.iter().map(|&c| c as u8).collect::<Vec<_>>());
+        out.hash("classes", &h);
+
+        let Some(reference) = o.reference().map_err(|e| Failure::failed("options", e))? else {
+            return Ok(());
+        };
+        let t = Instant::now();
+        let mut exact = Solver::new(reference, mesh, &options, None, None).map_err(refusal)?;
+        let expected = exact.classify_all(&points).map_err(refusal)?;
+        out.time("reference", t.elapsed());
+        let differing = classes.iter().zip(&expected).filter(|(a, b)| a != b).count();
+        out.check("differing", differing);
+        if differing > 0 {
+            return Err(Failure::failed(
+                "check",
+                format!("{differing} of {} points differ from the {reference} answer", points.len()),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Refusals (what `texgeo inclusion` would reject) and failures.
+fn refusal(e: InclusionError) -> Failure {
+    match e {
+        InclusionError::NotClosed { .. } => Failure::refused("not-closed", e),
+        InclusionError::TooLarge(_) => Failure::refused("too-large", e),
+        InclusionError::Resolution(_)
+        | InclusionError::OctreeDepth(_)
+        | InclusionError::Options(_)
+        | InclusionError::UnknownMethod(_) => Failure::refused("options", e),
+        InclusionError::Gpu(_) => Failure::failed("gpu", e),
+        InclusionError::NeedsGpu(_) => Failure::failed("device", e),
+    }
+}

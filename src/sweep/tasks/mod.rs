@@ -1,0 +1,5 @@
+//! The tasks a sweep can run, one module each (see [`super::task::Task`]).
+
+pub mod inclusion;
+pub mod subdivide;
+pub mod voxelize;

@@ -1,0 +1,196 @@
+//! `--task subdivide`: Catmull-Clark to a level with fragment meshes on the GPU (or the
+//! CPU reference) and compare the result with a reference refinement vertex by vertex.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::gpu::Context;
+use crate::mesh::{Mesh, Report};
+use crate::subdiv::compare::Comparison;
+use crate::subdiv::gpu::{Options as GpuOptions, Subdivider};
+use crate::subdiv::{SubdivError, cpu, osd};
+use crate::sweep::record::{Fnv, Record};
+use crate::sweep::task::{Failure, Task, relative};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Options {
+    /// `gpu` (fragment meshes) or `cpu` (the f64 reference).
+    pub method: String,
+    pub level: u32,
+    /// `auto` (the CPU reference for `gpu`, OpenSubdiv for `cpu`), `cpu`, `osd` or `none`.
+    pub reference: String,
+    /// Largest position error accepted, × the reference's bounding-box diagonal
+    /// (default: 1e-5 for `gpu`, 1e-12 for `cpu`, as `texgeo subdivide --validate`).
+    pub tolerance: Option<f64>,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options { method: "gpu".into(), level: 2, reference: "auto".into(), tolerance: None }
+    }
+}
+
+/// The highest level a sweep asks for (each level multiplies the faces by four).
+const MAX_LEVEL: u32 = 8;
+
+impl Options {
+    fn gpu(&self) -> Result<bool, String> {
+        match self.method.as_str() {
+            "gpu" => Ok(true),
+            "cpu" => Ok(false),
+            m => Err(format!("unknown subdivision method '{m}' (expected gpu or cpu)")),
+        }
+    }
+
+    fn reference(&self) -> Result<&str, String> {
+        match (self.reference.as_str(), self.gpu()?) {
+            ("auto", true) => Ok("cpu"),
+            ("auto", false) => Ok("osd"),
+            (r @ ("cpu" | "osd" | "none"), _) => Ok(r),
+            (r, _) => Err(format!("unknown reference '{r}' (expected auto, cpu, osd or none)")),
+        }
+    }
+}
+
+/// Catmull-Clark; keeps one [`Subdivider`] (pipeline, targets) for all the worker's meshes.
+#[derive(Default)]
+pub struct Subdivide {
+    subdivider: Option<Subdivider>,
+}
+
+impl Task for Subdivide {
+    const NAME: &'static str = "subdivide";
+    type Options = Options;
+
+    fn validate(o: &Options) -> Result<(), String> {
+        o.reference()?;
+        if o.level > MAX_LEVEL {
+            return Err(format!("level {} is above {MAX_LEVEL}", o.level));
+        }
+        if o.tolerance.is_some_and(|t| !(t.is_finite() && t >= 0.0)) {
+            return Err("tolerance must be a non-negative number".into());
+        }
+        Ok(())
+    }
+
+    fn needs_device(o: &Options) -> bool {
+        o.gpu().unwrap_or(false)
+    }
+
+    fn run(
+        &mut self,
+        ctx: Option<&Context>,
+        mesh: &Mesh,
+        _report: &Report,
+        o: &Options,
+        out: &mut Record,
+    ) -> Result<(), Failure> {
+        let gpu = o.gpu().map_err(|e| Failure::failed("options", e))?;
+        out.size("level", o.level);
+        let refined = if gpu {
+            let ctx = ctx.ok_or_else(|| Failure::failed("device", "the GPU method needs a Vulkan device"))?;
+            if self.subdivider.is_none() {
+                self.subdivider = Some(Subdivider::new(ctx).map_err(refusal)?);
+            }
+            let Some(subdivider) = self.subdivider.as_mut() else {
+                return Err(Failure::failed("device", "no subdivider"));
+            };
+            let run = subdivider.refine(ctx, mesh, o.level, &GpuOptions::default()).map_err(refusal)?;
+            let t = &run.times;
+            for (k, d) in [
+                ("base", t.base),
+                ("fragments", t.fragments),
+                ("upload", t.upload),
+                ("passes", t.passes_total()),
+                ("readback", t.readback),
+                ("submit", t.submit),
+                ("assembly", t.assembly),
+                ("refine", t.total),
+            ] {
+                out.time(k, d);
+            }
+            out.size("fragments", run.fragments);
+            out.size("gpu_levels", run.gpu_levels);
+            run.mesh
+        } else {
+            let t = Instant::now();
+            let refined = cpu::refine(mesh, o.level).map_err(refusal)?;
+            out.time("refine", t.elapsed());
+            refined
+        };
+        out.size("out_vertices", refined.num_vertices());
+        out.size("out_faces", refined.num_faces());
+        out.hash("mesh", &hash(&refined));
+
+        let reference = o.reference().map_err(|e| Failure::failed("options", e))?;
+        if reference == "none" {
+            return Ok(());
+        }
+        let t = Instant::now();
+        let expected = match reference {
+            "cpu" => cpu::refine(mesh, o.level),
+            _ => osd::refine(mesh, o.level),
+        }
+        .map_err(|e| match e {
+            SubdivError::HelperMissing { .. } | SubdivError::Helper { .. } | SubdivError::Io { .. } => {
+                Failure::failed("reference", e)
+            }
+            e => refusal(e),
+        })?;
+        out.time("reference", t.elapsed());
+        let tolerance = o.tolerance.unwrap_or(if gpu { 1e-5 } else { 1e-12 });
+        let c = Comparison::new(&refined, &expected, tolerance);
+        let rel = if c.diagonal > 0.0 { c.max_error / c.diagonal } else { c.max_error };
+        out.check("max_error", relative(rel));
+        out.check("matches", c.is_match());
+        if !c.is_match() {
+            return Err(Failure::failed(
+                "check",
+                format!("differs from the {reference} reference beyond {tolerance:e} × diagonal: {}", c)
+                    .trim_end()
+                    .replace('\n', ";"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// FNV-1a of the refined mesh: faces, then positions as f64 bits.
+fn hash(mesh: &Mesh) -> Fnv {
+    let mut h = Fnv::default();
+    for f in mesh.faces() {
+        h.u64(f.len() as u64);
+        for &v in f {
+            h.u64(u64::from(v));
+        }
+    }
+    for p in mesh.positions() {
+        let DVec3 { x, y, z } = *p;
+        for c in [x, y, z] {
+            h.u64(c.to_bits());
+        }
+    }
+    h
+}
+
+/// Refusals (input Catmull-Clark cannot refine, levels too large) and failures.
+fn refusal(e: SubdivError) -> Failure {
+    let reason = match &e {
+        SubdivError::DegenerateFace { .. } => "degenerate-face",
+        SubdivError::NonManifoldEdge { .. } => "non-manifold-edge",
+        SubdivError::NonManifoldVertex { .. } => "non-manifold-vertex",
+        SubdivError::Inconsistent { .. } => "inconsistent-orientation",
+        SubdivError::TooLarge { .. } | SubdivError::Memory { .. } => "too-large",
+        SubdivError::Fragment(_) => "fragment-mesh",
+        SubdivError::GpuLimit(_) => "gpu-limit",
+        SubdivError::Gpu(_) => return Failure::failed("gpu", e),
+        SubdivError::Mesh(_) => return Failure::failed("mesh", e),
+        SubdivError::HelperMissing { .. } | SubdivError::Helper { .. } | SubdivError::Io { .. } => {
+            return Failure::failed("error", e);
+        }
+    };
+    Failure::refused(reason, e)
+}

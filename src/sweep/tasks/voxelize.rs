@@ -1,0 +1,150 @@
+//! `--task voxelize`: voxelize at N³ with the method under test and compare the bit
+//! volume with an exact method, voxel by voxel.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::gpu::Context;
+use crate::mesh::{Mesh, Report};
+use crate::sweep::record::{Fnv, Record};
+use crate::sweep::task::{Failure, Task};
+use crate::voxel::{Grid, Method, Solid, VoxelError, Voxelizer, grid};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Options {
+    /// The method under test (`texgeo voxelize --method`).
+    pub method: String,
+    /// Voxels per side.
+    pub res: usize,
+    /// The method every voxel is compared with, or `none`.
+    pub reference: String,
+    /// Zone height for `zoned` (default: chosen from the mesh and memory).
+    pub zone: Option<usize>,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options { method: "zoned".into(), res: 64, reference: "scanline".into(), zone: None }
+    }
+}
+
+fn method(name: &str) -> Result<Method, String> {
+    Method::parse(name).ok_or_else(|| {
+        format!(
+            "unknown voxelization method '{name}' (expected {})",
+            Method::ALL.map(|m| m.name()).join(", ")
+        )
+    })
+}
+
+/// Solid voxelization by slicing tetrahedra; keeps one [`Voxelizer`] (and its pipelines)
+/// for all the worker's meshes.
+#[derive(Default)]
+pub struct Voxelize {
+    voxelizer: Option<Voxelizer>,
+    with_device: bool,
+}
+
+impl Voxelize {
+    fn voxelizer(&mut self, ctx: Option<&Context>, zone: Option<usize>) -> &mut Voxelizer {
+        if self.voxelizer.is_none() || (!self.with_device && ctx.is_some()) {
+            self.voxelizer = Some(Voxelizer::new(ctx.cloned()));
+            self.with_device = ctx.is_some();
+        }
+        let v = self.voxelizer.get_or_insert_with(|| Voxelizer::new(None));
+        v.zone = zone;
+        v
+    }
+}
+
+impl Task for Voxelize {
+    const NAME: &'static str = "voxelize";
+    type Options = Options;
+
+    fn validate(o: &Options) -> Result<(), String> {
+        method(&o.method)?;
+        if o.reference != "none" {
+            method(&o.reference)?;
+        }
+        grid::check_resolution(o.res).map_err(|e| e.to_string())
+    }
+
+    fn needs_device(o: &Options) -> bool {
+        let gpu = |name: &str| Method::parse(name).is_some_and(Method::uses_gpu);
+        gpu(&o.method) || gpu(&o.reference)
+    }
+
+    fn run(
+        &mut self,
+        ctx: Option<&Context>,
+        mesh: &Mesh,
+        report: &Report,
+        o: &Options,
+        out: &mut Record,
+    ) -> Result<(), Failure> {
+        let m = method(&o.method).map_err(|e| Failure::failed("options", e))?;
+        let refusal = |e: VoxelError| refusal(e, report);
+        let t = Instant::now();
+        let grid = Grid::for_mesh(mesh, o.res).map_err(refusal)?;
+        let solid = Solid::new(mesh).map_err(refusal)?;
+        out.time("covering", t.elapsed());
+        out.size("res", o.res);
+
+        let result = self.voxelizer(ctx, o.zone).run(&solid, &grid, m).map_err(refusal)?;
+        let t = result.timings;
+        for (k, d) in [
+            ("prepare", t.prepare),
+            ("draw", t.draw),
+            ("copy", t.copy),
+            ("readback", t.readback),
+            ("fallback", t.fallback),
+            ("voxelize", t.total),
+        ] {
+            out.time(k, d);
+        }
+        out.size("occupied", result.volume.count());
+        out.size("band_candidates", result.band.candidates);
+        out.size("band_corrected", result.band.changed);
+        let mut h = Fnv::default();
+        for j in 0..o.res {
+            for k in 0..o.res {
+                for &w in result.volume.row(j, k) {
+                    h.u64(w);
+                }
+            }
+        }
+        out.hash("volume", &h);
+
+        if o.reference == "none" {
+            return Ok(());
+        }
+        let r = method(&o.reference).map_err(|e| Failure::failed("options", e))?;
+        let t = Instant::now();
+        let expected = self.voxelizer(ctx, o.zone).run(&solid, &grid, r).map_err(refusal)?;
+        out.time("reference", t.elapsed());
+        let differing = result.volume.count_differences(&expected.volume).map_err(refusal)?;
+        out.check("differing", differing);
+        if differing > 0 {
+            return Err(Failure::failed("check", format!("{differing} voxels differ from the {r} volume")));
+        }
+        Ok(())
+    }
+}
+
+/// Refusals (what `texgeo voxelize` would reject) and failures.
+fn refusal(e: VoxelError, report: &Report) -> Failure {
+    match e {
+        VoxelError::Mesh(_) if !report.is_closed() => Failure::refused("not-closed", e),
+        VoxelError::Mesh(_) if report.faces == 0 => Failure::refused("empty", e),
+        VoxelError::Mesh(_) => Failure::refused("flat", e),
+        VoxelError::Resolution { .. } => Failure::refused("options", e),
+        VoxelError::Memory { .. } => Failure::refused("too-large", e),
+        VoxelError::Gpu(_) => Failure::failed("gpu", e),
+        VoxelError::Usage(_)
+        | VoxelError::Binvox { .. }
+        | VoxelError::Io { .. }
+        | VoxelError::MeshFile(_) => Failure::failed("error", e),
+    }
+}
