@@ -8,6 +8,7 @@ pub mod host;
 pub mod inclusion;
 pub mod mesh;
 pub mod random;
+pub mod render;
 pub mod report;
 pub mod subdiv;
 pub mod voxel;

@@ -77,6 +77,10 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: f32,
     pub push_descriptor: bool,
     pub vulkan13: bool,
+    /// Sample counts offered for colour and depth render targets, as a bit mask
+    /// (bit n set: 2^n samples per pixel).
+    pub colour_samples: u32,
+    pub depth_samples: u32,
 }
 
 impl DeviceInfo {
@@ -111,6 +115,19 @@ impl Drop for Device {
             self.raw.destroy_sampler(self.sampler, None);
             if let Ok(pool) = self.command_pool.get_mut() {
                 self.raw.destroy_command_pool(*pool, None);
+            }
+            // Every resource holds the device, so anything still allocated here was leaked
+            // by a bug in texgeo: say so loudly (gpu-allocator itself only logs it).
+            if let Ok(allocator) = self.allocator.get_mut() {
+                let report = allocator.generate_report();
+                if !report.allocations.is_empty() {
+                    let names: Vec<_> = report.allocations.iter().map(|a| a.name.as_str()).collect();
+                    eprintln!(
+                        "gpu-allocator: {} allocation(s) leaked at teardown: {}",
+                        names.len(),
+                        names.join(", ")
+                    );
+                }
             }
             ManuallyDrop::drop(&mut self.allocator);
             self.raw.destroy_device(None);
@@ -283,6 +300,8 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
         vulkan13: vk::api_version_minor(v) >= 3
             && f13.dynamic_rendering == vk::TRUE
             && f13.synchronization2 == vk::TRUE,
+        colour_samples: limits.framebuffer_color_sample_counts.as_raw(),
+        depth_samples: limits.framebuffer_depth_sample_counts.as_raw(),
     }
 }
 
@@ -462,6 +481,12 @@ impl Context {
 
     pub fn info(&self) -> &DeviceInfo {
         &self.dev.info
+    }
+
+    /// Allocations gpu-allocator holds for this device right now (buffers and textures
+    /// alive); a program that dropped all its resources must see 0.
+    pub fn live_allocations(&self) -> usize {
+        self.dev.allocator.lock().map(|a| a.generate_report().allocations.len()).unwrap_or(0)
     }
 
     /// Whether the validation layer is on for this context.

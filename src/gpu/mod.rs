@@ -20,8 +20,8 @@ pub use context::{Context, ContextOptions, DeviceChoice, DeviceInfo, list_device
 pub use error::{GpuError, Result};
 pub use memory::Buffer;
 pub use memory::{Pod, as_bytes, from_bytes};
-pub use pass::{Attachment, Load, PingPong, Recorder, Rect, RenderScope};
-pub use pipeline::{Blend, Pipeline, PipelineDesc, Topology};
+pub use pass::{Attachment, Load, PingPong, Recorder, Rect, RenderScope, Targets};
+pub use pipeline::{Blend, DepthTest, Pipeline, PipelineDesc, Raster, Topology};
 pub use reduce::{MAX_LAYERS, Reducer, reduce_sum};
 pub use scatter::{Datum, Scatter};
 pub use texture::{TexFormat, Texture};

@@ -6,6 +6,7 @@ mod demo;
 mod inclusion;
 mod info;
 mod mesh;
+mod render;
 mod subdivide;
 mod voxelize;
 
@@ -45,6 +46,8 @@ enum Command {
     Demo(demo::Args),
     /// Solid voxelization by slicing tetrahedra with XOR; writes .binvox (+ PNG slices).
     Voxelize(voxelize::Args),
+    /// An offscreen picture (PNG) of a mesh, a subdivision level or a voxel volume.
+    Render(render::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -64,6 +67,7 @@ fn main() {
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
+        Command::Render(a) => render::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");
