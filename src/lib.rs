@@ -11,4 +11,5 @@ pub mod random;
 pub mod render;
 pub mod report;
 pub mod subdiv;
+pub mod view;
 pub mod voxel;

@@ -69,6 +69,11 @@ impl<'d> Recorder<'d> {
         Recorder { dev, cmd, keep: Vec::new() }
     }
 
+    /// The command buffer being recorded (for the swapchain's copy, in `present`).
+    pub(crate) fn command_buffer(&self) -> vk::CommandBuffer {
+        self.cmd
+    }
+
     fn check(&self, tex: &Texture) -> Result<()> {
         if tex.same_device(&super::Context { dev: self.dev.clone() }) {
             Ok(())

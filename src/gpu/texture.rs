@@ -88,7 +88,8 @@ impl Use {
         match self {
             Use::Sampled => vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER,
             Use::Attachment => vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-            Use::CopySrc | Use::CopyDst => vk::PipelineStageFlags2::COPY,
+            // Blits too: a window's frame is a blit of the rendered picture.
+            Use::CopySrc | Use::CopyDst => vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::BLIT,
             Use::Depth => {
                 vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS
             }

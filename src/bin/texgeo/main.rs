@@ -8,6 +8,7 @@ mod info;
 mod mesh;
 mod render;
 mod subdivide;
+mod view;
 mod voxelize;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +49,8 @@ enum Command {
     Voxelize(voxelize::Args),
     /// An offscreen picture (PNG) of a mesh, a subdivision level or a voxel volume.
     Render(render::Args),
+    /// An interactive window: orbit a mesh, step through subdivision levels live, voxels.
+    View(view::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -68,6 +71,7 @@ fn main() {
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
         Command::Render(a) => render::run(device, a),
+        Command::View(a) => view::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");
