@@ -258,3 +258,70 @@ fn png_round_trip_leaves_no_temporary_file() {
     assert!(pic.save_png(dir.join("no/such/dir/p.png")).is_err());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn gpu_memory_is_counted_and_returned() {
+    let ctx = Context::from_env().unwrap();
+    let before = ctx.live_allocations();
+    let cube = procedural::cube();
+    let scene = Scene::new().with_mesh(SceneMesh::new(&cube, RED).wireframe(BLACK));
+    {
+        let mut r = Renderer::new(&ctx, 4).unwrap();
+        let prepared = r.prepare(&scene).unwrap();
+        r.render(&prepared, &View::fit(&scene, 32, 32).unwrap()).unwrap();
+        assert!(ctx.live_allocations() > before, "buffers and targets are allocated");
+    }
+    assert_eq!(ctx.live_allocations(), before, "everything the renderer made is freed");
+}
+
+fn texgeo(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().unwrap()
+}
+
+#[test]
+fn render_command_writes_pictures_and_refuses_bad_requests() {
+    let dir = std::env::temp_dir().join(format!("texgeo-render-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("cube.png");
+    let o = texgeo(&[
+        "render",
+        "builtin:cube",
+        "-l",
+        "2",
+        "--valence",
+        "--wireframe",
+        "--size",
+        "64x48",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("level 2, 98 vertices, 96 faces"));
+    let p = Picture::load_png(&png).unwrap();
+    assert_eq!((p.width, p.height), (64, 48));
+    let binvox = dir.join("cube.binvox");
+    assert!(
+        texgeo(&["voxelize", "builtin:cube", "--res", "8", "-o", binvox.to_str().unwrap()]).status.success()
+    );
+    let b = binvox.to_str().unwrap();
+    let out = dir.join("x.png");
+    let out = out.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["render", "builtin:cube", "-o", "cube.jpg"], "name it .png"),
+        (vec!["render", b, "-l", "1", "-o", out], "--level applies to meshes"),
+        (vec!["render", b, "--valence", "-o", out], "--valence applies to meshes"),
+        (vec!["render", "builtin:cube", "--aspect", "perlin", "-o", out], "--aspect colours voxels"),
+        (vec!["render", "builtin:cube", "builtin:knot", "-l", "1", "-o", out], "several models"),
+        (vec!["render", "builtin:cube", "--size", "0x10", "-o", out], "not a size"),
+        (vec!["render", "builtin:cube", "--pitch", "95", "-o", out], "--pitch"),
+        (vec!["render", "builtin:cube", "--samples", "3", "-o", out], "3-sample"),
+        (vec!["render", "builtin:nothing", "-o", out], "no built-in model"),
+    ] {
+        let o = texgeo(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    assert!(!dir.join("x.png").exists(), "no picture from a refused request");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -102,7 +102,11 @@ fn clean(o: &Output, what: &str) -> String {
 fn screenshots_equal_offscreen_pictures() {
     let x = Xvfb::start();
     let dir = temp("equal");
+    let binvox = dir.join("knot.binvox");
+    clean(&texgeo(&["voxelize", "builtin:knot", "--res", "32", "-o", binvox.to_str().unwrap()]), "voxelize");
     for (name, model) in [
+        ("binvox", vec![binvox.to_str().unwrap()]),
+        ("two meshes", vec!["builtin:torus", "builtin:sphere", "--wireframe"]),
         ("knot", vec!["builtin:knot", "--wireframe"]),
         ("voxels", vec!["builtin:torus", "--voxels", "--res", "24", "--aspect", "perlin"]),
         ("valence", vec!["builtin:cube", "--level", "2", "--valence", "--shading", "smooth", "--yaw", "-60"]),
@@ -244,6 +248,11 @@ fn real_x_input_resizes_orbits_unmaps_and_closes() {
     wait_for(limit, "level 1", || stdout().contains("level 1: 26 vertices, 24 faces").then_some(()));
     xdo(&["key", "plus"]);
     wait_for(limit, "level 2", || stdout().contains("level 2: 98 vertices, 96 faces").then_some(()));
+    let title = wait_for(limit, "the title to show level 2", || {
+        let t = xdo(&["getwindowname", &wid]);
+        t.contains("level 2").then_some(t)
+    });
+    assert!(title.contains("98 vertices, 96 faces") && title.contains("fps"), "{title}");
     xdo(&["mousedown", "1", "mousemove_relative", "40", "15", "mouseup", "1"]);
     xdo(&["click", "--repeat", "2", "4"]); // wheel: zoom in
     xdo(&["windowunmap", "--sync", &wid]);

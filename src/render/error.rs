@@ -16,4 +16,8 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Subdiv(#[from] crate::subdiv::SubdivError),
+    #[error(transparent)]
+    Voxel(#[from] crate::voxel::VoxelError),
 }

@@ -13,11 +13,10 @@ use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
 use crate::gpu::{Context, ContextOptions, Presented, Surface, Swapchain};
-use crate::render::{Camera, Look, Picture, Prepared, Renderer, View, colour};
+use crate::render::{Camera, Content, Look, Model, Picture, Prepared, RenderError, Renderer, View, colour};
 use crate::voxel::aspect::Aspect;
 
 use super::error::{Result, ViewError};
-use super::model::{Content, Model};
 use super::script::Step;
 
 /// How to run the viewer.
@@ -190,10 +189,10 @@ impl App {
                             self.dirty = true;
                         }
                         // A level that does not fit is a message, not the end of the session.
-                        Err(e @ (ViewError::Usage(_) | ViewError::Subdiv(_))) => {
+                        Err(e @ (RenderError::Usage(_) | RenderError::Subdiv(_))) => {
                             eprintln!("texgeo view: {e}")
                         }
-                        Err(e) => return Err(e),
+                        Err(e) => return Err(e.into()),
                     }
                 }
             }

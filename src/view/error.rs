@@ -23,8 +23,4 @@ pub enum ViewError {
     Gpu(#[from] crate::gpu::GpuError),
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
-    #[error(transparent)]
-    Subdiv(#[from] crate::subdiv::SubdivError),
-    #[error(transparent)]
-    Voxel(#[from] crate::voxel::VoxelError),
 }

@@ -10,10 +10,9 @@
 
 mod app;
 mod error;
-mod model;
 mod script;
 
+pub use crate::render::Content;
 pub use app::{Options, run};
 pub use error::{Result, ViewError};
-pub use model::Content;
 pub use script::{Step, parse_script};

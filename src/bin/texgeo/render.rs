@@ -5,12 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
-use texgeo::gpu::Context;
-use texgeo::mesh::Mesh;
-use texgeo::render::{Camera, Look, Renderer, Scene, Shading, View, colour};
-use texgeo::subdiv::gpu::{Options, Subdivider};
-use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::{self, Grid, Volume, binvox};
+use texgeo::render::{Camera, Content, Look, Model, Renderer, Scene, Shading, View, colour};
+use texgeo::voxel::aspect::{Aspect, Material};
+use texgeo::voxel::binvox;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ShadingArg {
@@ -34,6 +31,8 @@ impl From<ShadingArg> for Shading {
 pub struct Show {
     /// A mesh (.obj .off .ply .stl, or `builtin:NAME`) or a voxel volume (.binvox).
     pub input: String,
+    /// More meshes shown with the first, each in its own colour (no subdivision levels).
+    pub others: Vec<String>,
     /// Catmull-Clark level (GPU fragment passes, as `texgeo subdivide`).
     #[arg(short, long, default_value_t = 0)]
     pub level: u32,
@@ -93,12 +92,6 @@ pub struct Args {
     pub output: PathBuf,
 }
 
-/// A model as loaded: a polygon mesh, or a voxel volume with its grid.
-pub enum Model {
-    Mesh(Mesh),
-    Voxels(Grid, Volume),
-}
-
 impl Show {
     pub fn look(&self) -> Look {
         Look {
@@ -119,6 +112,9 @@ impl Show {
             bail!("--pitch must be within -89..=89 degrees and --yaw finite");
         }
         let voxels = self.voxels || self.is_binvox();
+        if !self.others.is_empty() && (voxels || self.level > 0) {
+            bail!("several models are shown as meshes, without --voxels or --level");
+        }
         if voxels && self.level > 0 {
             bail!("--level applies to meshes, not to voxel volumes");
         }
@@ -131,28 +127,34 @@ impl Show {
         Ok(())
     }
 
-    /// Reads the input: a .binvox volume, a mesh, or a mesh voxelized at `--res`.
-    pub fn load(&self, ctx: &Context) -> anyhow::Result<Model> {
+    /// What to show: a .binvox volume, a mesh (voxelized with --voxels), or several meshes.
+    pub fn content(&self) -> anyhow::Result<Content> {
         if self.is_binvox() {
             let (grid, volume) = binvox::read(&self.input)?;
-            return Ok(Model::Voxels(grid, volume));
+            return Ok(Content::Voxels(grid, volume));
         }
         let mesh = crate::mesh::load(&self.input)?;
         if self.voxels {
-            let v = voxel::voxelize(Some(ctx), &mesh, self.res, voxel::Method::Zoned)
-                .with_context(|| format!("voxelizing {}", self.input))?;
-            return Ok(Model::Voxels(v.grid, v.volume));
+            return Ok(Content::Voxelize(mesh, self.res));
         }
-        Ok(Model::Mesh(mesh))
+        if self.others.is_empty() {
+            return Ok(Content::Mesh(mesh));
+        }
+        let mut meshes = vec![(mesh, PALETTE[0])];
+        for (i, other) in self.others.iter().enumerate() {
+            meshes.push((crate::mesh::load(other)?, PALETTE[(i + 1) % PALETTE.len()]));
+        }
+        Ok(Content::Meshes(meshes, Vec::new()))
     }
 
-    /// The Perlin aspect slices of a volume, when asked for.
-    pub fn aspect_slices(&self, ctx: &Context, volume: &Volume) -> anyhow::Result<Option<Vec<Vec<u8>>>> {
-        if self.aspect.is_none() {
-            return Ok(None);
-        }
-        let params = Aspect { material: self.material, ..Aspect::default() };
-        Ok(Some(aspect::render(ctx, volume, &params)?))
+    /// The Perlin aspect parameters, when asked for.
+    pub fn aspect(&self) -> Option<Aspect> {
+        self.aspect.as_ref().map(|_| Aspect { material: self.material, ..Aspect::default() })
+    }
+
+    /// All inputs, for titles and messages.
+    pub fn name(&self) -> String {
+        std::iter::once(&self.input).chain(&self.others).cloned().collect::<Vec<_>>().join(" + ")
     }
 
     pub fn camera(&self, scene: &Scene) -> anyhow::Result<Camera> {
@@ -162,16 +164,8 @@ impl Show {
     }
 }
 
-/// Refines `mesh` to `level` with the GPU fragment passes (the same path as `subdivide`).
-pub fn refine(ctx: &Context, subdivider: &mut Subdivider, mesh: &Mesh, level: u32) -> anyhow::Result<Mesh> {
-    if level == 0 {
-        return Ok(mesh.clone());
-    }
-    let run = subdivider
-        .refine(ctx, mesh, level, &Options::default())
-        .with_context(|| format!("cannot subdivide to level {level}"))?;
-    Ok(run.mesh)
-}
+/// Colours of several meshes shown together.
+const PALETTE: [colour::Rgba; 4] = [colour::FIRST, colour::SECOND, colour::SURFACE, [120, 200, 120, 255]];
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let show = &args.show;
@@ -179,35 +173,16 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         bail!("{}: the picture is written as PNG; name it .png", args.output.display());
     }
+    let content = show.content()?;
     let ctx = crate::open_context(device)?;
-    let model = show.load(&ctx)?;
-    let look = show.look();
-    let (shown, item);
-    let scene = match &model {
-        Model::Mesh(mesh) => {
-            shown = refine(&ctx, &mut Subdivider::new(&ctx)?, mesh, show.level)?;
-            println!(
-                "{}: level {}, {} vertices, {} faces",
-                show.input,
-                show.level,
-                shown.num_vertices(),
-                shown.num_faces()
-            );
-            Scene::new().with_mesh(look.mesh(&shown))
-        }
-        Model::Voxels(grid, volume) => {
-            let slices = show.aspect_slices(&ctx, volume)?;
-            item = look.voxels(grid, volume, slices.as_deref())?;
-            println!(
-                "{}: {}³ voxels, {} occupied, {} boundary faces",
-                show.input,
-                volume.n(),
-                volume.count(),
-                item.mesh.num_faces()
-            );
-            Scene::new().with_mesh(item)
-        }
-    };
+    let mut model = Model::new(&ctx, content, show.level, show.look(), show.aspect())?;
+    let (vertices, faces) = model.counts();
+    if model.is_voxels() {
+        println!("{}: {faces} voxels", show.name());
+    } else {
+        println!("{}: level {}, {vertices} vertices, {faces} faces", show.name(), model.level);
+    }
+    let scene = model.scene(&ctx)?;
     let mut renderer = Renderer::new(&ctx, show.samples)?;
     let prepared = renderer.prepare(&scene)?;
     let view = View {

@@ -7,10 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use texgeo::gpu::{ContextOptions, DeviceChoice};
-use texgeo::render::colour;
-use texgeo::view::{self, Content, Options};
-use texgeo::voxel::aspect::Aspect;
-use texgeo::voxel::binvox;
+use texgeo::view::{self, Options};
 
 use crate::render::Show;
 
@@ -18,8 +15,6 @@ use crate::render::Show;
 pub struct Args {
     #[command(flatten)]
     show: Show,
-    /// More meshes shown with the first, each in its own colour (no subdivision levels).
-    others: Vec<String>,
     /// Draw this many frames, then exit (for scripts and tests).
     #[arg(long)]
     frames: Option<u64>,
@@ -35,15 +30,9 @@ pub struct Args {
     save_mesh: Option<PathBuf>,
 }
 
-/// Colours of several meshes shown together.
-const PALETTE: [colour::Rgba; 4] = [colour::FIRST, colour::SECOND, colour::SURFACE, [120, 200, 120, 255]];
-
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let show = &args.show;
     show.check()?;
-    if !args.others.is_empty() && (show.voxels || show.is_binvox() || show.level > 0) {
-        bail!("several models are shown as meshes, without --voxels or --level");
-    }
     if let Some(path) = &args.screenshot {
         if args.frames.is_none() {
             bail!(
@@ -61,26 +50,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         Some(s) => view::parse_script(s)?,
         None => Vec::new(),
     };
-    let content = if show.is_binvox() {
-        let (grid, volume) = binvox::read(&show.input)?;
-        Content::Voxels(grid, volume)
-    } else {
-        let mesh = crate::mesh::load(&show.input)?;
-        if show.voxels {
-            Content::Voxelize(mesh, show.res)
-        } else if args.others.is_empty() {
-            Content::Mesh(mesh)
-        } else {
-            let mut meshes = vec![(mesh, PALETTE[0])];
-            for (i, other) in args.others.iter().enumerate() {
-                meshes.push((crate::mesh::load(other)?, PALETTE[(i + 1) % PALETTE.len()]));
-            }
-            Content::Meshes(meshes, Vec::new())
-        }
-    };
-    let name = std::iter::once(&show.input).chain(&args.others).cloned().collect::<Vec<_>>().join(" + ");
+    let content = show.content()?;
     let options = Options {
-        name,
+        name: show.name(),
         context: ContextOptions { device: DeviceChoice::from_env_or(device), validation: None },
         size: show.size,
         samples: show.samples,
@@ -88,7 +60,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         pitch: show.pitch.to_radians(),
         level: show.level,
         look: show.look(),
-        aspect: show.aspect.as_ref().map(|_| Aspect { material: show.material, ..Aspect::default() }),
+        aspect: show.aspect(),
         frames: args.frames,
         screenshot: args.screenshot.clone(),
         script,

@@ -1,5 +1,7 @@
-//! What the viewer shows and its state: the current subdivision level (refined live on
-//! the GPU), the look, the aspect colours, and the scene made from them.
+//! What a picture or the viewer shows, and its state: the current subdivision level
+//! (refined on the GPU, live in the viewer), the look, the aspect colours, and the scene
+//! made from them. `texgeo render` and `texgeo view` build their scenes here, so a
+//! window's screenshot and an offscreen picture of the same model are the same picture.
 
 use std::time::Instant;
 
@@ -10,7 +12,7 @@ use crate::subdiv::gpu::{Options, Subdivider};
 use crate::voxel::aspect::{self, Aspect};
 use crate::voxel::{self, Grid, Volume};
 
-use super::error::{Result, ViewError};
+use super::error::{RenderError, Result};
 
 /// What to show.
 pub enum Content {
@@ -28,7 +30,8 @@ pub enum Content {
 /// Most faces a live level may have (beyond this, memory and frame time explode).
 const MAX_LEVEL_FACES: usize = 8 << 20;
 
-pub(crate) struct Model {
+/// A model being shown (see the module docs).
+pub struct Model {
     content: Content,
     pub level: u32,
     /// The mesh at `level` (Content::Mesh only).
@@ -57,7 +60,7 @@ impl Model {
             c => c,
         };
         if level > 0 && !matches!(content, Content::Mesh(_)) {
-            return Err(ViewError::Usage("subdivision levels apply to a single mesh".into()));
+            return Err(RenderError::Usage("subdivision levels apply to a single mesh".into()));
         }
         let subdivider = match content {
             Content::Mesh(_) => Some(Subdivider::new(ctx)?),
@@ -84,7 +87,7 @@ impl Model {
     /// Refines the base mesh to `level` on the GPU; returns a line for the console.
     pub fn set_level(&mut self, ctx: &Context, level: u32) -> Result<String> {
         let (Content::Mesh(base), Some(subdivider)) = (&self.content, self.subdivider.as_mut()) else {
-            return Err(ViewError::Usage("only a single mesh has subdivision levels".into()));
+            return Err(RenderError::Usage("only a single mesh has subdivision levels".into()));
         };
         if level == 0 {
             self.refined = None;
@@ -95,7 +98,7 @@ impl Model {
         let corners = base.face_parts().1.len();
         let faces = 4usize.checked_pow(level - 1).and_then(|f| f.checked_mul(corners));
         if faces.is_none_or(|f| f > MAX_LEVEL_FACES) {
-            return Err(ViewError::Usage(format!(
+            return Err(RenderError::Usage(format!(
                 "level {level} would have over {MAX_LEVEL_FACES} faces; the viewer stops here \
                  (`texgeo subdivide` writes bigger levels)"
             )));
