@@ -177,6 +177,42 @@ fn edges_and_polylines_are_drawn_over_the_surface() {
 }
 
 #[test]
+fn segments_passing_behind_the_eye_are_clipped_to_the_near_plane() {
+    let ctx = Context::from_env().unwrap();
+    let green = [0, 255, 0, 255];
+    let camera = Camera { target: DVec3::ZERO, yaw: 0.0, pitch: 0.0, distance: 5.0, fov_y: Camera::FOV_Y };
+    // From behind the eye (z = 10, above) to in front of it (below right).
+    let (a, b) = (DVec3::new(0.3, 3.0, 10.0), DVec3::new(1.0, -0.8, -1.0));
+    let scene = Scene::new().with_line(Polyline::new(vec![a, b], green, 3.0));
+    let mut r = Renderer::new(&ctx, 1).unwrap();
+    let prepared = r.prepare(&scene).unwrap();
+    let (w, h) = (160, 120);
+    let pic = r.render(&prepared, &View { camera, width: w, height: h, background: BLACK }).unwrap();
+    // The visible part on the CPU: from b to where the segment leaves the eye's half-space
+    // (a hair in front of the eye), projected.
+    let eye_z = |p: DVec3| p.z - camera.eye().z;
+    let t = (eye_z(b) + 1e-3) / (eye_z(b) - eye_z(a));
+    let front = b + (a - b) * t;
+    let (p, q) = (camera.project(b, w, h).unwrap(), camera.project(front, w, h).unwrap());
+    let distance = |x: f64, y: f64| {
+        let (d, v) = (q - p, glam::DVec2::new(x, y) - p);
+        let s = (v.dot(d) / d.length_squared()).clamp(0.0, 1.0);
+        (v - d * s).length()
+    };
+    let mut on = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if pic.pixel(x, y) == green {
+                on += 1;
+                let dist = distance(x as f64 + 0.5, y as f64 + 0.5);
+                assert!(dist < 3.0, "pixel ({x}, {y}) is {dist:.1} px off the visible segment");
+            }
+        }
+    }
+    assert!(on > 100, "{on} pixels");
+}
+
+#[test]
 fn pictures_are_deterministic() {
     let ctx = Context::from_env().unwrap();
     let knot = procedural::torus_knot();

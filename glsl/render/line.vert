@@ -24,6 +24,18 @@ vec4 clip(vec3 p) {
 void main() {
     vec4 ca = clip(a);
     vec4 cb = clip(b);
+    // Clip the segment to the near plane (z >= 0 in Vulkan clip space), so a segment that
+    // passes behind the eye never turns into a quad flipped across the picture.
+    if (ca.z < 0.0 && cb.z < 0.0) {
+        gl_Position = vec4(0.0, 0.0, -1.0, 1.0);  // wholly behind: outside the view volume
+        tint = vec4(0.0);
+        return;
+    }
+    if (ca.z < 0.0) {
+        ca = mix(ca, cb, ca.z / (ca.z - cb.z));
+    } else if (cb.z < 0.0) {
+        cb = mix(cb, ca, cb.z / (cb.z - ca.z));
+    }
     vec2 half_size = 0.5 * u.viewport.xy;
     vec2 d = (cb.xy / cb.w - ca.xy / ca.w) * half_size;
     float len = length(d);

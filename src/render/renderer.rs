@@ -239,6 +239,10 @@ impl Renderer {
         } else {
             let n = u32::try_from(segments.len())
                 .map_err(|_| RenderError::Usage("more than 2^32 line segments".into()))?;
+            // Padding to one segment per quad corner: the validation layer's synchronization
+            // check (1.3.239) sizes an instanced binding's read by the vertex count (6), and
+            // would see a short buffer's read run into its neighbour in the same memory block.
+            segments.resize(segments.len().max(6), Segment::default());
             Some((Buffer::with_data(&self.ctx, &segments, "render segments")?, n))
         };
         Ok(Prepared { meshes, segments, origin, bounds, triangles, segment_count })

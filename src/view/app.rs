@@ -281,6 +281,14 @@ impl App {
             if self.camera.is_none() {
                 self.reset_camera();
             }
+            if self
+                .gfx
+                .as_ref()
+                .and_then(|g| g.prepared.as_ref())
+                .is_some_and(|p| p.triangles() + p.segments() == 0)
+            {
+                return Err(ViewError::Usage("nothing to show: the model has no faces".into()));
+            }
         }
         let last = self.options.frames.is_some_and(|n| self.frames + 1 >= n) && self.script_done();
         let Some(gfx) = self.gfx.as_mut() else { return Ok(false) };

@@ -185,6 +185,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let scene = model.scene(&ctx)?;
     let mut renderer = Renderer::new(&ctx, show.samples)?;
     let prepared = renderer.prepare(&scene)?;
+    if prepared.triangles() + prepared.segments() == 0 {
+        bail!("nothing to show: the model has no faces");
+    }
     let view = View {
         camera: show.camera(&scene)?,
         width: show.size[0],
