@@ -24,7 +24,9 @@ struct Xvfb {
 impl Xvfb {
     fn start() -> Xvfb {
         let mut child = Command::new("Xvfb")
-            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
+            // -noreset: without it the server resets whenever its last client leaves, and a
+            // client connecting during the reset is refused.
+            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp", "-noreset"])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
@@ -45,6 +47,12 @@ impl Xvfb {
 
 impl Drop for Xvfb {
     fn drop(&mut self) {
+        // SIGTERM first, so the server removes its socket and lock file.
+        let _ = Command::new("kill").arg(self.child.id().to_string()).status();
+        let start = Instant::now();
+        while self.child.try_wait().ok().flatten().is_none() && start.elapsed() < Duration::from_secs(5) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
@@ -207,7 +215,15 @@ fn wait_for<T>(limit: Duration, what: &str, mut f: impl FnMut() -> Option<T>) ->
         if let Some(v) = f() {
             return v;
         }
-        assert!(start.elapsed() < limit, "timed out waiting for {what}");
+        if start.elapsed() > limit {
+            let dir = temp("xdotool");
+            let read = |n: &str| std::fs::read_to_string(dir.join(n)).unwrap_or_default();
+            panic!(
+                "timed out waiting for {what}\nviewer stdout: {}\nviewer stderr: {}",
+                read("stdout.txt"),
+                read("stderr.txt")
+            );
+        }
         std::thread::sleep(Duration::from_millis(50));
     }
 }
@@ -240,10 +256,18 @@ fn real_x_input_resizes_orbits_unmaps_and_closes() {
         let w = xdo(&["search", "--name", "texgeo view"]);
         (!w.is_empty()).then(|| w.lines().next().unwrap_or_default().to_string())
     });
-    wait_for(limit, "the first frame", || stdout().contains("device:").then_some(()));
+    // The title gets its counts and fps once a frame was presented: the window is mapped.
+    wait_for(limit, "the first frame", || xdo(&["getwindowname", &wid]).contains("fps").then_some(()));
     xdo(&["windowsize", &wid, "500", "400"]);
-    xdo(&["windowfocus", "--sync", &wid]);
-    xdo(&["mousemove", "--window", &wid, "100", "100"]);
+    // Keys typed through XTEST go to the focused window.
+    let focus = |wid: &str| {
+        wait_for(limit, "the window to take the focus", || {
+            xdo(&["windowfocus", "--sync", wid]);
+            (xdo(&["getwindowfocus"]) == wid).then_some(())
+        });
+        xdo(&["mousemove", "--window", wid, "100", "100"]);
+    };
+    focus(&wid);
     xdo(&["key", "plus"]);
     wait_for(limit, "level 1", || stdout().contains("level 1: 26 vertices, 24 faces").then_some(()));
     xdo(&["key", "plus"]);
@@ -257,8 +281,7 @@ fn real_x_input_resizes_orbits_unmaps_and_closes() {
     xdo(&["click", "--repeat", "2", "4"]); // wheel: zoom in
     xdo(&["windowunmap", "--sync", &wid]);
     xdo(&["windowmap", "--sync", &wid]);
-    xdo(&["windowfocus", "--sync", &wid]);
-    xdo(&["mousemove", "--window", &wid, "100", "100"]);
+    focus(&wid);
     xdo(&["key", "s"]);
     wait_for(limit, "the screenshot", || stdout().contains("wrote texgeo-view-001.png").then_some(()));
     xdo(&["key", "q"]);
