@@ -77,6 +77,10 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: f32,
     pub push_descriptor: bool,
     pub vulkan13: bool,
+    /// Sample counts offered for colour and depth render targets, as a bit mask
+    /// (bit n set: 2^n samples per pixel).
+    pub colour_samples: u32,
+    pub depth_samples: u32,
 }
 
 impl DeviceInfo {
@@ -111,6 +115,19 @@ impl Drop for Device {
             self.raw.destroy_sampler(self.sampler, None);
             if let Ok(pool) = self.command_pool.get_mut() {
                 self.raw.destroy_command_pool(*pool, None);
+            }
+            // Every resource holds the device, so anything still allocated here was leaked
+            // by a bug in texgeo: say so loudly (gpu-allocator itself only logs it).
+            if let Ok(allocator) = self.allocator.get_mut() {
+                let report = allocator.generate_report();
+                if !report.allocations.is_empty() {
+                    let names: Vec<_> = report.allocations.iter().map(|a| a.name.as_str()).collect();
+                    eprintln!(
+                        "gpu-allocator: {} allocation(s) leaked at teardown: {}",
+                        names.len(),
+                        names.join(", ")
+                    );
+                }
             }
             ManuallyDrop::drop(&mut self.allocator);
             self.raw.destroy_device(None);
@@ -158,7 +175,7 @@ struct Instance {
 }
 
 impl Instance {
-    fn new(validate: bool) -> Result<Instance> {
+    fn new(validate: bool, extra_extensions: &[*const std::ffi::c_char]) -> Result<Instance> {
         // SAFETY: loading libvulkan; failure is reported, not assumed.
         let entry = unsafe { ash::Entry::load()? };
         let app = vk::ApplicationInfo::default()
@@ -166,7 +183,7 @@ impl Instance {
             .engine_name(c"texgeo")
             .api_version(vk::API_VERSION_1_3);
         let mut layers = Vec::new();
-        let mut extensions = Vec::new();
+        let mut extensions = extra_extensions.to_vec();
         if validate {
             // SAFETY: plain enumeration.
             let available = unsafe { entry.enumerate_instance_layer_properties() }
@@ -283,6 +300,8 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
         vulkan13: vk::api_version_minor(v) >= 3
             && f13.dynamic_rendering == vk::TRUE
             && f13.synchronization2 == vk::TRUE,
+        colour_samples: limits.framebuffer_color_sample_counts.as_raw(),
+        depth_samples: limits.framebuffer_depth_sample_counts.as_raw(),
     }
 }
 
@@ -292,7 +311,7 @@ fn is_lavapipe(info: &DeviceInfo) -> bool {
 
 /// Every Vulkan device the loader sees, in index order.
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
-    let inst = Instance::new(false)?;
+    let inst = Instance::new(false, &[])?;
     // SAFETY: plain enumeration on a live instance.
     let physicals = unsafe { inst.instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     Ok(physicals.iter().enumerate().map(|(i, &p)| describe(&inst.instance, i, p)).collect())
@@ -351,20 +370,89 @@ fn choose(instance: &ash::Instance, choice: &DeviceChoice) -> Result<(vk::Physic
     Ok((p, info))
 }
 
+/// A window surface made before the device exists; destroyed here unless handed on.
+struct PendingSurface<'a> {
+    inst: &'a Instance,
+    loader: ash::khr::surface::Instance,
+    raw: vk::SurfaceKHR,
+}
+
+impl Drop for PendingSurface<'_> {
+    fn drop(&mut self) {
+        if self.raw != vk::SurfaceKHR::null() {
+            // SAFETY: the surface was made from this instance and nothing uses it.
+            unsafe { self.loader.destroy_surface(self.raw, None) };
+        }
+        let _ = self.inst;
+    }
+}
+
 impl Context {
     /// Opens the device `options` ask for (defaults: `TEXGEO_DEVICE`, `TEXGEO_VALIDATION`).
     pub fn new(options: &ContextOptions) -> Result<Context> {
+        Ok(Context::create(options, None)?.0)
+    }
+
+    /// Opens a device that can also present to the window `window` of `display`
+    /// (the raw handles of winit or any other windowing library): the instance gets the
+    /// platform's surface extensions, the device the swapchain extension and a graphics
+    /// queue that presents to the window's surface.
+    pub fn for_window(
+        options: &ContextOptions,
+        display: raw_window_handle::RawDisplayHandle,
+        window: raw_window_handle::RawWindowHandle,
+    ) -> Result<(Context, super::present::Surface)> {
+        let (ctx, surface) = Context::create(options, Some((display, window)))?;
+        let (loader, raw) = surface.ok_or_else(|| GpuError::Usage("no surface was created".into()))?;
+        Ok((ctx.clone(), super::present::Surface::new(&ctx, loader, raw)))
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn create(
+        options: &ContextOptions,
+        window: Option<(raw_window_handle::RawDisplayHandle, raw_window_handle::RawWindowHandle)>,
+    ) -> Result<(Context, Option<(ash::khr::surface::Instance, vk::SurfaceKHR)>)> {
         let validate = options.validation.unwrap_or_else(validation::requested);
-        let inst = Instance::new(validate)?;
+        let surface_extensions = match window {
+            Some((display, _)) => ash_window::enumerate_required_extensions(display)
+                .vk("vkEnumerateInstanceExtensionProperties (surface extensions)")?,
+            None => &[],
+        };
+        let inst = Instance::new(validate, surface_extensions)?;
+        let mut pending = match window {
+            Some((display, handle)) => {
+                // SAFETY: the handles come from a live window the caller keeps open while
+                // the surface exists.
+                let raw =
+                    unsafe { ash_window::create_surface(&inst.entry, &inst.instance, display, handle, None) }
+                        .vk("vkCreate…SurfaceKHR")?;
+                Some(PendingSurface {
+                    inst: &inst,
+                    loader: ash::khr::surface::Instance::new(&inst.entry, &inst.instance),
+                    raw,
+                })
+            }
+            None => None,
+        };
         let (physical, info) = choose(&inst.instance, &options.device)?;
 
         // SAFETY: valid physical device.
         let families = unsafe { inst.instance.get_physical_device_queue_family_properties(physical) };
-        let queue_family = families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
-            .ok_or_else(|| GpuError::NoDevice(format!("device '{}' has no graphics queue", info.name)))?
-            as u32;
+        let presents = |i: usize| match &pending {
+            // SAFETY: valid physical device, family index and surface.
+            Some(p) => unsafe { p.loader.get_physical_device_surface_support(physical, i as u32, p.raw) }
+                .unwrap_or(false),
+            None => true,
+        };
+        let queue_family = (0..families.len())
+            .find(|&i| families[i].queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
+            .ok_or_else(|| {
+                GpuError::NoDevice(format!(
+                    "device '{}' has no graphics queue{}",
+                    info.name,
+                    if pending.is_some() { " that presents to this window" } else { "" }
+                ))
+            })? as u32;
         let priorities = [1.0];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
@@ -375,7 +463,10 @@ impl Context {
             .independent_blend(true);
         let mut f13 =
             vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
-        let extensions = [ash::khr::push_descriptor::NAME.as_ptr()];
+        let mut extensions = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+        if pending.is_some() {
+            extensions.push(ash::khr::swapchain::NAME.as_ptr());
+        }
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&extensions)
@@ -426,6 +517,9 @@ impl Context {
             }
         };
         let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.instance, &raw);
+        // The surface now outlives this function in the caller's `Surface`.
+        let surface = pending.as_mut().map(|p| (p.loader.clone(), std::mem::take(&mut p.raw)));
+        drop(pending);
         // Move the instance parts into the device, which now owns their destruction.
         let inst = ManuallyDrop::new(inst);
         // SAFETY: each field is read exactly once out of a ManuallyDrop that is never dropped.
@@ -451,8 +545,15 @@ impl Context {
             sampler,
             info,
         };
-        dev.check_validation()?;
-        Ok(Context { dev: Arc::new(dev) })
+        let ctx = Context { dev: Arc::new(dev) };
+        if let Err(e) = ctx.dev.check_validation() {
+            if let Some((loader, raw)) = surface {
+                // SAFETY: nothing else uses the surface yet.
+                unsafe { loader.destroy_surface(raw, None) };
+            }
+            return Err(e);
+        }
+        Ok((ctx, surface))
     }
 
     /// Default options: device from `TEXGEO_DEVICE`, validation from `TEXGEO_VALIDATION`.
@@ -464,6 +565,12 @@ impl Context {
         &self.dev.info
     }
 
+    /// Allocations gpu-allocator holds for this device right now (buffers and textures
+    /// alive); a program that dropped all its resources must see 0.
+    pub fn live_allocations(&self) -> usize {
+        self.dev.allocator.lock().map(|a| a.generate_report().allocations.len()).unwrap_or(0)
+    }
+
     /// Whether the validation layer is on for this context.
     pub fn validating(&self) -> bool {
         self.dev.log.is_some()
@@ -472,6 +579,16 @@ impl Context {
     /// Records commands with `record`, submits them, waits, and reports validation errors.
     /// The one-shot style of the texture era: upload, draw, read back, done.
     pub fn submit<T>(&self, record: impl FnOnce(&mut Recorder) -> Result<T>) -> Result<T> {
+        self.submit_synced(None, record)
+    }
+
+    /// Like [`Context::submit`]; with `sync`, the submission waits on the first semaphore
+    /// (before its transfers) and signals the second (a swapchain frame).
+    pub(crate) fn submit_synced<T>(
+        &self,
+        sync: Option<(vk::Semaphore, vk::Semaphore)>,
+        record: impl FnOnce(&mut Recorder) -> Result<T>,
+    ) -> Result<T> {
         let dev = &self.dev;
         let pool =
             dev.command_pool.lock().map_err(|_| GpuError::Usage("command pool lock poisoned".into()))?;
@@ -493,12 +610,31 @@ impl Context {
             let fence_info = vk::FenceCreateInfo::default();
             // SAFETY: valid device.
             let fence = unsafe { dev.raw.create_fence(&fence_info, None) }.vk("vkCreateFence")?;
-            let cmds = [cmd];
-            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let waits: Vec<_> = sync
+                .iter()
+                .map(|&(wait, _)| {
+                    vk::SemaphoreSubmitInfo::default()
+                        .semaphore(wait)
+                        .stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+                })
+                .collect();
+            let signals: Vec<_> = sync
+                .iter()
+                .map(|&(_, signal)| {
+                    vk::SemaphoreSubmitInfo::default()
+                        .semaphore(signal)
+                        .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                })
+                .collect();
+            let submit = [vk::SubmitInfo2::default()
+                .command_buffer_infos(&cmds)
+                .wait_semaphore_infos(&waits)
+                .signal_semaphore_infos(&signals)];
             let waited = (|| {
                 let queue = dev.queue.lock().map_err(|_| GpuError::Usage("queue lock poisoned".into()))?;
                 // SAFETY: the command buffer is complete; the fence is unsignalled.
-                unsafe { dev.raw.queue_submit(*queue, &submit, fence) }.vk("vkQueueSubmit")?;
+                unsafe { dev.raw.queue_submit2(*queue, &submit, fence) }.vk("vkQueueSubmit2")?;
                 drop(queue);
                 // SAFETY: waiting on our own fence.
                 unsafe { dev.raw.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")

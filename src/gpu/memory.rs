@@ -64,7 +64,7 @@ impl Buffer {
         Ok(buffer)
     }
 
-    /// A buffer holding `data`, usable as vertex input, uniform block and copy source.
+    /// A buffer holding `data`, usable as vertex input, index list, uniform block and copy source.
     pub fn with_data<T: Pod>(ctx: &Context, data: &[T], name: &str) -> Result<Buffer> {
         let bytes = as_bytes(data);
         let mut b =
@@ -90,6 +90,7 @@ impl Buffer {
 
     const HOST_USAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(
         vk::BufferUsageFlags::VERTEX_BUFFER.as_raw()
+            | vk::BufferUsageFlags::INDEX_BUFFER.as_raw()
             | vk::BufferUsageFlags::UNIFORM_BUFFER.as_raw()
             | vk::BufferUsageFlags::TRANSFER_SRC.as_raw(),
     );

@@ -69,11 +69,28 @@ impl<'d> Recorder<'d> {
         Recorder { dev, cmd, keep: Vec::new() }
     }
 
+    /// The command buffer being recorded (for the swapchain's copy, in `present`).
+    pub(crate) fn command_buffer(&self) -> vk::CommandBuffer {
+        self.cmd
+    }
+
     fn check(&self, tex: &Texture) -> Result<()> {
         if tex.same_device(&super::Context { dev: self.dev.clone() }) {
             Ok(())
         } else {
             Err(GpuError::Usage("a texture from another device was used".into()))
+        }
+    }
+
+    fn check_copyable(&self, tex: &Texture) -> Result<()> {
+        if tex.copyable() {
+            Ok(())
+        } else {
+            Err(GpuError::Usage(format!(
+                "a {}-sample {:?} target cannot be copied or sampled (resolve it first)",
+                tex.samples(),
+                tex.format()
+            )))
         }
     }
 
@@ -104,7 +121,7 @@ impl<'d> Recorder<'d> {
                 .image(tex.image)
                 .subresource_range(
                     vk::ImageSubresourceRange::default()
-                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .aspect_mask(tex.format().aspect())
                         .level_count(1)
                         .layer_count(vk::REMAINING_ARRAY_LAYERS),
                 )];
@@ -131,6 +148,7 @@ impl<'d> Recorder<'d> {
     /// layer `layer` of `tex`; the rest of the texture keeps its contents.
     pub fn upload_region<T: Pod>(&mut self, tex: &Texture, layer: u32, rect: Rect, data: &[T]) -> Result<()> {
         self.check(tex)?;
+        self.check_copyable(tex)?;
         let bytes = as_bytes(data);
         let [x, y, w, h] = rect;
         let expected = w as u64 * h as u64 * tex.format().bytes_per_texel();
@@ -182,6 +200,7 @@ impl<'d> Recorder<'d> {
     /// Fills every layer of `tex` with zero.
     pub fn clear(&mut self, tex: &Texture) -> Result<()> {
         self.check(tex)?;
+        self.check_copyable(tex)?;
         self.use_texture(tex, Use::CopyDst);
         let range = [vk::ImageSubresourceRange::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
@@ -232,6 +251,7 @@ impl<'d> Recorder<'d> {
         offset: u64,
     ) -> Result<()> {
         self.check(tex)?;
+        self.check_copyable(tex)?;
         let [x, y, w, h] = rect;
         let size = w as u64 * h as u64 * layers.len() as u64 * tex.format().bytes_per_texel();
         if layers.is_empty()
@@ -318,58 +338,163 @@ impl<'d> Recorder<'d> {
         reads: &'p [&'p Texture],
         draw: impl FnOnce(&mut RenderScope<'_, 'p>) -> Result<T>,
     ) -> Result<T> {
-        let first = targets.first().ok_or_else(|| GpuError::Usage("a render pass needs a target".into()))?;
+        self.render_into(Targets { colour: targets, resolve: &[], depth: None }, area, reads, draw)
+    }
+
+    /// A render pass with a depth buffer and/or multisampled colour targets resolved at its
+    /// end (pictures of meshes); otherwise like [`Recorder::render`].
+    pub fn render_into<'p, T>(
+        &mut self,
+        targets: Targets,
+        area: Option<Rect>,
+        reads: &'p [&'p Texture],
+        draw: impl FnOnce(&mut RenderScope<'_, 'p>) -> Result<T>,
+    ) -> Result<T> {
+        let first =
+            targets.colour.first().ok_or_else(|| GpuError::Usage("a render pass needs a target".into()))?;
         let area = area.unwrap_or([0, 0, first.texture.width(), first.texture.height()]);
-        for a in targets {
-            self.check(a.texture)?;
+        let samples = first.texture.samples();
+        let fits = |t: &Texture| {
             let [x, y, w, h] = area;
-            if x + w > a.texture.width() || y + h > a.texture.height() || w == 0 || h == 0 {
+            if x + w > t.width() || y + h > t.height() || w == 0 || h == 0 {
                 return Err(GpuError::Usage(format!(
                     "render area {area:?} does not fit a {}×{} target",
-                    a.texture.width(),
-                    a.texture.height()
+                    t.width(),
+                    t.height()
                 )));
             }
-            if reads.iter().any(|r| std::ptr::eq(*r, a.texture)) {
+            if reads.iter().any(|r| std::ptr::eq(*r, t)) {
                 return Err(GpuError::Usage("a texture cannot be read and rendered in the same pass".into()));
+            }
+            Ok(())
+        };
+        for a in targets.colour {
+            self.check(a.texture)?;
+            fits(a.texture)?;
+            if a.texture.format().is_depth() || a.texture.samples() != samples {
+                return Err(GpuError::Usage(format!(
+                    "colour targets must be colour formats with one sample count ({:?} with {} samples)",
+                    a.texture.format(),
+                    a.texture.samples()
+                )));
+            }
+        }
+        if !targets.resolve.is_empty() {
+            if targets.resolve.len() != targets.colour.len() || samples == 1 {
+                return Err(GpuError::Usage(
+                    "resolve targets need one per multisampled colour target".into(),
+                ));
+            }
+            for (r, a) in targets.resolve.iter().zip(targets.colour) {
+                self.check(r)?;
+                fits(r)?;
+                if !r.copyable() || r.format() != a.texture.format() {
+                    return Err(GpuError::Usage(format!(
+                        "cannot resolve {:?} into a {}-sample {:?} texture",
+                        a.texture.format(),
+                        r.samples(),
+                        r.format()
+                    )));
+                }
+            }
+        }
+        if let Some(d) = &targets.depth {
+            self.check(d.texture)?;
+            fits(d.texture)?;
+            if !d.texture.format().is_depth() || d.texture.samples() != samples {
+                return Err(GpuError::Usage(format!(
+                    "the depth target is a {}-sample {:?} texture; a {samples}-sample depth format is needed",
+                    d.texture.samples(),
+                    d.texture.format()
+                )));
             }
         }
         for r in reads {
             self.check(r)?;
             self.use_texture(r, Use::Sampled);
         }
-        let mut infos = Vec::with_capacity(targets.len());
-        for a in targets {
+        let load_op = |load: Load| match load {
+            Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearColorValue::default()),
+            Load::Zero => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: [0; 4] }),
+            Load::Float(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { float32: v }),
+            Load::Uint(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: v }),
+            Load::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ClearColorValue::default()),
+        };
+        let mut infos = Vec::with_capacity(targets.colour.len());
+        for (i, a) in targets.colour.iter().enumerate() {
             self.use_texture(a.texture, Use::Attachment);
-            let (load_op, clear) = match a.load {
-                Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearColorValue::default()),
-                Load::Zero => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: [0; 4] }),
-                Load::Float(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { float32: v }),
-                Load::Uint(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: v }),
-                Load::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ClearColorValue::default()),
-            };
-            infos.push(
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(a.texture.target_view(a.layer)?)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(load_op)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { color: clear }),
-            );
+            let (op, clear) = load_op(a.load);
+            let mut info = vk::RenderingAttachmentInfo::default()
+                .image_view(a.texture.target_view(a.layer)?)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(op)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { color: clear });
+            if let Some(r) = targets.resolve.get(i) {
+                self.use_texture(r, Use::Attachment);
+                info = info
+                    .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                    .resolve_image_view(r.target_view(0)?)
+                    .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+            }
+            infos.push(info);
         }
+        let depth_info = match &targets.depth {
+            Some(d) => {
+                self.use_texture(d.texture, Use::Depth);
+                let (op, clear) = load_op(d.load);
+                // SAFETY: every Load variant writes the first four bytes of the union.
+                let value = unsafe { clear.float32[0] };
+                Some(
+                    vk::RenderingAttachmentInfo::default()
+                        .image_view(d.texture.target_view(0)?)
+                        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                        .load_op(op)
+                        .store_op(vk::AttachmentStoreOp::STORE)
+                        .clear_value(vk::ClearValue {
+                            depth_stencil: vk::ClearDepthStencilValue { depth: value, stencil: 0 },
+                        }),
+                )
+            }
+            None => None,
+        };
         let rect = vk::Rect2D {
             offset: vk::Offset2D { x: area[0] as i32, y: area[1] as i32 },
             extent: vk::Extent2D { width: area[2], height: area[3] },
         };
-        let info = vk::RenderingInfo::default().render_area(rect).layer_count(1).color_attachments(&infos);
+        let mut info =
+            vk::RenderingInfo::default().render_area(rect).layer_count(1).color_attachments(&infos);
+        if let Some(d) = &depth_info {
+            info = info.depth_attachment(d);
+        }
         // SAFETY: attachments transitioned above; they outlive the submission.
         unsafe { self.dev.raw.cmd_begin_rendering(self.cmd, &info) };
-        let mut scope = RenderScope { dev: self.dev, cmd: self.cmd, area, targets, reads, pipeline: None };
+        let mut scope = RenderScope {
+            dev: self.dev,
+            cmd: self.cmd,
+            area,
+            targets: targets.colour,
+            depth: targets.depth.map(|d| d.texture.format()),
+            samples,
+            reads,
+            pipeline: None,
+        };
         let result = draw(&mut scope);
         // SAFETY: matches the begin above, also when `draw` failed.
         unsafe { self.dev.raw.cmd_end_rendering(self.cmd) };
         result
     }
+}
+
+/// The attachments of a render pass that draws pictures: colour targets, the
+/// single-sample textures multisampled ones resolve into, and a depth buffer.
+#[derive(Clone, Copy)]
+pub struct Targets<'a> {
+    pub colour: &'a [Attachment<'a>],
+    /// One single-sample texture per colour target (multisampled targets only), or none.
+    pub resolve: &'a [&'a Texture],
+    /// A depth buffer (`Load::Float([d, ..])` clears it to d).
+    pub depth: Option<Attachment<'a>>,
 }
 
 /// Inside a render pass: bind a pipeline and its inputs, then draw.
@@ -378,6 +503,8 @@ pub struct RenderScope<'r, 'p> {
     cmd: vk::CommandBuffer,
     area: Rect,
     targets: &'r [Attachment<'r>],
+    depth: Option<TexFormat>,
+    samples: u32,
     reads: &'p [&'p Texture],
     pipeline: Option<&'p Pipeline>,
 }
@@ -390,6 +517,12 @@ impl<'p> RenderScope<'_, 'p> {
             return Err(GpuError::Usage(format!(
                 "pipeline {} renders {:?} but the pass targets are {formats:?}",
                 pipeline.name, pipeline.targets
+            )));
+        }
+        if pipeline.samples != self.samples || pipeline.depth != self.depth {
+            return Err(GpuError::Usage(format!(
+                "pipeline {} renders {} samples with depth {:?}, the pass {} samples with depth {:?}",
+                pipeline.name, pipeline.samples, pipeline.depth, self.samples, self.depth
             )));
         }
         // SAFETY: recording inside a compatible dynamic-rendering pass.
@@ -562,6 +695,39 @@ impl<'p> RenderScope<'_, 'p> {
                 vertices.end - vertices.start,
                 instances.end - instances.start,
                 vertices.start,
+                instances.start,
+            )
+        };
+        Ok(())
+    }
+
+    /// Binds `buffer` (u32 indices) for [`RenderScope::draw_indexed`].
+    pub fn index_buffer(&mut self, buffer: &Buffer) -> Result<()> {
+        self.bound()?;
+        // SAFETY: buffer alive for the submission; made with index-buffer usage.
+        unsafe { self.dev.raw.cmd_bind_index_buffer(self.cmd, buffer.raw, 0, vk::IndexType::UINT32) };
+        Ok(())
+    }
+
+    /// Draws the vertices listed at `indices` of the bound index buffer, `instances` times.
+    pub fn draw_indexed(
+        &mut self,
+        indices: std::ops::Range<u32>,
+        instances: std::ops::Range<u32>,
+    ) -> Result<()> {
+        self.bound()?;
+        if indices.is_empty() || instances.is_empty() {
+            return Ok(());
+        }
+        // SAFETY: pipeline bound; index and vertex buffers are the caller's responsibility
+        // (validation checks).
+        unsafe {
+            self.dev.raw.cmd_draw_indexed(
+                self.cmd,
+                indices.end - indices.start,
+                instances.end - instances.start,
+                indices.start,
+                0,
                 instances.start,
             )
         };

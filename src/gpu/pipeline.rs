@@ -44,6 +44,32 @@ pub struct PipelineDesc<'a> {
     pub per_instance: &'a [u32],
 }
 
+/// Fixed-function state of pipelines that draw pictures (depth-tested, possibly
+/// multisampled); `Raster::default()` is what the GPGPU passes use: no depth buffer, one
+/// sample, no culling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Raster {
+    /// Depth test against a `Depth32F` target: `Less` for surfaces, `LessOrEqual` for
+    /// lines drawn over them; every tested fragment that passes writes its depth.
+    pub depth: DepthTest,
+    /// Samples per pixel of the targets (1 = no multisampling).
+    pub samples: u32,
+}
+
+impl Default for Raster {
+    fn default() -> Raster {
+        Raster { depth: DepthTest::Off, samples: 1 }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthTest {
+    /// No depth buffer.
+    Off,
+    Less,
+    LessOrEqual,
+}
+
 /// A descriptor binding the pipeline expects (set 0, pushed per draw).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum BindingKind {
@@ -62,6 +88,9 @@ pub struct Pipeline {
     pub(crate) bindings: BTreeMap<u32, BindingKind>,
     pub(crate) push: Option<(vk::ShaderStageFlags, u32, u32)>,
     pub(crate) targets: Vec<TexFormat>,
+    /// Depth format of the pass (`None`: no depth buffer) and samples per pixel.
+    pub(crate) depth: Option<TexFormat>,
+    pub(crate) samples: u32,
     /// Byte strides of binding 0 (per vertex) and binding 1 (per instance).
     pub(crate) strides: [u32; 2],
     pub(crate) name: String,
@@ -197,6 +226,11 @@ fn vertex_inputs(shader: &Shader, r: &Reflection) -> Result<Vec<VertexInput>> {
 
 impl Pipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<Pipeline> {
+        Pipeline::with_raster(ctx, desc, &Raster::default())
+    }
+
+    /// A pipeline with a depth test and/or multisampling (see [`Raster`]).
+    pub fn with_raster(ctx: &Context, desc: &PipelineDesc, state: &Raster) -> Result<Pipeline> {
         let dev = ctx.dev.clone();
         let name = format!("{} + {}", desc.vertex.path, desc.fragment.path);
         if desc.blend == Blend::Xor {
@@ -323,6 +357,8 @@ impl Pipeline {
             bindings: bindings.iter().map(|(&b, &(k, _))| (b, k)).collect(),
             push,
             targets: desc.targets.to_vec(),
+            depth: (state.depth != DepthTest::Off).then_some(TexFormat::Depth32F),
+            samples: state.samples,
             strides,
             name,
         };
@@ -369,8 +405,21 @@ impl Pipeline {
             .cull_mode(vk::CullModeFlags::NONE)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
+        if !state.samples.is_power_of_two() || dev.info.colour_samples & state.samples == 0 {
+            return Err(GpuError::Unsupported(format!(
+                "{}: device '{}' offers no {}-sample targets",
+                pipeline.name, dev.info.name, state.samples
+            )));
+        }
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+            .rasterization_samples(vk::SampleCountFlags::from_raw(state.samples));
+        let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(state.depth != DepthTest::Off)
+            .depth_write_enable(state.depth != DepthTest::Off)
+            .depth_compare_op(match state.depth {
+                DepthTest::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
+                _ => vk::CompareOp::LESS,
+            });
         let attachments: Vec<_> = desc
             .targets
             .iter()
@@ -398,6 +447,9 @@ impl Pipeline {
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let formats: Vec<_> = desc.targets.iter().map(|f| f.vk()).collect();
         let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
+        if let Some(d) = pipeline.depth {
+            rendering = rendering.depth_attachment_format(d.vk());
+        }
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)
             .vertex_input_state(&vertex_input)
@@ -405,6 +457,7 @@ impl Pipeline {
             .viewport_state(&viewport)
             .rasterization_state(&raster)
             .multisample_state(&multisample)
+            .depth_stencil_state(&depth_state)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
             .layout(pipeline.layout)

@@ -22,8 +22,10 @@ pub enum TexFormat {
     R32Ui,
     /// XOR accumulation, one bit per texel.
     R8Ui,
-    /// Pictures (aspect function, PNG output).
+    /// Pictures (aspect function, PNG output, rendered meshes).
     Rgba8,
+    /// Depth buffer of a rendered picture (a depth attachment, never sampled).
+    Depth32F,
 }
 
 impl TexFormat {
@@ -34,13 +36,14 @@ impl TexFormat {
             TexFormat::R32Ui => vk::Format::R32_UINT,
             TexFormat::R8Ui => vk::Format::R8_UINT,
             TexFormat::Rgba8 => vk::Format::R8G8B8A8_UNORM,
+            TexFormat::Depth32F => vk::Format::D32_SFLOAT,
         }
     }
 
     pub fn bytes_per_texel(self) -> u64 {
         match self {
             TexFormat::Rgba32F => 16,
-            TexFormat::R32F | TexFormat::R32Ui | TexFormat::Rgba8 => 4,
+            TexFormat::R32F | TexFormat::R32Ui | TexFormat::Rgba8 | TexFormat::Depth32F => 4,
             TexFormat::R8Ui => 1,
         }
     }
@@ -48,6 +51,14 @@ impl TexFormat {
     /// Integer formats are the ones logic ops apply to (float targets ignore them).
     pub fn is_integer(self) -> bool {
         matches!(self, TexFormat::R32Ui | TexFormat::R8Ui)
+    }
+
+    pub fn is_depth(self) -> bool {
+        self == TexFormat::Depth32F
+    }
+
+    pub(crate) fn aspect(self) -> vk::ImageAspectFlags {
+        if self.is_depth() { vk::ImageAspectFlags::DEPTH } else { vk::ImageAspectFlags::COLOR }
     }
 }
 
@@ -58,6 +69,8 @@ pub(crate) enum Use {
     Attachment,
     CopySrc,
     CopyDst,
+    /// Depth attachment (tested and written by a render pass).
+    Depth,
 }
 
 impl Use {
@@ -67,6 +80,7 @@ impl Use {
             Use::Attachment => vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
             Use::CopySrc => vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             Use::CopyDst => vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            Use::Depth => vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
         }
     }
 
@@ -74,7 +88,11 @@ impl Use {
         match self {
             Use::Sampled => vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER,
             Use::Attachment => vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-            Use::CopySrc | Use::CopyDst => vk::PipelineStageFlags2::COPY,
+            // Blits too: a window's frame is a blit of the rendered picture.
+            Use::CopySrc | Use::CopyDst => vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::BLIT,
+            Use::Depth => {
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS
+            }
         }
     }
 
@@ -87,11 +105,15 @@ impl Use {
             }
             Use::CopySrc => vk::AccessFlags2::TRANSFER_READ,
             Use::CopyDst => vk::AccessFlags2::TRANSFER_WRITE,
+            Use::Depth => {
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+            }
         }
     }
 
     pub fn writes(self) -> bool {
-        matches!(self, Use::Attachment | Use::CopyDst)
+        matches!(self, Use::Attachment | Use::CopyDst | Use::Depth)
     }
 }
 
@@ -111,6 +133,7 @@ pub struct Texture {
     width: u32,
     height: u32,
     layers: u32,
+    samples: u32,
     /// The use recorded last; `None` before the first use (undefined contents).
     pub(crate) last_use: Cell<Option<Use>>,
 }
@@ -130,6 +153,31 @@ impl Texture {
         layers: u32,
         name: &str,
     ) -> Result<Texture> {
+        if format.is_depth() {
+            return Err(GpuError::Usage(format!(
+                "texture '{name}': depth buffers are made with Texture::target"
+            )));
+        }
+        Texture::create(ctx, format, [width, height, layers], 1, name)
+    }
+
+    /// A render target for pictures: a colour (`Rgba8`, …) or depth (`Depth32F`) attachment
+    /// with `samples` samples per pixel (1, 2, 4 or 8: what the device offers). A
+    /// single-sample colour target can also be sampled and copied like any texture; a
+    /// multisampled one is only rendered into and resolved, a depth buffer only tested.
+    pub fn target(
+        ctx: &Context,
+        format: TexFormat,
+        width: u32,
+        height: u32,
+        samples: u32,
+        name: &str,
+    ) -> Result<Texture> {
+        Texture::create(ctx, format, [width, height, 1], samples, name)
+    }
+
+    fn create(ctx: &Context, format: TexFormat, size: [u32; 3], samples: u32, name: &str) -> Result<Texture> {
+        let [width, height, layers] = size;
         let info = &ctx.dev.info;
         if width == 0 || height == 0 || layers == 0 {
             return Err(GpuError::Usage(format!(
@@ -146,13 +194,33 @@ impl Texture {
         let dev = ctx.dev.clone();
         // SAFETY: plain query on the context's physical device.
         let props = unsafe { dev.instance.get_physical_device_format_properties(dev.physical, format.vk()) };
-        let needed = vk::FormatFeatureFlags::SAMPLED_IMAGE
-            | vk::FormatFeatureFlags::COLOR_ATTACHMENT
-            | vk::FormatFeatureFlags::TRANSFER_SRC
-            | vk::FormatFeatureFlags::TRANSFER_DST;
+        let (needed, usage) = if format.is_depth() {
+            (vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)
+        } else if samples > 1 {
+            (vk::FormatFeatureFlags::COLOR_ATTACHMENT, vk::ImageUsageFlags::COLOR_ATTACHMENT)
+        } else {
+            (
+                vk::FormatFeatureFlags::SAMPLED_IMAGE
+                    | vk::FormatFeatureFlags::COLOR_ATTACHMENT
+                    | vk::FormatFeatureFlags::TRANSFER_SRC
+                    | vk::FormatFeatureFlags::TRANSFER_DST,
+                vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
+            )
+        };
         if !props.optimal_tiling_features.contains(needed) {
             return Err(GpuError::Unsupported(format!(
                 "device '{}' cannot sample, render and copy {format:?} textures",
+                info.name
+            )));
+        }
+        let sample_count = vk::SampleCountFlags::from_raw(samples);
+        let offered = if format.is_depth() { info.depth_samples } else { info.colour_samples };
+        if !samples.is_power_of_two() || offered & samples == 0 {
+            return Err(GpuError::Unsupported(format!(
+                "device '{}' offers no {samples}-sample {format:?} targets",
                 info.name
             )));
         }
@@ -162,14 +230,9 @@ impl Texture {
             .extent(vk::Extent3D { width, height, depth: 1 })
             .mip_levels(1)
             .array_layers(layers)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(sample_count)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(
-                vk::ImageUsageFlags::SAMPLED
-                    | vk::ImageUsageFlags::COLOR_ATTACHMENT
-                    | vk::ImageUsageFlags::TRANSFER_SRC
-                    | vk::ImageUsageFlags::TRANSFER_DST,
-            )
+            .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid device and create info.
@@ -185,6 +248,7 @@ impl Texture {
             width,
             height,
             layers,
+            samples,
             last_use: Cell::new(None),
         };
         // From here on `tex`'s Drop cleans up whatever was created if a step fails.
@@ -228,7 +292,7 @@ impl Texture {
             .format(self.format.vk())
             .subresource_range(
                 vk::ImageSubresourceRange::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .aspect_mask(self.format.aspect())
                     .level_count(1)
                     .base_array_layer(base_layer)
                     .layer_count(count),
@@ -251,6 +315,16 @@ impl Texture {
 
     pub fn layers(&self) -> u32 {
         self.layers
+    }
+
+    /// Samples per pixel (1 unless made by [`Texture::target`] with more).
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Whether it can be sampled, uploaded to and copied (single-sample colour textures).
+    pub(crate) fn copyable(&self) -> bool {
+        self.samples == 1 && !self.format.is_depth()
     }
 
     /// Bytes of one layer, tightly packed.

@@ -6,8 +6,10 @@ mod demo;
 mod inclusion;
 mod info;
 mod mesh;
+mod render;
 mod subdivide;
 mod sweep;
+mod view;
 mod voxelize;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +50,10 @@ enum Command {
     Voxelize(voxelize::Args),
     /// Run a task over a mesh collection: each mesh isolated, resumable, shardable; `sweep merge DIR`.
     Sweep(sweep::Args),
+    /// An offscreen picture (PNG) of a mesh, a subdivision level or a voxel volume.
+    Render(render::Args),
+    /// An interactive window: orbit a mesh, step through subdivision levels live, voxels.
+    View(view::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -68,6 +74,8 @@ fn main() {
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
         Command::Sweep(a) => sweep::run(device, a),
+        Command::Render(a) => render::run(device, a),
+        Command::View(a) => view::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");
