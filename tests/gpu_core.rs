@@ -75,6 +75,54 @@ fn xor_overlaps_cancel() {
     }
 }
 
+/// lavapipe draws nothing of a 9-vertex triangle list whose last triangle is degenerate,
+/// and cuts long draws into segments of 4095 vertices, so 4104 or 8199 vertices lose
+/// triangles the same way; `RenderScope::draw` splits such draws. Degenerate triangles
+/// are what the voxelizer's culled cross-sections are. Each real triangle here covers one
+/// texel centre of its own, so every one of them must show.
+#[test]
+fn triangle_draws_lose_no_triangle() {
+    let ctx = ctx();
+    let xor = XorRaster::new(&ctx, TexFormat::R32Ui).unwrap();
+    let n = 128u32;
+    // Every pattern of real and degenerate triangles in draws of 1 to 5 triangles.
+    for k in 1..=5usize {
+        for pattern in 0..1u32 << k {
+            let tris: Vec<_> = (0..k)
+                .map(|t| {
+                    let x = 3.0 * t as f32;
+                    match pattern >> t & 1 {
+                        1 => [[x + 0.1, 0.1], [x + 0.95, 0.1], [x + 0.1, 0.95]],
+                        _ => [[0.0, 0.0]; 3],
+                    }
+                })
+                .collect();
+            let out = xor.rasterize(&ctx, 16, 16, &tris, 1).unwrap();
+            let set = out.iter().filter(|&&v| v != 0).count();
+            assert_eq!(set, pattern.count_ones() as usize, "{k} triangles, pattern {pattern:b}");
+        }
+    }
+    let mut rng = Rng::new(7);
+    for triangles in [1368, 2733, 4098, 1369, 1365] {
+        for _ in 0..4 {
+            let mut tris = Vec::with_capacity(triangles);
+            let mut real = 0usize;
+            for _ in 0..triangles {
+                if rng.next_f64() < 0.5 {
+                    let (x, y) = ((real % n as usize) as f32, (real / n as usize) as f32);
+                    tris.push([[x + 0.1, y + 0.1], [x + 0.95, y + 0.1], [x + 0.1, y + 0.95]]);
+                    real += 1;
+                } else {
+                    tris.push([[0.0, 0.0]; 3]);
+                }
+            }
+            let out = xor.rasterize(&ctx, n, n, &tris, 1).unwrap();
+            let set = out.iter().filter(|&&v| v != 0).count();
+            assert_eq!(set, real, "{} vertices, {real} real triangles", 3 * triangles);
+        }
+    }
+}
+
 #[test]
 fn shared_edge_centre_flips_exactly_once() {
     let ctx = ctx();

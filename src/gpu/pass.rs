@@ -10,7 +10,11 @@ use gpu_allocator::MemoryLocation;
 use super::context::Device;
 use super::error::{GpuError, Result};
 use super::memory::{Buffer, Pod, as_bytes};
-use super::pipeline::{BindingKind, Pipeline};
+use super::pipeline::{BindingKind, Pipeline, Topology};
+
+/// Vertices per segment when lavapipe splits a long triangle-list draw (see
+/// [`RenderScope::draw`]).
+pub const TRIANGLE_SEGMENT: u32 = 4095;
 use super::texture::{TexFormat, Texture, Use};
 use super::timer::Timestamps;
 
@@ -683,12 +687,33 @@ impl<'p> RenderScope<'_, 'p> {
     }
 
     /// Draws `vertices` vertices (points or triangle corners), `instances` times.
+    ///
+    /// lavapipe (Mesa 22.3) draws nothing of a triangle list of exactly 9 vertices whose
+    /// last triangle is degenerate, and it cuts long triangle-list draws into segments of
+    /// [`TRIANGLE_SEGMENT`] vertices, so a draw of 4095·q + 9 vertices loses its last
+    /// three triangles the same way (`tests/gpu_core.rs` shows both). The voxelizer's
+    /// culled cross-sections are such degenerate triangles: a zone list of 4104 vertices
+    /// dropped voxels. Such draws are split so no draw or segment holds 9 vertices.
     pub fn draw(&mut self, vertices: std::ops::Range<u32>, instances: std::ops::Range<u32>) -> Result<()> {
-        self.bound()?;
-        if vertices.is_empty() || instances.is_empty() {
-            return Ok(());
+        let pipeline = self.bound()?;
+        let count = vertices.end.saturating_sub(vertices.start);
+        if pipeline.topology == Topology::Triangles && count % TRIANGLE_SEGMENT == 9 {
+            // 6 + 3 vertices, or (4095·q − 3) + 12: every part's last segment is safe.
+            let split = vertices.end - if count == 9 { 3 } else { 12 };
+            self.draw_once(vertices.start..split, instances.clone());
+            self.draw_once(split..vertices.end, instances);
+        } else {
+            self.draw_once(vertices, instances);
         }
-        // SAFETY: pipeline bound; vertex buffers are the caller's responsibility (validation checks).
+        Ok(())
+    }
+
+    fn draw_once(&mut self, vertices: std::ops::Range<u32>, instances: std::ops::Range<u32>) {
+        if vertices.is_empty() || instances.is_empty() {
+            return;
+        }
+        // SAFETY: pipeline bound (checked by `draw`); vertex buffers are the caller's
+        // responsibility (validation checks).
         unsafe {
             self.dev.raw.cmd_draw(
                 self.cmd,
@@ -698,7 +723,6 @@ impl<'p> RenderScope<'_, 'p> {
                 instances.start,
             )
         };
-        Ok(())
     }
 
     /// Binds `buffer` (u32 indices) for [`RenderScope::draw_indexed`].

@@ -93,6 +93,7 @@ pub struct Pipeline {
     pub(crate) samples: u32,
     /// Byte strides of binding 0 (per vertex) and binding 1 (per instance).
     pub(crate) strides: [u32; 2],
+    pub(crate) topology: Topology,
     pub(crate) name: String,
 }
 
@@ -360,6 +361,7 @@ impl Pipeline {
             depth: (state.depth != DepthTest::Off).then_some(TexFormat::Depth32F),
             samples: state.samples,
             strides,
+            topology: desc.topology,
             name,
         };
         // From here on, Drop of `pipeline` destroys whatever was created if a step fails.
