@@ -8,6 +8,24 @@ mod timing;
 pub use table::{Report, Table};
 pub use timing::{Samples, time_runs, timed};
 
+/// Where a long measurement says what it is doing: `texgeo bench` prints a line per
+/// step, `texgeo reproduce` advances a progress bar.
+pub trait Progress {
+    /// How many steps follow (called once, before the first step).
+    fn total(&mut self, _steps: u64) {}
+    /// A step starts.
+    fn step(&mut self, what: &str);
+}
+
+/// Prints every step on standard error after a prefix (`bench inclusion: …`).
+pub struct Log(pub &'static str);
+
+impl Progress for Log {
+    fn step(&mut self, what: &str) {
+        eprintln!("{}: {what}", self.0);
+    }
+}
+
 /// Where and on what a measurement was made; printed at the top of every report.
 #[derive(Clone, Debug)]
 pub struct Environment {
