@@ -2,6 +2,8 @@
 //! and CSV, and the description of the machine and device that produced them.
 
 pub mod bench;
+pub mod plot;
+pub mod reproduce;
 mod table;
 mod timing;
 
@@ -11,7 +13,8 @@ pub use timing::{Samples, time_runs, timed};
 /// Where a long measurement says what it is doing: `texgeo bench` prints a line per
 /// step, `texgeo reproduce` advances a progress bar.
 pub trait Progress {
-    /// How many steps follow (called once, before the first step).
+    /// How many more steps follow (called before them; a run of several parts calls it
+    /// once per part).
     fn total(&mut self, _steps: u64) {}
     /// A step starts.
     fn step(&mut self, what: &str);

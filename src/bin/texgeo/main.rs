@@ -7,6 +7,7 @@ mod inclusion;
 mod info;
 mod mesh;
 mod render;
+mod reproduce;
 mod subdivide;
 mod sweep;
 mod view;
@@ -54,6 +55,9 @@ enum Command {
     Render(render::Args),
     /// An interactive window: orbit a mesh, step through subdivision levels live, voxels.
     View(view::Args),
+    /// Every experiment of both theses in one report: tables beside the thesis', plots,
+    /// pictures and a verdict on every claim (`--compare OLD NEW` compares two runs).
+    Reproduce(reproduce::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -76,6 +80,7 @@ fn main() {
         Command::Sweep(a) => sweep::run(device, a),
         Command::Render(a) => render::run(device, a),
         Command::View(a) => view::run(device, a),
+        Command::Reproduce(a) => reproduce::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");

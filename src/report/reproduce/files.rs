@@ -1,0 +1,96 @@
+//! Output files of a reproduction: every file is written whole or not at all (a
+//! temporary file in the same folder, then renamed over the target), and the output
+//! folder is checked writable before a run that takes minutes starts.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::{ReproduceError, Result};
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ReproduceError + '_ {
+    move |source| ReproduceError::Io { path: path.to_path_buf(), source }
+}
+
+/// Writes `bytes` to `path` atomically: readers see the old file or the whole new one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| ReproduceError::Usage(format!("{}: not a file name", path.display())))?;
+    let tmp = path.with_file_name(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
+    let written = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(io(path))
+}
+
+/// Creates `dir` (and its parents) if needed and checks a file can be created in it.
+pub fn check_writable(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(ReproduceError::Usage(format!("{}: exists and is not a folder", dir.display())));
+    }
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let probe = dir.join(format!(".texgeo-write-test{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(io(dir))?;
+    std::fs::remove_file(&probe).map_err(io(&probe))
+}
+
+/// The folders of a report: `csv/`, `plots/`, `figures/` under the output folder.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    pub root: PathBuf,
+}
+
+impl Layout {
+    pub const CSV: &'static str = "csv";
+    pub const PLOTS: &'static str = "plots";
+    pub const FIGURES: &'static str = "figures";
+
+    /// Checks `root` writable and creates the sub-folders.
+    pub fn create(root: &Path) -> Result<Layout> {
+        check_writable(root)?;
+        for sub in [Layout::CSV, Layout::PLOTS, Layout::FIGURES] {
+            let dir = root.join(sub);
+            std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        }
+        Ok(Layout { root: root.to_path_buf() })
+    }
+
+    /// `root/relative`, written atomically.
+    pub fn write(&self, relative: &str, bytes: &[u8]) -> Result<PathBuf> {
+        let path = self.root.join(relative);
+        write_atomic(&path, bytes)?;
+        Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_replaces_whole_files_and_leaves_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("texgeo-files-{}", std::process::id()));
+        check_writable(&dir).unwrap();
+        let path = dir.join("a.txt");
+        write_atomic(&path, b"first").unwrap();
+        write_atomic(&path, b"second").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"second");
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("a.txt")]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_file_in_the_way_is_not_a_folder() {
+        let file = std::env::temp_dir().join(format!("texgeo-notdir-{}", std::process::id()));
+        std::fs::write(&file, b"x").unwrap();
+        assert!(matches!(check_writable(&file), Err(ReproduceError::Usage(_))));
+        std::fs::remove_file(&file).unwrap();
+    }
+}
