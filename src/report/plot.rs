@@ -67,9 +67,10 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
-/// Size of every chart, pixels.
-pub const WIDTH: u32 = 900;
+/// Size of every chart, pixels: the plot, and the legend in a column on its right.
+pub const WIDTH: u32 = 1000;
 pub const HEIGHT: u32 = 560;
+const LEGEND: u32 = 250;
 
 const PALETTE: [RGBColor; 10] = [
     RGBColor(0x1f, 0x77, 0xb4),
@@ -165,7 +166,8 @@ impl Chart {
     {
         let err = |e: &dyn std::fmt::Display| e.to_string();
         root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(root)
+        let (plot, legend) = root.split_horizontally(WIDTH - LEGEND);
+        let mut chart = ChartBuilder::on(&plot)
             .caption(&self.title, ("sans-serif", 20))
             .margin(14)
             .x_label_area_size(48)
@@ -201,29 +203,34 @@ impl Chart {
             if s.thesis {
                 chart
                     .draw_series(DashedLineSeries::new(pts.clone(), 7, 5, c.stroke_width(2)))
-                    .map_err(|e| err(&e))?
-                    .label(&s.label)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 10, y)], c.stroke_width(2)));
+                    .map_err(|e| err(&e))?;
                 chart
                     .draw_series(pts.iter().map(|&p| TriangleMarker::new(p, 5, c.stroke_width(1))))
                     .map_err(|e| err(&e))?;
             } else {
+                chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2))).map_err(|e| err(&e))?;
                 chart
-                    .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-                    .map_err(|e| err(&e))?
-                    .label(&s.label)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-                chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(|e| err(&e))?;
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))
+                    .map_err(|e| err(&e))?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font(("sans-serif", 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
+        // The legend in its own column, so it never hides a curve.
+        for (i, s) in self.series.iter().enumerate() {
+            let c = PALETTE[s.colour % PALETTE.len()];
+            let y = 50 + 20 * i as i32;
+            if s.thesis {
+                for x in [8, 22] {
+                    legend.draw(&PathElement::new(vec![(x, y), (x + 9, y)], c.stroke_width(2))).map_err(|e| err(&e))?;
+                }
+                legend.draw(&TriangleMarker::new((20, y), 5, c.stroke_width(1))).map_err(|e| err(&e))?;
+            } else {
+                legend.draw(&PathElement::new(vec![(8, y), (32, y)], c.stroke_width(2))).map_err(|e| err(&e))?;
+                legend.draw(&Circle::new((20, y), 4, c.filled())).map_err(|e| err(&e))?;
+            }
+            legend
+                .draw(&Text::new(s.label.clone(), (40, y - 7), ("sans-serif", 13).into_font().color(&BLACK)))
+                .map_err(|e| err(&e))?;
+        }
         Ok(())
     }
 }

@@ -117,11 +117,7 @@ pub fn steps(models: usize, cfg: &Config) -> u64 {
 /// Whether an error means "this device cannot run the method" (a row to mark) rather
 /// than a failure of the run.
 fn unsupported(e: &VoxelError) -> bool {
-    match e {
-        VoxelError::Gpu(crate::gpu::GpuError::Unsupported(_)) => true,
-        VoxelError::Usage(m) => m.contains("has no logic op"),
-        _ => false,
-    }
+    matches!(e, VoxelError::Gpu(crate::gpu::GpuError::Unsupported(_)))
 }
 
 /// Every method at every resolution on every model, each compared with `scanline`.

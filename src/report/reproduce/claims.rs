@@ -7,7 +7,7 @@
 //! 1; "much", "considerably", "greatly" — at least 2×; "drastically", "enormously", "the
 //! vast majority" — at least 10× (90 %); "linear" — a log–log slope between 0.8 and 1.2;
 //! "close" — within a factor of 2; "equal or better" — not slower beyond the range of the
-//! repeated runs.
+//! repeated runs (within 5 % for single numbers, such as the thesis').
 
 use super::facts::{Facts, Stat, geomean, loglog_slope, spearman};
 
@@ -501,7 +501,9 @@ fn mp_never_slower(f: &Facts) -> Measure {
         let (p, z) = (voxel_get(&t, m, *n, "pgpu").copied(), voxel_get(&t, m, *n, "zoned").copied());
         let (Some(p), Some(z)) = (p, z) else { continue };
         ratios.push(p.value / z.value);
-        if z.value > p.value && !z.overlaps(&p) {
+        // Repeated runs: the ranges overlap. Single numbers (the thesis'): within 5 %.
+        let equal = if p.runs > 1 && z.runs > 1 { z.overlaps(&p) } else { z.value <= p.value * 1.05 };
+        if z.value > p.value && !equal {
             slower.push(format!("{m} {n}³"));
         }
     }
@@ -601,6 +603,9 @@ fn gpu_linear_in_faces(f: &Facts) -> Measure {
         }
     }
     if slopes.is_empty() {
+        if voxel_cells(&t, &["pgpu"]).is_empty() || voxel_cells(&t, &["zoned"]).is_empty() {
+            return Err(missing_cells(&t, &["pgpu", "zoned"], f));
+        }
         return Err("needs models whose sizes span a factor of 2 or more at one resolution".into());
     }
     let lo = slopes.iter().map(|s| s.2).fold(f64::INFINITY, f64::min);
@@ -650,7 +655,7 @@ pub const VOXELIZE: &[Claim] = &[
         source: "2006 §5.4.2",
         quote: "el rendimiento obtenido siempre es igual o mejor que utilizando una sola pasada",
         claim: "the multi-pass GPU version (PGPU-MP, `zoned`) is never slower than the single-pass one (PGPU)",
-        rule: "zoned ≤ pgpu, or their runs overlap, at every model and N",
+        rule: "zoned ≤ pgpu at every model and N, or equal: their runs overlap (single numbers: within 5 %)",
         measure: mp_never_slower,
     },
     Claim {

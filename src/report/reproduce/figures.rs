@@ -150,8 +150,9 @@ pub fn valence_model() -> Mesh {
 /// coloured by valence (2010 Figs. 27–30).
 pub fn valence_levels(run: &mut Run) -> Result<Vec<Block>> {
     let base = valence_model();
-    let (lo, hi) = base.bounds();
-    let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
+    // The unit sphere's own radius, not its bounding box's, so it fills the picture.
+    let r = DVec3::splat(1.0 / 3f64.sqrt());
+    let camera = Camera::fit(-r, r, Camera::YAW, Camera::PITCH, aspect());
     let look = Look { valence: true, wireframe: false, shading: Shading::Smooth, colour: colour::SURFACE };
     let mut blocks = vec![Block::Para(
         "Valence colours: 3 red, 4 grey, 5 green, 6 blue, 7 magenta, 8 or more yellow, 2 or less cyan. Each level \
@@ -238,7 +239,7 @@ pub fn voxel_aspect(run: &mut Run) -> Result<Vec<Block>> {
     Ok(blocks)
 }
 
-/// Query points on the plane z = 0 through the knot, coloured by the GPU test's answer
+/// Query points on a plane z = const through the knot, coloured by the GPU test's answer
 /// (inside green, outside grey, on the boundary red), with the plane's cut through the
 /// surface in yellow.
 pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
@@ -247,7 +248,8 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
     let pad = (hi - lo) * 0.05;
     let (lo, hi) = (lo - pad, hi + pad);
     let side = 200usize;
-    let z = 0.0;
+    // Near the knot's mid-plane, but off z = 0, where mesh vertices lie.
+    let z = 0.05;
     let points: Vec<DVec3> = (0..side * side)
         .map(|i| {
             let (u, v) = ((i % side) as f64 + 0.5, (i / side) as f64 + 0.5);
@@ -273,7 +275,9 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
     let on = group(Class::OnBoundary, [230, 60, 50, 255]);
     let counts = (inside.positions.len(), outside.positions.len(), on.positions.len());
     let mut scene = Scene::new().with_points(outside).with_points(inside).with_points(on);
-    // The cut of every triangle by the plane.
+    // The cut of every triangle by the plane, lifted a little towards the camera so the
+    // points on the plane do not hide it.
+    let lift = DVec3::new(0.0, 0.0, 1e-3 * (hi - lo).max_element());
     for f in mesh.faces() {
         let corners: Vec<DVec3> = f.iter().map(|&i| mesh.positions()[i as usize]).collect();
         let mut cut = Vec::new();
@@ -284,7 +288,7 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
             }
         }
         if cut.len() == 2 {
-            scene = scene.with_line(Polyline::new(cut, colour::CURVE, 2.0));
+            scene = scene.with_line(Polyline::new(cut.iter().map(|p| *p + lift).collect(), colour::CURVE, 2.0));
         }
     }
     let camera = Camera::fit(DVec3::new(lo.x, lo.y, z), DVec3::new(hi.x, hi.y, z), 0.0, 0.0, aspect());
@@ -294,7 +298,7 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
         model: "builtin:knot".into(),
         camera: camera.into(),
         note: format!(
-            "{} points on z = 0 by `{method}`: {} inside, {} outside, {} on the boundary",
+            "{} points on z = {z} by `{method}`: {} inside, {} outside, {} on the boundary",
             points.len(),
             counts.0,
             counts.1,
@@ -303,7 +307,7 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
         ..FigureRecord::default()
     };
     let caption = format!(
-        "Inclusion slice: {side}×{side} points on the plane z = 0 through the torus knot, classified by `{method}`: \
+        "Inclusion slice: {side}×{side} points on the plane z = {z} through the torus knot, classified by `{method}`: \
          {} inside (green), {} outside (grey), {} on the boundary (red); the plane's cut through the surface in yellow",
         counts.0, counts.1, counts.2
     );

@@ -64,6 +64,26 @@ pub enum ReproduceError {
     Render(#[from] crate::render::RenderError),
 }
 
+impl ReproduceError {
+    /// The device feature missing, when that is why the error happened: such an
+    /// experiment is not measurable on this device rather than failed.
+    pub fn unsupported(&self) -> Option<&str> {
+        use crate::gpu::GpuError::Unsupported;
+        let gpu = match self {
+            ReproduceError::Gpu(g) => g,
+            ReproduceError::Inclusion(crate::inclusion::InclusionError::Gpu(g)) => g,
+            ReproduceError::Voxel(crate::voxel::VoxelError::Gpu(g)) => g,
+            ReproduceError::Subdiv(crate::subdiv::SubdivError::Gpu(g)) => g,
+            ReproduceError::Render(crate::render::RenderError::Gpu(g)) => g,
+            _ => return None,
+        };
+        match gpu {
+            Unsupported(m) => Some(m),
+            _ => None,
+        }
+    }
+}
+
 /// What to run.
 #[derive(Clone, Debug)]
 pub struct Config {
@@ -156,9 +176,13 @@ impl Run<'_> {
         Ok(())
     }
 
-    /// `table` as a block, its cells written to `csv/STEM.csv`.
-    pub fn table(&mut self, table: Table, stem: &str) -> Result<Block> {
+    /// `table` as a block, its cells written to `csv/STEM.csv`. An empty cell (a number
+    /// a thesis table does not have) shows as "–".
+    pub fn table(&mut self, mut table: Table, stem: &str) -> Result<Block> {
         self.unique(&format!("csv/{stem}"))?;
+        for cell in table.rows.iter_mut().flatten().filter(|c| c.trim().is_empty()) {
+            *cell = "–".to_string();
+        }
         let csv = format!("{}/{stem}.csv", Layout::CSV);
         self.layout.write(&csv, table.to_csv().as_bytes())?;
         Ok(Block::Table { table, csv })
@@ -249,10 +273,15 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
                             Err(why) => b.push(Block::Para(format!("Not drawn: {why}."))),
                             Ok(draw) => match draw(&mut r) {
                                 Ok(pics) => b.extend(pics),
-                                Err(err) => {
-                                    failures.push((format!("{}: figure {}", e.key, f.key), err.to_string()));
-                                    b.push(Block::Para(format!("**Figure failed:** {err}")));
-                                }
+                                Err(err) => match err.unsupported() {
+                                    Some(why) => {
+                                        b.push(Block::Para(format!("**Not drawn on this device:** {why}.")))
+                                    }
+                                    None => {
+                                        failures.push((format!("{}: figure {}", e.key, f.key), err.to_string()));
+                                        b.push(Block::Para(format!("**Figure failed:** {err}")));
+                                    }
+                                },
                             },
                         }
                     }
@@ -262,12 +291,19 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
                         blocks.extend(b);
                         "ran".to_string()
                     }
-                    Err(err) => {
-                        today.skipped(e.key, &format!("the experiment failed: {err}"));
-                        failures.push((e.key.to_string(), err.to_string()));
-                        blocks.push(Block::Para(format!("**Failed:** {err}")));
-                        format!("FAILED: {err}")
-                    }
+                    Err(err) => match err.unsupported() {
+                        Some(why) => {
+                            today.skipped(e.key, &format!("not measurable on this device: {why}"));
+                            blocks.push(Block::Para(format!("**Not measurable on this device:** {why}.")));
+                            format!("not measurable on this device: {why}")
+                        }
+                        None => {
+                            today.skipped(e.key, &format!("the experiment failed: {err}"));
+                            failures.push((e.key.to_string(), err.to_string()));
+                            blocks.push(Block::Para(format!("**Failed:** {err}")));
+                            format!("FAILED: {err}")
+                        }
+                    },
                 }
             }
         };
@@ -324,7 +360,8 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
          own tables gives \"thesis' own numbers\". Words of degree are read the same way everywhere: faster or better \
          — a ratio above 1; much, considerably, greatly — at least 2×; drastically, enormously, the vast majority — \
          at least 10× (90 %); linear — a log–log slope within 0.8–1.2; close — within a factor of 2; equal or better \
-         — not slower beyond the range of the repeated runs. \"not measurable\" says why in \"measured here\".",
+         — not slower beyond the range of the repeated runs (within 5 % for single numbers, such as the thesis'). \
+         \"not measurable\" says why in \"measured here\".",
     );
 
     let elapsed = start.elapsed();

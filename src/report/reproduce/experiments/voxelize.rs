@@ -38,7 +38,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
 
     let mut list: Vec<(String, &str, usize)> = Vec::new();
     let mut wrong = Vec::new();
-    let mut failed = Vec::new();
+    let mut failed: Vec<(String, Vec<String>)> = Vec::new();
     for m in &measured {
         r.facts.model(EXP, &m.model, m.triangles as f64, m.thesis);
         if !list.iter().any(|l| l.0 == m.model) {
@@ -54,7 +54,12 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             }
             Err(why) => {
                 r.facts.missing(EXP, &m.model, &key, "s", why);
-                failed.push(format!("{} on {} at {}³: {why}", m.method, m.model, m.n));
+                // One line per reason: the methods it stops, every model and resolution.
+                match failed.iter_mut().find(|(w, _)| w == why) {
+                    Some((_, methods)) if !methods.contains(&m.method.to_string()) => methods.push(m.method.to_string()),
+                    Some(_) => {}
+                    None => failed.push((why.clone(), vec![m.method.to_string()])),
+                }
             }
         }
     }
@@ -76,8 +81,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
     } else {
         format!("**Volumes that differ from the exact one:** {}.", wrong.join(", "))
     }));
-    if !failed.is_empty() {
-        blocks.push(Block::Para(format!("**Not measurable on this device:** {}.", failed.join("; "))));
+    for (why, methods) in &failed {
+        blocks.push(Block::Para(format!("**Not measurable on this device:** {} ({why}).", methods.join(", "))));
     }
 
     let mut quantities = Vec::new();
