@@ -87,13 +87,19 @@ pub enum InclusionError {
     #[error("octree depth {0} is outside 1..=10")]
     OctreeDepth(u32),
     #[error("GPU: {0}")]
-    Gpu(#[from] crate::gpu::GpuError),
+    Gpu(crate::gpu::GpuError),
     #[error("too large for the GPU path: {0}")]
     TooLarge(String),
     #[error("invalid options: {0}")]
     Options(String),
     #[error("method '{0}' runs on the GPU: build it with inclusion::solver::Solver")]
     NeedsGpu(Method),
+}
+
+impl From<crate::gpu::GpuError> for InclusionError {
+    fn from(e: crate::gpu::GpuError) -> InclusionError {
+        InclusionError::Gpu(e)
+    }
 }
 
 impl From<UnbalancedEdge> for InclusionError {

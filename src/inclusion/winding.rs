@@ -5,7 +5,6 @@
 //! subtract what their positive partners add, so the covering works as is. Inside iff
 //! |w| ≥ 0.5; within ε of a face, OnBoundary (the shared rule of [`crate::inclusion`]).
 
-use std::f64::consts::PI;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -14,26 +13,12 @@ use super::surface::Surface;
 use super::{BuildStats, Class, Classifier, Result};
 use crate::mesh::Mesh;
 
-/// Signed solid angle of triangle (a, b, c) seen from the origin (corners relative to the
-/// viewer): positive when the origin is behind the triangle, i.e. on the side opposite to
-/// its normal (b−a)×(c−a) — so w = +1 inside an outward-oriented closed surface.
-pub fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (la, lb, lc) = (a.length(), b.length(), c.length());
-    let num = a.dot(b.cross(c));
-    let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    2.0 * num.atan2(den)
-}
+pub use crate::mesh::covering::solid_angle;
 
 /// Winding number of the covering around `p` (≈ integer away from the boundary).
 pub fn winding_number(surface: &Surface, p: DVec3) -> f64 {
     let covering = surface.covering();
-    let sum: f64 = (0..covering.triangles.len())
-        .map(|t| {
-            let [a, b, c] = covering.triangle(t);
-            solid_angle(a - p, b - p, c - p)
-        })
-        .sum();
-    sum / (4.0 * PI)
+    covering.winding_number(0..covering.triangles.len(), p)
 }
 
 /// OnBoundary within ε of a face, else Inside iff |w| ≥ 0.5 (measured from a point moved
@@ -92,6 +77,8 @@ impl Classifier for WindingNumber {
 
 #[cfg(test)]
 mod tests {
+    use std::f64::consts::PI;
+
     use super::*;
 
     #[test]

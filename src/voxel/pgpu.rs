@@ -135,7 +135,7 @@ impl LayerPainter for Tetras<'_> {
         pass.vertex_buffers(&self.vertices, None)?;
         let first = layer * SLICES_PER_LAYER;
         for j in first..(first + SLICES_PER_LAYER).min(self.n) {
-            pass.push(&params(self.n, j as f32 + 0.5, 1 << (j - first)))?;
+            pass.push(&[params(self.n, j as f32 + 0.5, 1 << (j - first))])?;
             pass.draw(self.ranges[j / self.zone].clone(), 0..1)?;
         }
         Ok(())

@@ -78,13 +78,12 @@ pub fn read_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
-/// Writes a mesh, choosing the format from the file extension.
+/// Writes a mesh, choosing the format from the file extension. The file is written
+/// atomically ([`crate::output`]): a failure leaves any previous file at `path` intact.
 pub fn write(path: impl AsRef<Path>, mesh: &Mesh) -> Result<()> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let mut out = Vec::new();
-    write_to(&mut out, mesh, format).map_err(|error| MeshError::Io { path: path.into(), error })?;
-    std::fs::write(path, out).map_err(|error| MeshError::Io { path: path.into(), error })
+    Ok(crate::output::write_with(path, |w| write_to(w, mesh, format))?)
 }
 
 /// Writes a mesh in `format` to any writer.
