@@ -4,6 +4,7 @@
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top; `output`
 //! writes every file atomically.
 
+pub mod exact;
 pub mod gpu;
 pub mod host;
 pub mod inclusion;

@@ -5,9 +5,10 @@
 //! point by point:
 //!
 //! - **Inside** iff the winding number w of the surface around P is non-zero. For a
-//!   valid solid w ∈ {0, 1} and this is the thesis' `acc == 2`; the non-zero rule also
-//!   classifies unions of overlapping closed shells, and inverted shells, like the
-//!   winding-number oracle does.
+//!   valid solid ([`crate::mesh::solidity`]) w ∈ {0, 1} and this is the thesis'
+//!   `acc == 2`. The commands refuse meshes that are not valid solids; with
+//!   `--allow-open` only the `winding` method runs, and it answers w ≥ ½ for the
+//!   generalized winding number of the open surface.
 //! - **OnBoundary** iff P is within ε of some face polygon ([`surface::Surface::on_face`]).
 //!
 //! ## The tolerance rule (one rule, used everywhere)
@@ -28,13 +29,25 @@
 //!   triangle's smallest height is ≤ ε;
 //! - points outside the mesh's bounding box grown by ε are Outside without further work.
 //!
-//! ε is far above f64 rounding for coordinates of size D (≈1e-16·D), so a decision taken
-//! with a margin larger than ε is geometrically right; a decision within ε is either
-//! shared bit for bit by the two tetras it concerns or sends the point to an exact
-//! fallback (see [`cpu`]). Points at a distance of exactly ε (to within rounding) from a
-//! face may come out either way. The Jordan baselines add their own re-cast triggers
-//! (barycentric 1e-9, grazing 1e-7, [`jordan`]); they only choose when to cast another
-//! ray, never a class.
+//! "Within ε of a face" is decided **exactly** ([`crate::exact`]: a filtered f64 distance,
+//! recomputed in exact arithmetic when it is within the filter's margin of ε), on the
+//! covering points as they are. So every method gives a point the same OnBoundary label,
+//! and a solid translated by any amount that keeps its coordinates exact (1e7, 1e12: a
+//! shift by a multiple of the coordinates' unit in the last place) labels the translated
+//! points as at the origin (`tests/inclusion_placement.rs`). (For an n-gon whose centroid
+//! rounds differently after the translation, the covering itself moves by that rounding.)
+//!
+//! The other decisions are taken on coordinates relative to the apex or to a triangle's
+//! corner, whose differences are exact far from the origin, and ε is far above f64
+//! rounding at the scale D (≈1e-16·D): a decision taken with a margin larger than ε is
+//! geometrically right; a decision within ε is either shared bit for bit by the two tetras
+//! it concerns or sends the point to an exact fallback (see [`cpu`]). The Jordan baselines
+//! add their own re-cast triggers (barycentric 1e-9, grazing 1e-7, [`jordan`]); they only
+//! choose when to cast another ray, never a class.
+//!
+//! Which meshes count as solids, and what the commands do with the others, is
+//! [`crate::mesh::solidity`]'s: on a valid solid the winding number is 0 or 1, so the
+//! non-zero rule here, the parity of the voxelizers and "w ≥ ½" agree.
 
 use std::fmt;
 use std::str::FromStr;
