@@ -10,7 +10,7 @@ use glam::DVec3;
 
 use super::cpu::FeitoTorres;
 use super::tetra::CompactPlanes;
-use super::{BuildStats, Class, Classifier, vec_bytes};
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Tetras per leaf.
 const LEAF: usize = 4;

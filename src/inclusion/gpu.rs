@@ -35,7 +35,9 @@ use crate::gpu::{
 };
 
 use super::tetragrid::TetraGrid;
-use super::{Class, Classifier, FeitoTorres, InclusionError, Result};
+use super::classifier::{Class, Classifier};
+use super::cpu::FeitoTorres;
+use super::error::{InclusionError, Result};
 
 /// Plane-distance margin in normalized coordinates (bounding cube = [-1, 1]³). f32
 /// evaluation errors stay below 2·10⁻⁶ there; CPU ties are decided at 10⁻⁹ of the
@@ -59,6 +61,10 @@ pub enum Phase2 {
     Host,
 }
 
+/// Tetrahedra per point-vertex by default, measured on lavapipe (`texgeo bench inclusion`
+/// reports the thesis' batch of 1 beside it).
+pub const DEFAULT_BATCH: u32 = 64;
+
 #[derive(Clone, Copy, Debug)]
 pub struct GpuOptions {
     /// Tetrahedra summed per point-vertex (1 = the thesis' layout).
@@ -70,7 +76,7 @@ pub struct GpuOptions {
 
 impl Default for GpuOptions {
     fn default() -> GpuOptions {
-        GpuOptions { batch: super::solver::GPU_BATCH, groups_per_draw: 32, phase2: Phase2::Gpu }
+        GpuOptions { batch: DEFAULT_BATCH, groups_per_draw: 32, phase2: Phase2::Gpu }
     }
 }
 

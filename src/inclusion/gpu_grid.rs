@@ -15,7 +15,8 @@ use super::gpu::{
     GROUP_POINTS, GpuStats, LAYERS, MAX_POINTS, TetraSet, classify_pipeline, decode, fall_back, triage,
 };
 use super::tetragrid::TetraGrid;
-use super::{Class, InclusionError, Result};
+use super::classifier::Class;
+use super::error::{InclusionError, Result};
 use crate::gpu::{Attachment, Buffer, Context, Load, Pipeline, Reducer, TexFormat, Texture};
 
 /// Side of the square tiles a job's point-vertices fill (a power of two).
@@ -23,6 +24,9 @@ const TILE: u32 = 4;
 /// Target size in tiles.
 const TILES_WIDE: u32 = 64;
 const TILES_HIGH: u32 = 256;
+
+/// Tetrahedra of a cell's list per point-vertex by default (measured on lavapipe).
+pub const DEFAULT_BATCH: u32 = 64;
 
 pub struct GpuGridInclusion {
     ctx: Context,

@@ -14,7 +14,7 @@ use glam::DVec3;
 
 use super::cpu::FeitoTorres;
 use super::tetra::{CompactPlanes, octant_bit};
-use super::{BuildStats, Class, Classifier, vec_bytes};
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Feito-Torres over the tetras of the point's octant.
 #[derive(Clone, Debug)]

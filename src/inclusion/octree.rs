@@ -13,7 +13,8 @@ use glam::DVec3;
 
 use super::jordan::{Hit, cast, ray_hit, segment_meets_box};
 use super::surface::Surface;
-use super::{BuildStats, Class, Classifier, InclusionError, Result, vec_bytes};
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::{InclusionError, Result};
 use crate::mesh::Mesh;
 
 /// Triangles a leaf may hold before it is split (when the depth allows).

@@ -39,7 +39,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
 }
 
 /// Writes one class per line (`1` inside, `0` outside, `2` on the boundary).
-pub fn write_classes(out: &mut impl Write, classes: &[super::Class]) -> std::io::Result<()> {
+pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     for c in classes {
         writeln!(w, "{}", *c as u8)?;

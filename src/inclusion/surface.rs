@@ -3,7 +3,8 @@
 
 use glam::DVec3;
 
-use super::{InclusionError, vec_bytes};
+use super::classifier::vec_bytes;
+use super::error::InclusionError;
 use crate::exact;
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;

@@ -17,7 +17,8 @@ use glam::DVec3;
 
 use super::cpu::FeitoTorres;
 use super::tetra::{CompactPlanes, Kind, TetraPlanes};
-use super::{BuildStats, Class, Classifier, InclusionError, Result, vec_bytes};
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::{InclusionError, Result};
 
 pub const DEFAULT_RESOLUTION: usize = 32;
 pub const RESOLUTIONS: Range<usize> = 2..65;
