@@ -13,4 +13,5 @@ pub mod output;
 pub mod random;
 pub mod report;
 pub mod subdiv;
+pub mod tetragrid;
 pub mod voxel;

@@ -8,8 +8,8 @@ use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::procedural;
 use texgeo::random::Rng;
+use texgeo::tetragrid::{Cells, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::tetragrid::{self, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::{Grid, Method, binvox, pictures, voxelize};
 
 fn temp_dir(name: &str) -> std::path::PathBuf {
@@ -135,6 +135,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
     let mut rng = Rng::new(45);
     for n in [7usize, 16, 32] {
         let grid = Grid::new(n, DVec3::ZERO, 1.0).unwrap();
+        let cells_of = Cells::new(grid.min, grid.h(), n);
         let h = grid.h();
         for _ in 0..60 {
             let t = random_tetra(&mut rng);
@@ -144,7 +145,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                 Growth::CellBox { extra: 0.0 },
             ] {
                 let mut cells = Vec::new();
-                tetragrid::cells(&grid, &t, growth, &mut cells);
+                cells_of.rasterize(&t, growth, |c| cells.push(c as u32));
                 let listed: std::collections::HashSet<u32> = cells.iter().copied().collect();
                 assert_eq!(listed.len(), cells.len(), "no duplicates");
                 let mut touched = 0;
@@ -154,7 +155,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                             let lo = grid.min + DVec3::new(i as f64, j as f64, k as f64) * h;
                             if tetra_box_overlap(&t, lo, lo + DVec3::splat(h)) {
                                 touched += 1;
-                                let c = tetragrid::cell_index(n, i, j, k) as u32;
+                                let c = cells_of.index([i, j, k]) as u32;
                                 assert!(listed.contains(&c), "n {n} {growth:?}: cell ({i},{j},{k}) of {t:?}");
                             }
                         }
@@ -174,7 +175,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                 let reach = (offset + 1.0) * h * 3f64.sqrt();
                 for &c in &cells {
                     let c = c as usize;
-                    let (i, k, j) = (c % n, c / n % n, c / (n * n));
+                    let (i, j, k) = (c % n, c / n % n, c / (n * n));
                     let centre = grid.centre(i, j, k);
                     assert!(
                         centre.cmpge(tlo - DVec3::splat(reach)).all()
@@ -202,13 +203,15 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
     let mesh = procedural::torus_knot();
     let solid = texgeo::voxel::Solid::new(&mesh).unwrap();
     let grid = Grid::for_mesh(&mesh, 16).unwrap();
+    let cells = Cells::new(grid.min, grid.h(), 16);
     let tetras = solid.tetras();
     for growth in
         [Growth::CellBox { extra: 0.0 }, Growth::Diagonals(MIN_OFFSET), Growth::Diagonals(SPEC_OFFSET)]
     {
-        let tg = TetraGrid::build(&grid, &tetras, growth).unwrap();
-        assert_eq!(tg.offsets.len(), 16 * 16 * 16 + 1);
-        assert_eq!(*tg.offsets.last().unwrap() as usize, tg.tetras.len());
+        let tg = TetraGrid::of_tetras(cells, &tetras, growth).unwrap();
+        let (start, ids) = tg.lists();
+        assert_eq!(start.len(), 16 * 16 * 16 + 1);
+        assert_eq!(*start.last().unwrap() as usize, ids.len());
         let mut rng = Rng::new(3);
         // A point inside a tetra is found in its cell's list.
         for _ in 0..2000 {
@@ -220,7 +223,7 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
             assert!(tg.tetras_at(p).binary_search(&(id as u32)).is_ok(), "tetra {id} at {p}");
         }
     }
-    let size = |g| TetraGrid::build(&grid, &tetras, g).unwrap().tetras.len();
+    let size = |g| TetraGrid::of_tetras(cells, &tetras, g).unwrap().lists().1.len();
     let (tight, small, spec) = (
         size(Growth::CellBox { extra: 0.0 }),
         size(Growth::Diagonals(MIN_OFFSET)),
@@ -231,7 +234,7 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
 
 #[test]
 fn the_inclusion_tetragrid_uses_the_conservative_rasterizer() {
-    use texgeo::inclusion::tetragrid::TetraGrid as InclusionGrid;
+    use texgeo::inclusion::tetragrid::GridClassifier as InclusionGrid;
     use texgeo::inclusion::{Classifier, FeitoTorres};
     for mesh in
         [procedural::torus_knot(), procedural::cube_with_cavity(), procedural::two_cubes_sharing_edge()]

@@ -58,10 +58,10 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::surface::Surface;
-use super::tetra::{CompactPlanes, CompactPoint, Contact, TetraPlanes, Verdict, octant_bit};
 use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::Result;
+use super::surface::Surface;
+use super::tetra::{CompactPlanes, CompactPoint, Contact, TetraPlanes, Verdict, octant_bit};
 use super::winding;
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;

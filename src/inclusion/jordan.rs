@@ -17,9 +17,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::surface::Surface;
 use super::classifier::{BuildStats, Class, Classifier};
 use super::error::Result;
+use super::surface::Surface;
 use super::winding;
 use crate::mesh::Mesh;
 use crate::random::Rng;

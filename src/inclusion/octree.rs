@@ -11,10 +11,10 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::jordan::{Hit, cast, ray_hit, segment_meets_box};
-use super::surface::Surface;
 use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::{InclusionError, Result};
+use super::jordan::{Hit, cast, ray_hit, segment_meets_box};
+use super::surface::Surface;
 use crate::mesh::Mesh;
 
 /// Triangles a leaf may hold before it is split (when the depth allows).

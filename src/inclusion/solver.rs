@@ -18,7 +18,7 @@ use super::jordan::Jordan;
 use super::method::{Method, Options};
 use super::octants::Octants;
 use super::octree::JordanOctree;
-use super::tetragrid::TetraGrid;
+use super::tetragrid::GridClassifier;
 use super::winding::WindingNumber;
 use crate::gpu::Context;
 use crate::mesh::Mesh;
@@ -53,7 +53,7 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
         Method::Cpu => Box::new(ft()?),
         Method::Bvh => Box::new(Bvh::new(ft()?)),
         Method::Octants => Box::new(Octants::new(ft()?)),
-        Method::TetraGrid => Box::new(TetraGrid::new(ft()?, options.tetragrid_resolution)?),
+        Method::TetraGrid => Box::new(GridClassifier::new(ft()?, options.tetragrid_resolution)?),
         Method::Jordan => Box::new(Jordan::with_policy(mesh, options.allow_open)?),
         Method::JordanOctree => {
             Box::new(JordanOctree::with_policy(mesh, options.octree_depth, options.allow_open)?)
@@ -80,7 +80,7 @@ impl Solver {
         }
         check_open(method, mesh, options)?;
         let grid = || {
-            TetraGrid::new(
+            GridClassifier::new(
                 FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open)?,
                 options.tetragrid_resolution,
             )

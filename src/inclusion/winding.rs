@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use super::surface::Surface;
 use super::classifier::{BuildStats, Class, Classifier};
 use super::error::Result;
+use super::surface::Surface;
 use crate::mesh::Mesh;
 
 pub use crate::mesh::covering::solid_angle;

@@ -39,7 +39,6 @@ pub mod raster;
 pub mod scanline;
 pub mod slicing;
 pub mod solid;
-pub mod tetragrid;
 pub mod volume;
 
 use std::time::{Duration, Instant};
