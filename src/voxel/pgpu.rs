@@ -90,11 +90,7 @@ impl<'a> Tetras<'a> {
     ) -> Result<Tetras<'a>> {
         let n = grid.n;
         let tetras = solid.sorted_tetras(grid);
-        let zone = match zone {
-            Some(0) => default_zone(n),
-            Some(z) => z,
-            None => n,
-        };
+        let zone = zone.unwrap_or(n).max(1);
         let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n.div_ceil(zone)];
         for (i, t) in tetras.iter().enumerate() {
             let r = f32_slices(t, n);

@@ -47,6 +47,15 @@ impl Volume {
         (j * self.n + k) * self.words_per_row
     }
 
+    /// Every word, rows in (j, k) order ([`Self::words_per_row`] words each).
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
+    pub fn words_per_row(&self) -> usize {
+        self.words_per_row
+    }
+
     /// The words of row (j, k): bit i of the row is voxel (i, j, k).
     pub fn row(&self, j: usize, k: usize) -> &[u64] {
         let s = self.row_start(j, k);
