@@ -46,6 +46,8 @@ pub struct AtomicFile {
     target: PathBuf,
     temp: PathBuf,
     out: Option<BufWriter<File>>,
+    /// Renamed onto the target: nothing to clean up.
+    done: bool,
 }
 
 impl AtomicFile {
@@ -68,7 +70,7 @@ impl AtomicFile {
         if let Ok(meta) = std::fs::metadata(&target) {
             let _ = file.set_permissions(meta.permissions());
         }
-        Ok(AtomicFile { target, temp, out: Some(BufWriter::with_capacity(1 << 20, file)) })
+        Ok(AtomicFile { target, temp, out: Some(BufWriter::with_capacity(1 << 20, file)), done: false })
     }
 
     /// The path the file will have once committed.
@@ -84,7 +86,9 @@ impl AtomicFile {
             .ok_or_else(|| Error::new(&self.target, std::io::Error::other("committed twice")))?;
         let file = out.into_inner().map_err(|e| Error::new(&self.target, e.into_error()))?;
         drop(file);
-        std::fs::rename(&self.temp, &self.target).map_err(|e| Error::new(&self.target, e))
+        std::fs::rename(&self.temp, &self.target).map_err(|e| Error::new(&self.target, e))?;
+        self.done = true;
+        Ok(())
     }
 
     /// Wraps an I/O error of a write into this file's [`Error`].
@@ -113,7 +117,8 @@ impl Write for AtomicFile {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.out.take().is_some() {
+        if !self.done {
+            drop(self.out.take());
             let _ = std::fs::remove_file(&self.temp);
         }
     }

@@ -82,6 +82,8 @@ fn a_full_disk_while_writing_slices_is_one_clean_error() {
 fn output_paths_are_checked_before_any_work() {
     let dir = TempDir::new("outputs-check");
     let missing = dir.arg("no/such/folder/out.binvox");
+    let folder = dir.arg("folder.off");
+    std::fs::create_dir(&folder).unwrap();
     // /proc accepts no new files, even for root.
     for (args, needle) in [
         (vec!["voxelize", "builtin:knot", "--res", "64", "-o", &missing], "does not exist"),
@@ -117,7 +119,7 @@ fn output_paths_are_checked_before_any_work() {
         (vec!["inclusion", "builtin:knot", "--random", "100", "-o", "/proc/texgeo.txt"], "/proc/texgeo.txt"),
         (vec!["subdivide", "builtin:cube", "-l", "2", "-o", "/proc/texgeo.obj"], "/proc/texgeo.obj"),
         (vec!["mesh", "convert", "builtin:cube", "/proc/texgeo.off"], "/proc/texgeo.off"),
-        (vec!["mesh", "convert", "builtin:cube", dir.path().to_str().unwrap()], "is a folder"),
+        (vec!["mesh", "convert", "builtin:cube", &folder], "is a folder"),
     ] {
         let o = texgeo(&args);
         assert_refused(&o, &[needle]);

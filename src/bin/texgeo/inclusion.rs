@@ -64,12 +64,6 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let policy = Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
     let mesh = solid.mesh;
-    if solid.open {
-        eprintln!(
-            "texgeo: warning: {} is not closed; points are classified by the generalized winding number",
-            args.mesh
-        );
-    }
     if solid.flipped {
         eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
@@ -88,6 +82,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mut solver = Solver::new(args.method, &mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", args.method, args.mesh))?;
     let build = t.elapsed();
+    if solid.open {
+        eprintln!(
+            "texgeo: warning: {} is not closed; points are classified by the generalized winding number",
+            args.mesh
+        );
+    }
     let t = Instant::now();
     let classes = solver.classify_all(&pts)?;
     let run = t.elapsed();

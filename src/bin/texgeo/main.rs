@@ -87,10 +87,16 @@ fn main() {
             return;
         }
         Err(e) => {
-            // clap's usage errors, on one line like every other error.
+            // clap's usage errors, on one line like every other error (without the usage
+            // block, which --help shows).
             let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            eprintln!("texgeo: error: {} (see --help)", first.trim_start_matches("error: "));
+            let parts: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+                .filter(|l| !l.is_empty())
+                .collect();
+            eprintln!("texgeo: error: {} (see --help)", parts.join(" ").trim_start_matches("error: "));
             std::process::exit(2);
         }
     };
