@@ -8,6 +8,7 @@ pub mod error;
 pub mod formats;
 pub mod procedural;
 pub mod solidity;
+pub mod triangulate;
 pub mod validate;
 
 pub use error::{MeshError, Result};
