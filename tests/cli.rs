@@ -143,3 +143,118 @@ fn voxelize_writes_binvox_slices_and_aspect() {
         assert_refused(&texgeo(&args), &[expect]);
     }
 }
+
+#[test]
+fn numeric_options_must_be_finite_and_positive() {
+    let dir = TempDir::new("cli-numbers");
+    let out = dir.arg("x.binvox");
+    for (args, needle) in [
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "nan"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "inf"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "0"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "0", "-o", &out], "resolution 0"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--zone", "0"], "--zone"),
+        (vec!["inclusion", "builtin:cube", "--random", "0"], "--random"),
+        (vec!["inclusion", "builtin:cube", "--random", "10", "--batch", "0"], "--batch"),
+        (vec!["bench", "xor", "--runs", "0"], "--runs"),
+        (vec!["bench", "inclusion", "--sets", "0"], "--sets"),
+    ] {
+        assert_refused(&texgeo(&args), &[needle]);
+    }
+    assert!(!dir.join("x.binvox").exists());
+    // `--zone auto` and a number are both fine.
+    for zone in ["auto", "5"] {
+        let o = texgeo(&[
+            "voxelize",
+            "builtin:cube",
+            "--res",
+            "8",
+            "--method",
+            "zoned",
+            "--zone",
+            zone,
+            "-o",
+            &out,
+        ]);
+        assert!(o.status.success(), "{zone}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn file_errors_say_the_os_error_once() {
+    let o = texgeo(&["voxelize", "builtin:cube", "--res", "8", "-o", "/nonexistent/texgeo/x.binvox"]);
+    assert_refused(&o, &["/nonexistent/texgeo/x.binvox"]);
+    let o = texgeo(&["mesh", "stats", "/nonexistent/texgeo/m.off"]);
+    assert_refused(&o, &["/nonexistent/texgeo/m.off: No such file or directory (os error 2)"]);
+    assert_eq!(stderr(&o).matches("os error").count(), 1, "{}", stderr(&o));
+}
+
+#[test]
+fn a_gpu_method_without_a_vulkan_driver_suggests_a_cpu_one() {
+    // No ICD: the loader finds no driver.
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(args)
+            .env("VK_DRIVER_FILES", "/nonexistent/texgeo-icd.json")
+            .env("VK_ICD_FILENAMES", "/nonexistent/texgeo-icd.json")
+            .env_remove("TEXGEO_VALIDATION")
+            .env_remove("TEXGEO_REQUIRE_VALIDATION")
+            .output()
+            .unwrap()
+    };
+    let dir = TempDir::new("cli-nodriver");
+    let out = dir.arg("x.binvox");
+    assert_refused(
+        &run(&["inclusion", "builtin:cube", "--random", "10", "--method", "gpu"]),
+        &["--method cpu"],
+    );
+    assert_refused(
+        &run(&["voxelize", "builtin:cube", "--res", "8", "--method", "pgpu", "-o", &out]),
+        &["--method cpu"],
+    );
+    assert_refused(&run(&["subdivide", "builtin:cube", "-l", "2", "--method", "gpu"]), &["--method cpu"]);
+    // The CPU methods do not need it.
+    let o = run(&["inclusion", "builtin:cube", "--random", "10", "--method", "cpu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn coordinates_that_overflow_area_or_volume_are_refused() {
+    let dir = TempDir::new("cli-huge");
+    let huge = dir.join("huge.off");
+    let m = texgeo::mesh::procedural::cube().map_positions(|p| p * 1e200).unwrap();
+    texgeo::mesh::formats::write(&huge, &m).unwrap();
+    let huge = huge.to_str().unwrap();
+    let out = dir.arg("x.binvox");
+    for args in [
+        vec!["mesh", "stats", huge],
+        vec!["inclusion", huge, "--random", "10", "--method", "cpu"],
+        vec!["voxelize", huge, "--res", "8", "--method", "cpu", "-o", &out],
+    ] {
+        assert_refused(&texgeo(&args), &["overflows f64", "1e200"]);
+    }
+}
+
+#[test]
+fn sizes_that_do_not_fit_are_refused_before_any_work() {
+    // Far more than any machine has: refused at once, with the estimate.
+    let o = texgeo(&[
+        "inclusion",
+        "builtin:cube",
+        "--random",
+        "100000000000000",
+        "--method",
+        "cpu",
+        "-o",
+        "/tmp/x.txt",
+    ]);
+    assert_refused(&o, &["100000000000000 points", "MiB", "of text"]);
+    let o = texgeo(&["subdivide", "builtin:knot", "-l", "10", "--method", "cpu", "-o", "/tmp/x.obj"]);
+    assert_refused(&o, &["level 10", "MiB", "/tmp/x.obj would be about"]);
+    assert!(!stdout(&o).contains("CPU reference"), "{}", stdout(&o));
+    let o = texgeo(&["subdivide", "builtin:cube", "-l", "40", "--method", "gpu"]);
+    assert_refused(&o, &["level 40", "32-bit"]);
+    assert!(!stdout(&o).contains("device"), "{}", stdout(&o));
+    let o = texgeo(&["voxelize", "builtin:cube", "--res", "100000", "-o", "/tmp/x.binvox"]);
+    assert_refused(&o, &["resolution 100000", "1024"]);
+}
