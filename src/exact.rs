@@ -1,6 +1,6 @@
 //! Exact arithmetic on f64 inputs: the sign of a polynomial in the input coordinates, and
 //! the predicates texgeo decides with it, so that a decision never depends on rounding —
-//! on which method asks, or on where the mesh sits (issue 12).
+//! on which method asks, or on where the mesh sits.
 //!
 //! Inputs are f64 numbers, i.e. exact dyadic rationals. Every predicate first evaluates in
 //! floating point with an error bound (the *filter*); only when the answer is in doubt does

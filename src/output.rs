@@ -1,4 +1,4 @@
-//! Output files that are never half-written (issue 12, item 5).
+//! Output files that are never half-written.
 //!
 //! Every file texgeo writes — meshes, binvox volumes, PNG slices, point classes, reports —
 //! goes through [`AtomicFile`]: the bytes go to a temporary file in the target's own

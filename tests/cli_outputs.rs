@@ -1,4 +1,4 @@
-//! Outputs are never half-written (issue 12, item 5): a failed, interrupted or concurrent
+//! Outputs are never half-written: a failed, interrupted or concurrent
 //! run leaves the previous good file or one complete new one; output paths are checked
 //! before any work; a closed stdout does not stop the `-o` file. The full-disk cases run
 //! the binary under `ulimit -f` (with SIGXFSZ ignored, so writes fail with EFBIG instead

@@ -1,4 +1,4 @@
-//! Boundary decisions do not depend on where the mesh sits (issue 12, item 2): the same
+//! Boundary decisions do not depend on where the mesh sits: the same
 //! solid and the same points, translated far from the origin by an amount that keeps
 //! every coordinate exact, get the same label from every method as at the origin —
 //! including points a few units in the last place from a face, where "within ε of the

@@ -1,4 +1,4 @@
-//! One meaning of "inside" across commands (issue 12, item 1): `mesh stats` reports what
+//! One meaning of "inside" across commands: `mesh stats` reports what
 //! keeps a mesh from being a solid, and `inclusion` and `voxelize` refuse it with status 2
 //! and the reason — or, with `--flip-inverted`, answer for the flipped solid exactly as
 //! for a well-oriented one. `--allow-open` means "inside iff the generalized winding number

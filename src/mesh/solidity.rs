@@ -1,4 +1,4 @@
-//! Is a mesh a solid, and what "inside" means — one rule for every command (issue 12).
+//! Is a mesh a solid, and what "inside" means — one rule for every command.
 //!
 //! ## The rule
 //!

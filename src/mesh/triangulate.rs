@@ -1,7 +1,7 @@
 //! Triangles for formats and renderers that only know triangles (STL, a rasterizer):
 //! every polygon face split into n − 2 triangles that tile it exactly, non-convex ones
-//! included (issue 12: a fan from the first vertex folds over a non-convex polygon, which
-//! keeps the signed area but not the area, nor the surface as a closed 2-manifold).
+//! included (a fan from the first vertex folds over a non-convex polygon, which keeps the
+//! signed area but not the area).
 //!
 //! Convex faces (the common case) get the fan (v0, vᵢ, vᵢ₊₁), as before; other faces are
 //! ear-clipped in the plane they project to best (along the dominant axis of their vector

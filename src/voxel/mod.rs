@@ -1,5 +1,5 @@
 //! Solid voxelization by slicing the tetras of a simplicial covering with XOR (2006
-//! thesis, Ch. 5; SPEC §4; issue 4).
+//! thesis, Ch. 5; SPEC §4).
 //!
 //! Every method returns the same bit volume: voxel (i, j, k) is occupied iff its centre
 //! ([`Grid::centre`]) is inside the solid, with centres on the surface decided by the
@@ -9,10 +9,11 @@
 //! silently wrong (SPEC §0).
 //!
 //! "Inside" is the parity of the XOR accumulation (§5.3.1): an odd number of covering
-//! tetras, i.e. an odd winding number. For a valid solid that is the same as `inclusion`'s
-//! non-zero rule; they differ only for self-overlapping shells (winding 2: `inclusion`
-//! says Inside, a voxelization Outside). Where `inclusion` answers OnBoundary, the tie
-//! rule gives the voxel's value.
+//! tetras, i.e. an odd winding number. On a valid solid ([`crate::mesh::solidity`]: the
+//! winding number is 0 or 1) that is `inclusion`'s answer too; `texgeo voxelize` refuses
+//! meshes that are not valid solids (nested or overlapping shells would give winding 2,
+//! which parity calls outside), or flips inverted ones with `--flip-inverted`. Where
+//! `inclusion` answers OnBoundary, the tie rule gives the voxel's value.
 //!
 //! | method | what it is |
 //! |---|---|

@@ -1,5 +1,5 @@
 //! `texgeo voxelize MESH --res N [--method …] -o OUT.binvox [--slices DIR]
-//! [--aspect perlin --aspect-out DIR]`: solid voxelization by tetra slicing (issue 4).
+//! [--aspect perlin --aspect-out DIR]`: solid voxelization by tetra slicing.
 
 use std::path::PathBuf;
 
