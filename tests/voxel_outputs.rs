@@ -12,12 +12,9 @@ use texgeo::tetragrid::{Cells, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra
 use texgeo::voxel::aspect::{self, Aspect, Material};
 use texgeo::voxel::{Grid, Method, binvox, pictures, voxelize};
 
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("texgeo-voxel-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+
+use common::TempDir;
 
 #[test]
 fn binvox_round_trips_exactly() {
@@ -31,11 +28,10 @@ fn binvox_round_trips_exactly() {
         assert_eq!(grid, r.grid);
         assert_eq!(volume, r.volume);
         // Through a file as well.
-        let dir = temp_dir("binvox");
+        let dir = TempDir::new("voxel-binvox");
         let path = dir.join("v.binvox");
         binvox::write(&path, &r.grid, &r.volume).unwrap();
         assert_eq!(binvox::read(&path).unwrap(), (r.grid, r.volume.clone()));
-        std::fs::remove_dir_all(dir).unwrap();
     }
 }
 
@@ -75,8 +71,8 @@ fn bad_binvox_files_are_rejected_with_a_reason() {
 #[test]
 fn slice_pngs_show_the_slices() {
     let r = voxelize(None, &procedural::torus(1.0, 0.4, 24, 12), 24, Method::Cpu).unwrap();
-    let dir = temp_dir("slices");
-    let files = pictures::write_slices(&r.volume, &dir).unwrap();
+    let dir = TempDir::new("voxel-slices");
+    let files = pictures::write_slices(&r.volume, dir.path()).unwrap();
     assert_eq!(files.len(), 24);
     for (j, f) in files.iter().enumerate() {
         let img = image::open(f).unwrap().to_luma8();
@@ -85,7 +81,6 @@ fn slice_pngs_show_the_slices() {
             assert_eq!(p.0[0] == 255, r.volume.get(i as usize, j, k as usize));
         }
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]

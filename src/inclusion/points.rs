@@ -62,7 +62,9 @@ mod tests {
         assert!(e.contains("pts.txt:1") && e.contains("not finite"), "{e}");
         let e = parse(b"1 2 x\n", p).unwrap_err().to_string();
         assert!(e.contains("'x' is not a number"), "{e}");
-        assert!(parse(b"# nothing\n", p).is_err());
-        assert!(parse(&[0xff, 0xfe], p).is_err());
+        let e = parse(b"# nothing\n", p).unwrap_err().to_string();
+        assert_eq!(e, "pts.txt: no points in the file");
+        let e = parse(&[0xff, 0xfe], p).unwrap_err().to_string();
+        assert_eq!(e, "pts.txt:1: not a text file (invalid UTF-8 at byte 0)");
     }
 }

@@ -264,18 +264,7 @@ mod tests {
     use super::*;
 
     fn quad_box(lo: DVec3, hi: DVec3) -> Mesh {
-        let p: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2]))
-            .collect();
-        let f = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![2, 6, 7, 3],
-            vec![0, 4, 6, 2],
-            vec![1, 3, 7, 5],
-        ];
-        Mesh::new(p, f).unwrap()
+        crate::mesh::procedural::box_between(lo, hi)
     }
 
     fn prism(xy: &[(f64, f64)], h: f64) -> Mesh {
