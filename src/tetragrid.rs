@@ -306,7 +306,7 @@ impl TetraGrid {
         if entries.len() >= u32::MAX as usize {
             return Err(TooLarge {
                 what: "lists (more than 2^32 entries)",
-                need_mib: entries.len() as u64 * 4 >> 20,
+                need_mib: (entries.len() as u64 * 4) >> 20,
                 have_mib: 0,
             });
         }

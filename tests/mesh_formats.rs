@@ -96,6 +96,9 @@ fn ascii_stl_round_trip_is_exact_in_f64() {
     }
 }
 
+/// A writer of one format.
+type Writer = fn(&mut Vec<u8>, &Mesh) -> std::io::Result<()>;
+
 /// (area, volume) from the simplicial covering.
 fn measures(mesh: &Mesh) -> (f64, f64) {
     let c = Covering::new(mesh);
@@ -124,7 +127,7 @@ fn convert_keeps_area_and_volume_in_every_format() {
     all.push(("comb", procedural::prism(&comb, 0.75).unwrap()));
     for (name, mesh) in all {
         let (area, volume) = measures(&mesh);
-        let writers: [(&str, Format, fn(&mut Vec<u8>, &Mesh) -> std::io::Result<()>); 6] = [
+        let writers: [(&str, Format, Writer); 6] = [
             ("obj", Format::Obj, |w, m| obj::write(w, m)),
             ("off", Format::Off, |w, m| off::write(w, m)),
             ("ply", Format::Ply, |w, m| ply::write(w, m)),
@@ -397,7 +400,7 @@ fn off_reads_what_the_thesis_files_use() {
 fn text_formats_accept_a_byte_order_mark() {
     let mesh = procedural::pyramid();
     let bom = b"\xef\xbb\xbf";
-    let writers: [(Format, fn(&mut Vec<u8>, &Mesh) -> std::io::Result<()>); 4] = [
+    let writers: [(Format, Writer); 4] = [
         (Format::Obj, |w, m| obj::write(w, m)),
         (Format::Off, |w, m| off::write(w, m)),
         (Format::Ply, |w, m| ply::write_ascii(w, m)),

@@ -58,7 +58,7 @@ impl Buffer {
             }
         };
         let buffer = Buffer { dev, raw, allocation: Some(allocation), size };
-        let a = buffer.allocation.as_ref().ok_or_else(|| GpuError::Internal("buffer without memory"))?;
+        let a = buffer.allocation.as_ref().ok_or(GpuError::Internal("buffer without memory"))?;
         // SAFETY: memory and offset come from the allocator for this buffer's requirements.
         unsafe { buffer.dev.raw.bind_buffer_memory(raw, a.memory(), a.offset()) }.vk("vkBindBufferMemory")?;
         Ok(buffer)
@@ -106,7 +106,7 @@ impl Buffer {
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
-            .ok_or_else(|| GpuError::Internal("buffer memory is not host-visible"))?;
+            .ok_or(GpuError::Internal("buffer memory is not host-visible"))?;
         let start = offset as usize;
         let end = start.checked_add(bytes.len()).filter(|&e| e as u64 <= size).ok_or_else(|| {
             GpuError::Usage(format!(
@@ -148,7 +148,7 @@ impl Buffer {
             .as_ref()
             .and_then(|a| a.mapped_slice())
             .map(|s| &s[..size.min(s.len())])
-            .ok_or_else(|| GpuError::Internal("buffer memory is not host-visible"))
+            .ok_or(GpuError::Internal("buffer memory is not host-visible"))
     }
 }
 

@@ -318,7 +318,7 @@ impl<'d> Recorder<'d> {
         reads: &'p [&'p Texture],
         draw: impl FnOnce(&mut RenderScope<'_, 'p>) -> Result<T>,
     ) -> Result<T> {
-        let first = targets.first().ok_or_else(|| GpuError::Internal("a render pass without a target"))?;
+        let first = targets.first().ok_or(GpuError::Internal("a render pass without a target"))?;
         let area = area.unwrap_or([0, 0, first.texture.width(), first.texture.height()]);
         for a in targets {
             self.check(a.texture)?;
@@ -424,7 +424,7 @@ impl<'p> RenderScope<'_, 'p> {
     }
 
     fn bound(&self) -> Result<&'p Pipeline> {
-        self.pipeline.ok_or_else(|| GpuError::Internal("draw without a bound pipeline"))
+        self.pipeline.ok_or(GpuError::Internal("draw without a bound pipeline"))
     }
 
     /// Binds textures (sampled with `texelFetch`) to set-0 bindings. Each must have been

@@ -86,6 +86,8 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
                         transpose64(&mut stage[slot(g, dz, yb)]);
                     }
                 }
+                // xl outermost, so each column's ybs words are written together.
+                #[allow(clippy::needless_range_loop)]
                 for xl in 0..xs(g) {
                     for dz in 0..zs {
                         let at = ((g * 64 + xl) * n + z0 + dz) * ybs;
