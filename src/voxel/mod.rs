@@ -90,11 +90,6 @@ impl Method {
         Method::ALL.into_iter().find(|m| m.name() == s)
     }
 
-    /// The names, for messages.
-    pub fn names() -> Vec<&'static str> {
-        Method::ALL.iter().map(|m| m.name()).collect()
-    }
-
     /// Whether the method needs a Vulkan device.
     pub fn uses_gpu(self) -> bool {
         matches!(self, Method::Fgpu | Method::Pgpu | Method::Zoned | Method::Fang)
