@@ -187,3 +187,44 @@ fn concurrent_runs_never_mix_their_files() {
     }
     assert_eq!(dir.entries(), vec!["knot.obj", "mesh.obj", "sphere.obj"]);
 }
+
+#[test]
+fn an_interrupted_run_leaves_the_previous_file() {
+    let dir = TempDir::new("outputs-kill");
+    let out = dir.join("s.binvox");
+    std::fs::write(&out, b"previous good contents").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
+        .args([
+            "voxelize",
+            "builtin:sphere",
+            "--res",
+            "512",
+            "--method",
+            "scanline",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill it as soon as it starts writing (a temporary file appears, or the target
+    // changes), or when it is done.
+    let started = std::time::Instant::now();
+    loop {
+        let writing = dir.entries().iter().any(|e| e.starts_with(".s.binvox.texgeo-"))
+            || std::fs::metadata(&out).map_or(true, |m| m.len() != 22);
+        if writing || child.try_wait().unwrap().is_some() || started.elapsed().as_secs() > 120 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    let _ = child.kill();
+    child.wait().unwrap();
+    let bytes = std::fs::read(&out).unwrap();
+    if bytes != b"previous good contents" {
+        // It finished first: then the file is complete.
+        let (grid, _) = texgeo::voxel::binvox::from_bytes(&bytes, &out).unwrap();
+        assert_eq!(grid.n, 512);
+    }
+}
