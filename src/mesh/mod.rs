@@ -7,6 +7,8 @@ pub mod covering;
 pub mod error;
 pub mod formats;
 pub mod procedural;
+pub mod solidity;
+pub mod triangulate;
 pub mod validate;
 
 pub use error::{MeshError, Result};

@@ -49,6 +49,6 @@ pub enum SubdivError {
     #[error("OpenSubdiv helper {}: {message}", path.display())]
     Helper { path: PathBuf, message: String },
     /// A temporary file or the helper process could not be created.
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
 }

@@ -91,7 +91,7 @@ pub fn run(mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
     if options.sparse {
         command.arg("--sparse");
     }
-    let result = command.output().map_err(|source| SubdivError::Io { path: helper.clone(), source })?;
+    let result = command.output().map_err(|error| SubdivError::Io { path: helper.clone(), error })?;
     if !result.status.success() {
         let stderr = String::from_utf8_lossy(&result.stderr);
         return Err(helper_error(&helper, format!("{}: {}", result.status, stderr.trim())));
@@ -134,7 +134,7 @@ impl TempDir {
         static COUNTER: AtomicU64 = AtomicU64::new(0);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let path = std::env::temp_dir().join(format!("texgeo-osd-{}-{n}", std::process::id()));
-        std::fs::create_dir_all(&path).map_err(|source| SubdivError::Io { path: path.clone(), source })?;
+        std::fs::create_dir_all(&path).map_err(|error| SubdivError::Io { path: path.clone(), error })?;
         Ok(TempDir { path })
     }
 }

@@ -18,6 +18,7 @@ use serde_json::{Map, Value};
 use super::record::{Outcome, Record};
 use super::tasks;
 use crate::gpu::Context;
+use crate::mesh::solidity::NotSolid;
 use crate::mesh::{Mesh, Report};
 
 /// A refusal or a failure of one mesh.
@@ -33,6 +34,11 @@ impl Failure {
     /// The task declines the mesh with a clear error (the answer it would give a user).
     pub fn refused(reason: &str, error: impl std::fmt::Display) -> Failure {
         Failure { outcome: Outcome::Refused, reason: reason.into(), error: error.to_string() }
+    }
+
+    /// The mesh is not a solid the command would accept (`mesh::solidity`).
+    pub fn not_solid(e: NotSolid) -> Failure {
+        Failure::refused(e.defect.slug(), e)
     }
 
     /// A check failed or an unexpected error happened.

@@ -37,35 +37,15 @@ pub fn tetrahedron() -> Mesh {
     procedural::tetrahedron()
 }
 
-/// Square pyramid: four triangles and a quad, apex valence 4, base valence 3.
+/// Square pyramid: four triangles and a quad, apex valence 4, base valence 3 (the
+/// built-in model).
 pub fn pyramid() -> Mesh {
-    let positions = vec![
-        DVec3::new(-1.0, -1.0, 0.0),
-        DVec3::new(1.0, -1.0, 0.0),
-        DVec3::new(1.0, 1.0, 0.0),
-        DVec3::new(-1.0, 1.0, 0.0),
-        DVec3::new(0.0, 0.0, 1.5),
-    ];
-    let faces = vec![vec![0, 3, 2, 1], vec![0, 1, 4], vec![1, 2, 4], vec![2, 3, 4], vec![3, 0, 4]];
-    mesh(positions, faces)
+    procedural::pyramid()
 }
 
 /// Torus of `nu × nv` quads (major radius 2, minor 0.6): every vertex regular (valence 4).
 pub fn torus(nu: u32, nv: u32) -> Mesh {
-    let mut positions = Vec::new();
-    for i in 0..nu {
-        let u = TAU * f64::from(i) / f64::from(nu);
-        for j in 0..nv {
-            let v = TAU * f64::from(j) / f64::from(nv);
-            let r = 2.0 + 0.6 * v.cos();
-            positions.push(DVec3::new(r * u.cos(), r * u.sin(), 0.6 * v.sin()));
-        }
-    }
-    let id = |i: u32, j: u32| (i % nu) * nv + j % nv;
-    let faces = (0..nu)
-        .flat_map(|i| (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
-        .collect();
-    mesh(positions, faces)
+    procedural::torus(2.0, 0.6, nu as usize, nv as usize)
 }
 
 /// A closed mesh with vertices of every valence 3…8 and a heptagonal face: a heptagonal

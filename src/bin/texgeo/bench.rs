@@ -12,12 +12,12 @@ pub enum Command {
         #[command(flatten)]
         models: Models,
         /// Point sets per model (the thesis: 10).
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = crate::args::positive_usize)]
         sets: usize,
         /// Points per set (the thesis: 1000).
-        #[arg(long, default_value_t = 1000)]
+        #[arg(long, default_value_t = 1000, value_parser = crate::args::positive_usize)]
         points: usize,
-        /// TetraGrid resolutions for Tables 4-4 and 4-5.
+        /// TetraGrid resolutions for Tables 4-4 and 4-5 (2..=64).
         #[arg(long, value_delimiter = ',', default_values_t = vec![2, 4, 8, 16, 32, 64])]
         resolutions: Vec<usize>,
         /// Folder for the Markdown and CSV files.
@@ -28,17 +28,17 @@ pub enum Command {
     Voxelize {
         #[command(flatten)]
         models: Models,
-        /// Resolutions N (N³ voxels).
+        /// Resolutions N (N³ voxels, 1..=1024).
         #[arg(long, value_delimiter = ',', default_values_t = bench::voxelize::DEFAULT_RESOLUTIONS.to_vec())]
         sizes: Vec<usize>,
         /// Methods to measure (default: all).
-        #[arg(long, value_delimiter = ',')]
-        methods: Vec<String>,
-        /// Zone height in slices for `zoned` (default: automatic).
-        #[arg(long)]
-        zone: Option<usize>,
+        #[arg(long, value_delimiter = ',', value_enum)]
+        methods: Vec<texgeo::voxel::Method>,
+        /// Zone height in slices for `zoned`: a number ≥ 1, or `auto` (N/8, between 4 and 32).
+        #[arg(long, default_value_t = texgeo::voxel::Zone::Auto)]
+        zone: texgeo::voxel::Zone,
         /// Timed runs per measurement (the median is reported).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = crate::args::positive_usize)]
         runs: usize,
         /// Folder for the Markdown and CSV files.
         #[arg(long, short, default_value = "out/bench")]
@@ -50,7 +50,7 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = bench::xor::DEFAULT_SIDES.to_vec())]
         sizes: Vec<u32>,
         /// Triangles per target.
-        #[arg(long, default_value_t = 20_000)]
+        #[arg(long, default_value_t = 20_000, value_parser = crate::args::positive_usize)]
         triangles: usize,
         #[command(flatten)]
         common: Common,
@@ -66,8 +66,8 @@ pub enum Command {
     /// The 2010 thesis' Table 5: Catmull-Clark to level 5 with fragment meshes on the GPU
     /// vs the CPU reference and OpenSubdiv, on built-in models and fetched ones.
     Subdivide {
-        /// Subdivision level.
-        #[arg(long, short, default_value_t = 5)]
+        /// Subdivision level (≥ 1).
+        #[arg(long, short, default_value_t = 5, value_parser = crate::args::positive_u32)]
         level: u32,
         /// Extra mesh files (or `builtin:NAME`) to measure after the default models.
         #[arg(long = "mesh", value_name = "MESH")]
@@ -129,7 +129,7 @@ impl Models {
 #[derive(clap::Args)]
 pub struct Common {
     /// Timed runs per measurement (the median is reported).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = crate::args::positive_usize)]
     runs: usize,
     /// Folder for the Markdown and CSV files.
     #[arg(long, short, default_value = "out/bench")]
@@ -137,7 +137,7 @@ pub struct Common {
 }
 
 fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
-    println!("{}", report.to_markdown());
+    say!("{}", report.to_markdown());
     for f in report.write(&common.out)? {
         eprintln!("wrote {}", f.display());
     }
@@ -145,10 +145,17 @@ fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
 }
 
 pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
+    // The report folder must take files before hours of measuring start.
+    let out = match &cmd {
+        Command::Inclusion { out, .. } | Command::Voxelize { out, .. } => out,
+        Command::Xor { common, .. } | Command::Reduce { common, .. } | Command::Subdivide { common, .. } => {
+            &common.out
+        }
+    };
+    texgeo::output::check_dir(out)?;
     let ctx = crate::open_context(device)?;
     match cmd {
         Command::Inclusion { models, sets, points, resolutions, out } => {
-            anyhow::ensure!(sets > 0 && points > 0, "--sets and --points must be positive");
             let models = models
                 .load(bench::inclusion::STAND_INS)?
                 .into_iter()
@@ -158,15 +165,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             finish(bench::inclusion::run(&ctx, &models, &cfg)?, &Common { runs: 0, out })
         }
         Command::Voxelize { models, sizes, methods, zone, runs, out } => {
-            use texgeo::voxel::Method;
-            let methods = if methods.is_empty() {
-                Method::ALL.to_vec()
-            } else {
-                methods
-                    .iter()
-                    .map(|m| Method::parse(m).ok_or_else(|| anyhow::anyhow!("unknown method '{m}'")))
-                    .collect::<anyhow::Result<_>>()?
-            };
+            let methods = if methods.is_empty() { texgeo::voxel::Method::ALL.to_vec() } else { methods };
             for &n in &sizes {
                 texgeo::voxel::grid::check_resolution(n)?;
             }
@@ -183,7 +182,6 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
-            anyhow::ensure!(triangles > 0, "--triangles must be positive");
             finish(bench::xor::run(&ctx, &sizes, triangles, common.runs)?, &common)
         }
         Command::Reduce { sizes, common } => {

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Context as _;
 use texgeo::mesh::{Mesh, formats};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::gpu::{Options, Run, Subdivider};
@@ -48,19 +47,20 @@ fn ms(d: std::time::Duration) -> f64 {
 fn describe_gpu(run: &Run) {
     let t = &run.times;
     if run.gpu_levels == 0 && run.fragments == 0 {
-        println!(
-            "level {} is below the base level: computed on the CPU ({:.1} ms)",
-            run.cpu_levels,
-            ms(t.total)
-        );
+        say!("level {} is below the base level: computed on the CPU ({:.1} ms)", run.cpu_levels, ms(t.total));
         return;
     }
-    println!(
+    say!(
         "GPU: {} CPU level(s), {} fragment pass(es); {} fragments in {} classes; targets 2 × {}×{} RGBA32F",
-        run.cpu_levels, run.gpu_levels, run.fragments, run.classes, run.texture[0], run.texture[1]
+        run.cpu_levels,
+        run.gpu_levels,
+        run.fragments,
+        run.classes,
+        run.texture[0],
+        run.texture[1]
     );
     let passes: Vec<String> = t.passes.iter().map(|&p| format!("{:.1}", ms(p))).collect();
-    println!(
+    say!(
         "time: {:.1} ms = base level {:.1} + fragments {:.1} + submission {:.1} (upload {:.1}, passes [{}], \
          readback {:.1}; GPU timestamps) + assembly {:.1}",
         ms(t.total),
@@ -74,17 +74,67 @@ fn describe_gpu(run: &Run) {
     );
 }
 
+/// Exact vertex, face and edge counts after `level` Catmull-Clark steps: one step makes
+/// V + E + F vertices, Σ degrees quads and 2E + Σ degrees edges, whatever the mesh.
+fn refined_counts(mesh: &Mesh, level: u32) -> (u128, u128, u128) {
+    let r = mesh.report();
+    let corners: usize = mesh.faces().map(<[u32]>::len).sum();
+    let (mut v, mut f, mut e) = ((r.vertices - r.unused_vertices) as u128, r.faces as u128, r.edges as u128);
+    let mut c = corners as u128;
+    for _ in 0..level {
+        (v, f, e, c) = (v + e + f, c, 2 * e + c, 4 * c);
+        if v > u64::MAX as u128 {
+            break;
+        }
+    }
+    (v, f, e)
+}
+
+/// Refuses, before any level is built, a level whose result does not fit: 32-bit vertex
+/// indices, or the memory of the last level and the refined mesh (plus the GPU's
+/// ping-pong targets and readback); the message gives the estimate and the output size.
+fn check_size(
+    mesh: &Mesh,
+    level: u32,
+    method: Method,
+    output: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let (v, f, e) = refined_counts(mesh, level);
+    let text = match output {
+        Some(p) => format!("; {} would be about {} MiB", p.display(), (60 * v + 30 * f) >> 20),
+        None => String::new(),
+    };
+    if v >= u64::from(u32::MAX) as u128 || 4 * f >= u64::from(u32::MAX) as u128 {
+        anyhow::bail!(
+            "level {level} would have {v} vertices and {f} faces, more than 32-bit indices hold{text}"
+        );
+    }
+    // The last level and the mesh built from it (as `cpu::refine` counts them), and for
+    // the GPU two RGBA32F targets and a readback, fragments overlapping by up to 2×.
+    let gpu = if method == Method::Gpu { 3 * 16 * 2 * v } else { 0 };
+    let bytes = 48 * v + 64 * f + 9 * e + gpu;
+    if let Err((need, have)) = texgeo::host::check_available(bytes.min(u64::MAX as u128) as u64) {
+        anyhow::bail!(
+            "level {level} ({v} vertices, {f} faces) needs about {need} MiB, but only {have} MiB are available{text}; \
+             use a lower level"
+        );
+    }
+    Ok(())
+}
+
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
-        // A wrong extension fails now, not after the subdivision.
+        // A wrong extension or an unwritable folder fails now, not after the subdivision.
         formats::Format::from_path(out)?;
+        texgeo::output::check_file(out)?;
     }
     let mesh = crate::mesh::load(&args.input)?;
-    println!("{}: {} vertices, {} faces", args.input, mesh.num_vertices(), mesh.num_faces());
+    check_size(&mesh, args.level, args.method, args.output.as_deref())?;
+    say!("{}: {} vertices, {} faces", args.input, mesh.num_vertices(), mesh.num_faces());
     let refined = match args.method {
         Method::Gpu => {
-            let ctx = crate::open_context(device)?;
-            println!("device: {}", ctx.info().label());
+            let ctx = crate::open_context_for(device, "cpu")?;
+            say!("device: {}", ctx.info().label());
             let mut subdivider = Subdivider::new(&ctx)?;
             let run = subdivider.refine(&ctx, &mesh, args.level, &Options::default()).map_err(explain)?;
             describe_gpu(&run);
@@ -93,14 +143,14 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         Method::Cpu => {
             let start = Instant::now();
             let refined = cpu::refine(&mesh, args.level).map_err(explain)?;
-            println!("CPU reference: {:.1} ms", ms(start.elapsed()));
+            say!("CPU reference: {:.1} ms", ms(start.elapsed()));
             refined
         }
     };
-    println!("level {}: {} vertices, {} faces", args.level, refined.num_vertices(), refined.num_faces());
+    say!("level {}: {} vertices, {} faces", args.level, refined.num_vertices(), refined.num_faces());
     if let Some(out) = &args.output {
-        formats::write(out, &refined).with_context(|| format!("writing {}", out.display()))?;
-        println!("wrote {}", out.display());
+        formats::write(out, &refined)?;
+        say!("wrote {}", out.display());
     }
     if args.validate && !validate(&mesh, &refined, args.level, args.method)? {
         std::process::exit(1);
@@ -114,9 +164,9 @@ fn validate(mesh: &Mesh, refined: &Mesh, level: u32, method: Method) -> anyhow::
     let reference = osd::refine(mesh, level)?;
     let tolerance = if method == Method::Gpu { GPU_TOLERANCE } else { CPU_TOLERANCE };
     let c = Comparison::new(refined, &reference, tolerance);
-    println!("OpenSubdiv ({:.1} ms incl. files): {c}", ms(start.elapsed()));
+    say!("OpenSubdiv ({:.1} ms incl. files): {c}", ms(start.elapsed()));
     let ok = c.is_match();
-    println!(
+    say!(
         "validation {}: tolerance {tolerance:e} × bounding-box diagonal",
         if ok { "passed" } else { "FAILED" }
     );

@@ -14,7 +14,7 @@ use crate::inclusion::bvh::Bvh;
 use crate::inclusion::octants::Octants;
 use crate::inclusion::octree::JordanOctree;
 use crate::inclusion::solver::Solver;
-use crate::inclusion::tetragrid::{RESOLUTIONS, TetraGrid};
+use crate::inclusion::tetragrid::{GridClassifier, RESOLUTIONS};
 use crate::inclusion::{Class, Classifier, EdgeRule, FeitoTorres, InclusionError, Method, Options};
 use crate::mesh::Mesh;
 use crate::random::Rng;
@@ -170,13 +170,13 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
     let cpu = crate::inclusion::build(Method::Cpu, mesh, &Options::default())?;
     let want: Vec<Vec<Class>> = sets.iter().map(|s| cpu.classify_all(s)).collect();
 
-    // Tables 4-4 and 4-5: TetraGrid at every resolution.
+    // Tables 4-4 and 4-5: GridClassifier at every resolution.
     for &n in &cfg.resolutions {
         if !RESOLUTIONS.contains(&n) {
             return Err(InclusionError::Resolution(n));
         }
         let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
-        let grid = TetraGrid::new(ft, n)?;
+        let grid = GridClassifier::new(ft, n)?;
         let s = grid.index_stats();
         m.grid_builds.push((s.build_time, s.bytes));
         let (t, ok) = mean_time(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
@@ -223,7 +223,7 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
     let ft = || FeitoTorres::with_options(mesh, None, EdgeRule::Rerun);
     m.index = vec![
         ("octants", Octants::new(ft()?).index_stats()),
-        ("tetragrid", TetraGrid::new(ft()?, 32)?.index_stats()),
+        ("tetragrid", GridClassifier::new(ft()?, 32)?.index_stats()),
         ("bvh", Bvh::new(ft()?).index_stats()),
         ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
     ];
@@ -252,7 +252,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
         cols.push(format!("{n}³ KiB"));
     }
     let mut t44 = Table {
-        title: "Table 4-4: TetraGrid build time (s) and memory (KiB)".into(),
+        title: "Table 4-4: GridClassifier build time (s) and memory (KiB)".into(),
         columns: cols,
         ..Default::default()
     };
