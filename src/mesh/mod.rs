@@ -6,7 +6,9 @@ use glam::DVec3;
 pub mod covering;
 pub mod error;
 pub mod formats;
+pub mod intersect;
 pub mod procedural;
+pub mod triangulate;
 pub mod validate;
 
 pub use error::{MeshError, Result};
