@@ -3,6 +3,7 @@
 //! `gpu` owns every Vulkan object; `mesh` is the polygon mesh and its formats;
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top.
 
+pub mod boolean;
 pub mod gpu;
 pub mod host;
 pub mod inclusion;

@@ -371,7 +371,11 @@ fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
 /// reported as `(f, f)`. Faces with no area (exactly collinear corners) are skipped:
 /// [`super::validate::Report::degenerate_faces`] counts them.
 pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
-    let soup = TriangleSoup::new(mesh);
+    soup_self_intersections(&TriangleSoup::new(mesh), limit)
+}
+
+/// [`self_intersections`] of a mesh already tessellated (`soup.face_of` names the faces).
+pub fn soup_self_intersections(soup: &TriangleSoup, limit: usize) -> Vec<(usize, usize)> {
     let mut found: Vec<(usize, usize)> = soup
         .failed
         .iter()
@@ -404,7 +408,7 @@ pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
                         if j > i
                             && !degenerate[j]
                             && soup.face_of[i] != soup.face_of[j]
-                            && soup_pair_meets(&soup, i, j)
+                            && soup_pair_meets(soup, i, j)
                         {
                             local.push((i as u32, j as u32));
                         }

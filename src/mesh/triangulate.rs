@@ -113,7 +113,7 @@ pub fn polygon(corners: &[DVec3]) -> Result<Vec<[u32; 3]>, TriangulateError> {
         }
     }
     let outline: Vec<u32> = (0..n as u32).collect();
-    let tris = cdt(&p, &outline, &[])?;
+    let tris = cdt(&p, &outline, &[])?.triangles;
     if tris.is_empty() {
         return Err(TriangulateError::Degenerate);
     }
@@ -133,20 +133,26 @@ impl HasPosition for Vertex2 {
     }
 }
 
+/// A constrained triangulation of a region.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Cdt {
+    /// Triangles inside the outline, as index triples, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+    /// The constraint edges inside the region (not on the outline), as index pairs: the
+    /// given constraints, split where a point lies exactly on one.
+    pub constraint_edges: Vec<[u32; 2]>,
+}
+
 /// Constrained Delaunay triangulation of the region bounded by the closed loop
 /// `outline` (indices into `points`, counter-clockwise), with the extra segments
 /// `constraints` (index pairs) as edges. Returns the triangles inside the outline as
-/// index triples into `points`, counter-clockwise. Points not on the outline are
-/// inserted too (they must lie inside it).
+/// index triples into `points`, counter-clockwise, and the constraint edges inside it.
+/// Points not on the outline are inserted too (they must lie inside it).
 ///
 /// Fails when segments cross or two points coincide: both mean the input was not a
 /// planar straight-line graph (a self-overlapping polygon, or intersection segments
 /// that rounding put across each other).
-pub fn cdt(
-    points: &[DVec2],
-    outline: &[u32],
-    constraints: &[[u32; 2]],
-) -> Result<Vec<[u32; 3]>, TriangulateError> {
+pub fn cdt(points: &[DVec2], outline: &[u32], constraints: &[[u32; 2]]) -> Result<Cdt, TriangulateError> {
     let vertices: Vec<Vertex2> = points
         .iter()
         .enumerate()
@@ -206,7 +212,21 @@ pub fn cdt(
             }
         }
     }
-    Ok(cdt.inner_faces().filter(|f| !outside[f.index()]).map(|f| f.vertices().map(|v| v.data().id)).collect())
+    let triangles = cdt
+        .inner_faces()
+        .filter(|f| !outside[f.index()])
+        .map(|f| f.vertices().map(|v| v.data().id))
+        .collect();
+    let constraint_edges = if constraints.is_empty() {
+        Vec::new()
+    } else {
+        cdt.undirected_edges()
+            .filter(|e| e.is_constraint_edge())
+            .map(|e| e.vertices().map(|v| v.data().id))
+            .filter(|[a, b]| !is_wall(*a, *b))
+            .collect()
+    };
+    Ok(Cdt { triangles, constraint_edges })
 }
 
 #[cfg(test)]
@@ -290,7 +310,12 @@ mod tests {
             DVec2::new(0.0, 1.0),
             DVec2::new(0.5, 0.5),
         ];
-        let tris = cdt(&p, &[0, 1, 2, 3, 4, 5], &[[1, 6], [6, 4]]).unwrap();
+        let out = cdt(&p, &[0, 1, 2, 3, 4, 5], &[[1, 6], [6, 4]]).unwrap();
+        let mut inner: Vec<[u32; 2]> =
+            out.constraint_edges.iter().map(|&[a, b]| [a.min(b), a.max(b)]).collect();
+        inner.sort_unstable();
+        assert_eq!(inner, vec![[1, 6], [4, 6]]);
+        let tris = out.triangles;
         let has_edge = |a: u32, b: u32| tris.iter().any(|t| (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b));
         assert!(has_edge(1, 6) || has_edge(6, 1));
         assert!(has_edge(6, 4) || has_edge(4, 6));
