@@ -6,6 +6,8 @@
 //! writes nothing. (NaN and infinite coordinates never get this far: the mesh readers
 //! refuse them.)
 
+use rayon::prelude::*;
+
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate, soup_self_intersections};
@@ -40,12 +42,12 @@ pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup
     if mesh.num_faces() == 0 {
         return Err(InputError::Empty);
     }
-    let report = mesh.report();
-    if report.boundary_edges > 0 {
-        return Err(InputError::Open { edges: report.boundary_edges });
+    let (boundary, misoriented) = edge_balance(mesh);
+    if boundary > 0 {
+        return Err(InputError::Open { edges: boundary });
     }
-    if report.misoriented_edges > 0 {
-        return Err(InputError::Inconsistent { edges: report.misoriented_edges });
+    if misoriented > 0 {
+        return Err(InputError::Inconsistent { edges: misoriented });
     }
     let soup = TriangleSoup::new(mesh);
     if let Some((face, reason)) = soup.failed.first().cloned() {
@@ -75,6 +77,42 @@ pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup
     Ok(soup)
 }
 
+/// Edges with one face (boundary) and edges used unequally in the two directions
+/// (misoriented), counted as [`crate::mesh::Report`] counts them, by sorting half-edges
+/// (the full report also finds fans and components, which are not needed here).
+fn edge_balance(mesh: &Mesh) -> (usize, usize) {
+    let (offsets, indices) = mesh.face_parts();
+    let mut half: Vec<(u64, bool)> = Vec::with_capacity(indices.len());
+    for w in offsets.windows(2) {
+        let face = &indices[w[0]..w[1]];
+        for (k, &a) in face.iter().enumerate() {
+            let b = face[(k + 1) % face.len()];
+            if a != b {
+                half.push(((a.min(b) as u64) << 32 | a.max(b) as u64, a < b));
+            }
+        }
+    }
+    half.par_sort_unstable();
+    let (mut boundary, mut misoriented) = (0, 0);
+    let mut i = 0;
+    while i < half.len() {
+        let mut j = i;
+        let mut forward = 0usize;
+        while j < half.len() && half[j].0 == half[i].0 {
+            forward += usize::from(half[j].1);
+            j += 1;
+        }
+        let n = j - i;
+        if n == 1 {
+            boundary += 1;
+        } else if 2 * forward != n {
+            misoriented += 1;
+        }
+        i = j;
+    }
+    (boundary, misoriented)
+}
+
 #[cfg(test)]
 mod tests {
     use glam::DVec3;
@@ -95,6 +133,11 @@ mod tests {
     fn refusals_name_the_reason() {
         let cube = procedural::cube();
         assert!(check(&cube, false).is_ok());
+        for m in [procedural::cube(), procedural::two_cubes_sharing_edge(), procedural::torus(1.0, 0.3, 8, 6)]
+        {
+            let r = m.report();
+            assert_eq!(edge_balance(&m), (r.boundary_edges, r.misoriented_edges));
+        }
         assert!(check(&procedural::two_cubes_sharing_edge(), false).is_ok());
         assert!(check(&procedural::cube_with_cavity(), false).is_ok());
         assert!(check(&procedural::l_prism(), false).is_ok());

@@ -13,13 +13,14 @@
 //! not crossing. Polygon faces are tessellated in their plane ([`super::triangulate`],
 //! never the covering's centroid fan, which overlaps itself on non-convex faces);
 //! triangles of one face are not tested against each other, and a face whose outline
-//! crosses itself is reported paired with itself. Candidate pairs come from a box
-//! hierarchy over the triangles ([`BoxTree`]).
+//! crosses itself is reported paired with itself. Candidate pairs come from a uniform
+//! grid over the triangles' boxes ([`super::boxgrid`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Mesh;
+use super::boxgrid::box_pairs;
 use super::triangulate::{self, Projection, TriangulateError};
 
 /// Exact orientation of d relative to the plane through a, b, c: positive when d lies on
@@ -249,115 +250,44 @@ pub fn weld_by_position(positions: &[DVec3]) -> Vec<u32> {
     weld
 }
 
-/// A bounding-box hierarchy over boxes (median split on the longest axis, 4 per leaf):
-/// the spatial index that yields candidate triangle pairs.
-#[derive(Clone, Debug)]
-pub struct BoxTree {
-    nodes: Vec<Node>,
-    /// Box ids in leaf order.
-    order: Vec<u32>,
-    /// Their boxes, in the same order.
-    leaf_boxes: Vec<(DVec3, DVec3)>,
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Node {
-    lo: DVec3,
-    hi: DVec3,
-    /// Leaf: first index into `order`; inner: left child (right = left + 1).
-    first: u32,
-    /// Leaf: number of boxes; inner: 0.
-    count: u32,
-}
-
-const LEAF: usize = 4;
-
-impl BoxTree {
-    /// Builds the hierarchy over `boxes` (closed boxes: touching counts as overlapping).
-    pub fn new(boxes: &[(DVec3, DVec3)]) -> BoxTree {
-        BoxTree::over(boxes, (0..boxes.len() as u32).collect())
-    }
-
-    /// Builds the hierarchy over the boxes listed in `ids` only.
-    pub fn over(boxes: &[(DVec3, DVec3)], mut order: Vec<u32>) -> BoxTree {
-        let mut nodes = Vec::with_capacity(2 * order.len() / LEAF + 1);
-        let centre = |t: u32| boxes[t as usize].0 + boxes[t as usize].1;
-        nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 });
-        let mut stack = vec![(0usize, 0usize, order.len())];
-        while let Some((n, a, b)) = stack.pop() {
-            let (lo, hi) = order[a..b].iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &t| {
-                (lo.min(boxes[t as usize].0), hi.max(boxes[t as usize].1))
-            });
-            if b - a <= LEAF {
-                nodes[n] = Node { lo, hi, first: a as u32, count: (b - a) as u32 };
-                continue;
-            }
-            let ext = hi - lo;
-            let axis = if ext.x >= ext.y && ext.x >= ext.z {
-                0
-            } else if ext.y >= ext.z {
-                1
-            } else {
-                2
-            };
-            let mid = (a + b) / 2;
-            order[a..b].select_nth_unstable_by(mid - a, |&s, &t| centre(s)[axis].total_cmp(&centre(t)[axis]));
-            let left = nodes.len();
-            nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 });
-            nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, first: 0, count: 0 });
-            nodes[n] = Node { lo, hi, first: left as u32, count: 0 };
-            stack.push((left, a, mid));
-            stack.push((left + 1, mid, b));
-        }
-        let leaf_boxes = order.iter().map(|&t| boxes[t as usize]).collect();
-        BoxTree { nodes, order, leaf_boxes }
-    }
-
-    /// Calls `f` with every box id whose box overlaps the closed box [lo, hi].
-    #[inline]
-    pub fn query(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(u32)) {
-        if self.order.is_empty() {
-            return;
-        }
-        let mut stack = [0u32; 64];
-        let mut depth = 1;
-        while depth > 0 {
-            depth -= 1;
-            let node = &self.nodes[stack[depth] as usize];
-            if node.lo.cmpgt(hi).any() || node.hi.cmplt(lo).any() {
-                continue;
-            }
-            if node.count > 0 {
-                let range = node.first as usize..(node.first + node.count) as usize;
-                for (&t, b) in self.order[range.clone()].iter().zip(&self.leaf_boxes[range]) {
-                    if !(b.0.cmpgt(hi).any() || b.1.cmplt(lo).any()) {
-                        f(t);
-                    }
-                }
-            } else if depth + 2 <= stack.len() {
-                stack[depth] = node.first;
-                stack[depth + 1] = node.first + 1;
-                depth += 2;
-            }
-        }
-    }
-}
-
 /// How two triangles of one mesh meet, judged by the vertices they share.
 fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
     let (ti, tj) = (soup.triangles[i], soup.triangles[j]);
-    let shared: Vec<(usize, usize)> =
-        (0..3).flat_map(|a| (0..3).filter(move |&b| ti[a] == tj[b]).map(move |b| (a, b))).collect();
+    // Shared corners as (corner of i, corner of j), without allocating.
+    let mut shared = [(0usize, 0usize); 3];
+    let mut k = 0;
+    for a in 0..3 {
+        for b in 0..3 {
+            if ti[a] == tj[b] {
+                shared[k] = (a, b);
+                k += 1;
+            }
+        }
+    }
     let (p, q) = (soup.triangle(i), soup.triangle(j));
-    match shared.len() {
+    match k {
         0 => triangles_meet(p, q),
         1 => {
             let (a, b) = shared[0];
-            meet_beyond_vertex(p[a], [p[(a + 1) % 3], p[(a + 2) % 3]], [q[(b + 1) % 3], q[(b + 2) % 3]])
+            let (pb, pc) = (p[(a + 1) % 3], p[(a + 2) % 3]);
+            let (qd, qe) = (q[(b + 1) % 3], q[(b + 2) % 3]);
+            // Quick exit: one triangle's free corners strictly on one side of the other's
+            // plane, so it touches that plane at the shared corner only.
+            let side = |plane: [DVec3; 3], x: DVec3, y: DVec3| {
+                let (sx, sy) = (
+                    sign(orient3d(plane[0], plane[1], plane[2], x)),
+                    sign(orient3d(plane[0], plane[1], plane[2], y)),
+                );
+                sx * sy > 0
+            };
+            if side(q, pb, pc) || side(p, qd, qe) {
+                return false;
+            }
+            meet_beyond_vertex(p[a], [pb, pc], [qd, qe])
         }
         2 => {
-            let c = (0..3).find(|&k| shared.iter().all(|s| s.0 != k)).unwrap_or(0);
-            let d = (0..3).find(|&k| shared.iter().all(|s| s.1 != k)).unwrap_or(0);
+            let c = (0..3).find(|&x| shared[0].0 != x && shared[1].0 != x).unwrap_or(0);
+            let d = (0..3).find(|&x| shared[0].1 != x && shared[1].1 != x).unwrap_or(0);
             meet_beyond_edge(p[shared[0].0], p[shared[1].0], p[c], q[d])
         }
         // The same three corners: the faces coincide there.
@@ -366,8 +296,8 @@ fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
 }
 
 /// Face pairs `(f, g)`, f ≤ g, of `mesh` that intersect more than they may (see the
-/// module docs), at most `limit` of them: the pairs found first in triangle order, so
-/// the answer is the same on every run. A face whose outline crosses itself is
+/// module docs), at most `limit` of them: the first ones in triangle order, so the
+/// answer is the same on every run. A face whose outline crosses itself is
 /// reported as `(f, f)`. Faces with no area (exactly collinear corners) are skipped:
 /// [`super::validate::Report::degenerate_faces`] counts them.
 pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
@@ -387,40 +317,20 @@ pub fn soup_self_intersections(soup: &TriangleSoup, limit: usize) -> Vec<(usize,
         return found;
     }
     let n = soup.triangles.len();
-    let boxes = soup.boxes();
     let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();
-    let tree = BoxTree::new(&boxes);
-    // Chunks in triangle order, parallel inside a chunk: stop after the chunk in which
-    // the limit is reached, so the pairs kept do not depend on thread timing.
-    const CHUNK: usize = 1 << 14;
-    let mut start = 0;
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    while start < n && pairs.len() < limit {
-        let end = (start + CHUNK).min(n);
-        let mut chunk: Vec<(u32, u32)> = (start..end)
-            .into_par_iter()
-            .with_min_len(256)
-            .flat_map_iter(|i| {
-                let mut local = Vec::new();
-                if !degenerate[i] {
-                    tree.query(boxes[i].0, boxes[i].1, |j| {
-                        let j = j as usize;
-                        if j > i
-                            && !degenerate[j]
-                            && soup.face_of[i] != soup.face_of[j]
-                            && soup_pair_meets(soup, i, j)
-                        {
-                            local.push((i as u32, j as u32));
-                        }
-                    });
-                }
-                local
-            })
-            .collect();
-        chunk.sort_unstable();
-        pairs.extend(chunk);
-        start = end;
-    }
+    let mut pairs: Vec<(u32, u32)> = box_pairs(&soup.boxes(), None)
+        .into_par_iter()
+        .with_min_len(1024)
+        .filter(|&(i, j)| {
+            let (i, j) = (i as usize, j as usize);
+            !degenerate[i]
+                && !degenerate[j]
+                && soup.face_of[i] != soup.face_of[j]
+                && soup_pair_meets(soup, i, j)
+        })
+        .collect();
+    // Triangle-pair order, so the pairs kept under the limit do not depend on timing.
+    pairs.par_sort_unstable();
     let mut faces: Vec<(usize, usize)> = pairs
         .into_iter()
         .map(|(i, j)| {
@@ -511,16 +421,5 @@ mod tests {
     fn welding_treats_negative_zero_as_zero() {
         let w = weld_by_position(&[v(0.0, 1.0, 2.0), v(5.0, 5.0, 5.0), v(-0.0, 1.0, 2.0)]);
         assert_eq!(w, vec![0, 1, 0]);
-    }
-
-    #[test]
-    fn box_tree_finds_every_overlap() {
-        let boxes: Vec<(DVec3, DVec3)> =
-            (0..100).map(|i| (DVec3::splat(i as f64), DVec3::splat(i as f64 + 1.0))).collect();
-        let tree = BoxTree::new(&boxes);
-        let mut hits = Vec::new();
-        tree.query(DVec3::splat(10.0), DVec3::splat(10.5), |t| hits.push(t));
-        hits.sort_unstable();
-        assert_eq!(hits, vec![9, 10]);
     }
 }

@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 
+pub mod boxgrid;
 pub mod covering;
 pub mod error;
 pub mod formats;

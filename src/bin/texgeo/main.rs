@@ -2,6 +2,7 @@
 //! `--validate` comparison exits with status 1).
 
 mod bench;
+mod boolean;
 mod demo;
 mod inclusion;
 mod info;
@@ -45,6 +46,8 @@ enum Command {
     Demo(demo::Args),
     /// Solid voxelization by slicing tetrahedra with XOR; writes .binvox (+ PNG slices).
     Voxelize(voxelize::Args),
+    /// Boolean operations on two closed solids: union, intersection, difference, symmetric difference.
+    Boolean(boolean::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -64,6 +67,7 @@ fn main() {
         Command::Bench(c) => bench::run(device, c),
         Command::Demo(a) => demo::run(device, a),
         Command::Voxelize(a) => voxelize::run(device, a),
+        Command::Boolean(a) => boolean::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {e:#}");
