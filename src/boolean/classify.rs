@@ -7,7 +7,9 @@
 //! - **Groups** (§6.5.1): triangles connected across edges that are not on the cut
 //!   curve lie on the same side of the other solid, so each group is classified by one
 //!   interior point: the centroid of its largest triangle. [`Grouping::Plain`] tests
-//!   every triangle's centroid instead (the thesis' "Nuevo" columns of Table 6-1).
+//!   every triangle's centroid instead (the thesis' "Nuevo" columns of Table 6-1); a
+//!   sliver whose centroid lies within the method's tolerance of the other surface then
+//!   takes the class its group's other answers give.
 //! - **Point tests** go to the inclusion module through the caller (any method, the GPU
 //!   ones included). A point the method finds *on the boundary* — within its tolerance
 //!   of the other surface, although the piece is not on it (a thin sliver) — is decided
@@ -87,6 +89,9 @@ pub enum ClassifyError {
     Undecided { side: Side, count: usize, near: DVec3 },
 }
 
+/// Classifies points against the input solid A or B with an inclusion method.
+pub type PointTest<'a> = dyn FnMut(Side, &[DVec3]) -> inclusion::Result<Vec<inclusion::Class>> + 'a;
+
 /// Classifies both refined meshes. `test(solid, points)` classifies points against the
 /// input solid `solid` (A or B) with an inclusion method.
 pub fn classify(
@@ -94,7 +99,7 @@ pub fn classify(
     a: &TriangleSoup,
     b: &TriangleSoup,
     grouping: Grouping,
-    test: &mut dyn FnMut(Side, &[DVec3]) -> inclusion::Result<Vec<inclusion::Class>>,
+    test: &mut PointTest,
 ) -> Result<Classification, ClassifyError> {
     let mut b_coplanar: Vec<(u32, u32, bool)> = r.coplanar.iter().map(|&(t, u, s)| (u, t, s)).collect();
     b_coplanar.sort_unstable_by_key(|c| (c.0, c.1));
@@ -103,7 +108,7 @@ pub fn classify(
         || on_status(&r.b, &r.points, b, a, &b_coplanar),
     );
     let ((groups_a, count_a), (groups_b, count_b)) =
-        rayon::join(|| groups(&r.a, &on_a, r, grouping), || groups(&r.b, &on_b, r, grouping));
+        rayon::join(|| groups(&r.a, &on_a, r), || groups(&r.b, &on_b, r));
 
     let mut stats = ClassifyStats {
         triangles: r.a.triangles.len() + r.b.triangles.len(),
@@ -115,33 +120,49 @@ pub fn classify(
     for (side, refined, on, (group, count), other) in
         [(Side::A, &r.a, &on_a, (&groups_a, count_a), b), (Side::B, &r.b, &on_b, (&groups_b, count_b), a)]
     {
-        let reps = representatives(refined, &r.points, group, count);
-        let points: Vec<DVec3> = reps.iter().map(|&t| centroid(refined, &r.points, t)).collect();
+        // Grouped: one point per group. Plain: one per off-surface triangle.
+        let tested: Vec<u32> = match grouping {
+            Grouping::Grouped => representatives(refined, &r.points, group, count),
+            Grouping::Plain => {
+                (0..refined.triangles.len() as u32).filter(|&t| on[t as usize].is_none()).collect()
+            }
+        };
+        let points: Vec<DVec3> = tested.iter().map(|&t| centroid(refined, &r.points, t)).collect();
         stats.point_tests += points.len();
         let other_side = if side == Side::A { Side::B } else { Side::A };
         let answers = test(other_side, &points)?;
-        // Decide the boundary answers exactly, trying other triangles of the group.
-        let mut group_class: Vec<Class> = Vec::with_capacity(count);
-        let mut pending = Vec::new();
-        for (g, c) in answers.iter().enumerate() {
-            group_class.push(match c {
-                inclusion::Class::Inside => Class::In,
-                inclusion::Class::Outside => Class::Out,
-                inclusion::Class::OnBoundary => {
-                    pending.push(g);
-                    Class::Out
-                }
-            });
+        let decisive = |c: &inclusion::Class| match c {
+            inclusion::Class::Inside => Some(Class::In),
+            inclusion::Class::Outside => Some(Class::Out),
+            inclusion::Class::OnBoundary => None,
+        };
+        // A group takes the class of its decisive answers (all equal: the group lies on
+        // one side). Plain mode keeps each triangle's own answer where it is decisive.
+        let mut group_class: Vec<Option<Class>> = vec![None; count];
+        for (&t, c) in tested.iter().zip(&answers) {
+            if let Some(c) = decisive(c) {
+                group_class[group[t as usize] as usize].get_or_insert(c);
+            }
         }
-        stats.exact_fallbacks += pending.len();
+        let mut own: Vec<Option<Class>> = vec![None; refined.triangles.len()];
+        if grouping == Grouping::Plain {
+            for (&t, c) in tested.iter().zip(&answers) {
+                own[t as usize] = decisive(c);
+            }
+        }
+        // A point within the method's tolerance of the other surface (a thin piece):
+        // groups with no decisive answer are decided exactly, trying other triangles.
+        let pending: Vec<usize> = (0..count).filter(|&g| group_class[g].is_none()).collect();
+        stats.exact_fallbacks += answers.iter().filter(|c| decisive(c).is_none()).count();
         if !pending.is_empty() {
             let decided = decide_exactly(refined, &r.points, group, &pending, other, side)?;
             for (g, c) in pending.into_iter().zip(decided) {
-                group_class[g] = c;
+                group_class[g] = Some(c);
             }
         }
+        let group_class: Vec<Class> = group_class.into_iter().map(|c| c.unwrap_or(Class::Out)).collect();
         let cls: Vec<Class> = (0..refined.triangles.len())
-            .map(|t| on[t].unwrap_or_else(|| group_class[group[t] as usize]))
+            .map(|t| on[t].or(own[t]).unwrap_or_else(|| group_class[group[t] as usize]))
             .collect();
         classes.push(cls);
     }
@@ -196,10 +217,10 @@ fn on_status(
 
 /// Group id of every refined triangle (on-triangles get their own groups, which are
 /// never tested) and the number of groups of off-surface triangles, which come first.
-fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement, grouping: Grouping) -> (Vec<u32>, usize) {
+fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>, usize) {
     let n = refined.triangles.len();
     let mut sets = UnionFind::new(n);
-    if grouping == Grouping::Grouped {
+    {
         // Edges of every triangle, sorted so that the triangles around an edge are adjacent.
         let mut edges: Vec<(u64, u32)> = (0..n as u32)
             .into_par_iter()
@@ -311,8 +332,8 @@ pub fn exact_parity(p: DVec3, soup: &TriangleSoup) -> Option<bool> {
     const DIRECTIONS: [DVec3; 8] = [
         DVec3::new(0.577_215_664_9, 0.271_828_182_8, 0.314_159_265_3),
         DVec3::new(-0.414_213_562_3, 0.732_050_807_5, 0.236_067_977_4),
-        DVec3::new(0.161_803_398_8, -0.693_147_180_5, 0.577_215_664_9),
-        DVec3::new(-0.301_029_995_6, -0.477_121_254_7, -0.698_970_004_3),
+        DVec3::new(0.161_803_398_8, -0.683_147_180_5, 0.577_215_664_9),
+        DVec3::new(-0.311_029_995_6, -0.477_121_254_7, -0.698_970_004_3),
         DVec3::new(0.845_098_040_0, 0.041_392_685_1, -0.903_089_987_0),
         DVec3::new(0.113_943_352_3, 0.954_242_509_4, -0.079_181_246_0),
         DVec3::new(-0.929_418_925_7, 0.146_128_035_7, 0.602_059_991_3),

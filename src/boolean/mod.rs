@@ -85,6 +85,8 @@ pub enum BooleanError {
     Classify(#[from] classify::ClassifyError),
     #[error("preparing the inclusion test of {name}: {source}")]
     Inclusion { name: String, source: inclusion::InclusionError },
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
     /// A regularized result of closed operands is not closed: a bug, reported.
     #[error(
         "internal error: the {op} is not closed ({boundary} boundary edge(s), {misoriented} misoriented); please report it"

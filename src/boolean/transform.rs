@@ -84,7 +84,7 @@ impl Transform {
                     if m3.determinant() == 0.0 {
                         return Err(format!("'{step}': the matrix is singular"));
                     }
-                    DAffine3 { matrix3: m3.into(), translation: DVec3::new(v[3], v[7], v[11]).into() }
+                    DAffine3 { matrix3: m3, translation: DVec3::new(v[3], v[7], v[11]) }
                 }
                 _ => {
                     return Err(format!(

@@ -185,6 +185,7 @@ mod tests {
     use super::*;
     use crate::random::Rng;
 
+    #[allow(clippy::needless_range_loop)]
     fn brute(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
         match b {

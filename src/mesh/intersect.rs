@@ -256,9 +256,9 @@ fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
     // Shared corners as (corner of i, corner of j), without allocating.
     let mut shared = [(0usize, 0usize); 3];
     let mut k = 0;
-    for a in 0..3 {
-        for b in 0..3 {
-            if ti[a] == tj[b] {
+    for (a, va) in ti.iter().enumerate() {
+        for (b, vb) in tj.iter().enumerate() {
+            if va == vb {
                 shared[k] = (a, b);
                 k += 1;
             }
