@@ -135,10 +135,18 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         overlap: false,
         ..Options::default()
     };
+    let mut refused = Vec::new();
     for pair in pairs {
         let triangles = pair.a.num_faces() + pair.b.num_faces();
-        let (p1, p2, asm, ev) =
-            measure(pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs)?;
+        let grouped = measure(pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs);
+        let (p1, p2, asm, ev) = match grouped {
+            Err(e @ boolean::BooleanError::Input { .. }) => {
+                eprintln!("texgeo: skipping {}: {e}", pair.name);
+                refused.push(format!("{} ({e})", pair.name));
+                continue;
+            }
+            r => r?,
+        };
         let (_, p2_gpu, _, ev_gpu) =
             measure(pair, &sequential(Method::Gpu, Grouping::Grouped), Some(ctx), cfg.runs)?;
         // The GPU and CPU classifications agree (they are both exact).
@@ -204,6 +212,9 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         cfg.runs.max(1),
         cfg.cpu_method
     ));
+    if !refused.is_empty() {
+        table.note(format!("Refused as operands, so not measured: {}.", refused.join("; ")));
+    }
     let mut tables = vec![table];
     if !cfg.scaling.is_empty() {
         let mut scaling = Table::new(
