@@ -4,6 +4,7 @@
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top; `sweep`
 //! runs one of them over a whole mesh collection; `output` writes every file atomically.
 
+pub mod boolean;
 pub mod exact;
 pub mod gpu;
 pub mod host;

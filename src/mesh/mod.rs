@@ -3,9 +3,11 @@
 
 use glam::DVec3;
 
+pub mod boxgrid;
 pub mod covering;
 pub mod error;
 pub mod formats;
+pub mod intersect;
 pub mod procedural;
 pub mod solidity;
 pub mod triangulate;

@@ -22,27 +22,30 @@
 //!    the cavity faces outwards again, and so on. Two shells with the same orientation,
 //!    one inside the other, give w = 2 between them; an inverted solid gives w = −1;
 //! 4. **not self-intersecting**: no two faces cross (overlapping shells give w = 2 where
-//!    they overlap). Detected by `mesh::intersect` (exact triangle–triangle tests); here,
-//!    shells that overlap are caught when a shell has vertices both inside and outside
+//!    they overlap). Detected by [`super::intersect::self_intersections`] (exact
+//!    triangle–triangle tests on the faces tessellated in their planes); shells that
+//!    overlap are also named as such when a shell has vertices both inside and outside
 //!    another.
 //!
-//! Anything else is refused by `inclusion` and `voxelize` with status 2 and the reason
-//! ([`Defect`]), unless a flag changes the question:
+//! Anything else is refused by `inclusion`, `voxelize` and `boolean` (and skipped by
+//! `sweep` with the same reason) with status 2 and the reason ([`Defect`]), unless a flag
+//! changes the question:
 //!
 //! - `--flip-inverted`: an inverted solid (every face reversed would make it valid) is
 //!   flipped and then treated as the solid it describes;
 //! - `--allow-open` (`inclusion` only): a mesh that is not closed has no inside; a point
 //!   is then classified by the *generalized* winding number of the open surface (inside
 //!   iff w ≥ ½), which only the `winding` method computes: other methods are refused
-//!   under it when the mesh really is open.
+//!   under it when the mesh really is open;
+//! - `--allow-self-intersections` (`boolean` only): go on with crossing faces, best effort.
 //!
 //! [`check`] measures everything and lists every defect (`texgeo mesh stats` prints it);
 //! [`require_solid`] is the gate a command puts in front of its algorithm.
 
 use glam::DVec3;
 
-use super::Mesh;
 use super::covering::{Covering, UnbalancedEdge, signed_tetra_volume};
+use super::{Mesh, intersect};
 
 /// Vertices sampled per shell to find how deep it is nested.
 const SAMPLES: usize = 8;
@@ -88,6 +91,8 @@ pub enum Defect {
          the winding number is not 0 or 1 where they overlap"
     )]
     CrossingShells { a: usize, b: usize },
+    #[error("faces {a} and {b} cross each other (the surface intersects itself)")]
+    SelfIntersecting { a: usize, b: usize },
 }
 
 impl Defect {
@@ -100,6 +105,7 @@ impl Defect {
             Defect::InvertedShell { .. } => "inverted-shell",
             Defect::NestedShell { .. } => "nested-shell",
             Defect::CrossingShells { .. } => "crossing-shells",
+            Defect::SelfIntersecting { .. } => "self-intersecting",
         }
     }
 
@@ -204,8 +210,11 @@ pub fn check(mesh: &Mesh) -> Solidity {
     report.volume = Some(volume);
     nesting(mesh, &covering, &groups, &mut report);
     orientation(&mut report);
-    // Self-intersection (`mesh::intersect`, exact triangle–triangle tests) is point 4 of
-    // the rule: one more defect variant, pushed here.
+    // Exact triangle–triangle tests: faces that cross make the winding number 2 (or −1)
+    // somewhere even when every shell on its own is fine.
+    if let Some(&(a, b)) = intersect::self_intersections(mesh, 1).first() {
+        report.defects.push(Defect::SelfIntersecting { a, b });
+    }
     report
 }
 
@@ -366,6 +375,19 @@ pub struct Policy {
     pub allow_open: bool,
     /// `--flip-inverted`: reverse every face of an inverted solid.
     pub flip_inverted: bool,
+    /// `boolean --allow-self-intersections`: go on with faces that cross (best effort).
+    pub allow_self_intersections: bool,
+}
+
+/// The first defect of `solidity` that `policy` does not excuse (an inverted solid is
+/// excused when the policy flips it; [`require_solid`] then checks the flipped mesh).
+pub fn first_refusal(solidity: &Solidity, policy: Policy) -> Option<&Defect> {
+    solidity.defects.iter().find(|d| match d {
+        Defect::Open(_) => !policy.allow_open,
+        Defect::Inverted { .. } => !policy.flip_inverted,
+        Defect::SelfIntersecting { .. } | Defect::CrossingShells { .. } => !policy.allow_self_intersections,
+        _ => true,
+    })
 }
 
 /// A mesh a command may work on.
@@ -392,21 +414,19 @@ pub struct NotSolid {
 /// (or flipped, or open, as `policy` allows), else the reason it is not.
 pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
     let solidity = check(&mesh);
-    match solidity.defects.first() {
-        None => Ok(Accepted { mesh, solidity, flipped: false, open: false }),
-        Some(Defect::Open(_)) if policy.allow_open => {
-            Ok(Accepted { mesh, solidity, flipped: false, open: true })
-        }
-        Some(Defect::Inverted { .. }) if policy.flip_inverted => {
-            let mesh = flipped(&mesh);
-            let solidity = check(&mesh);
-            match solidity.defects.first() {
-                None => Ok(Accepted { mesh, solidity, flipped: true, open: false }),
-                Some(d) => Err(NotSolid { defect: d.clone() }),
-            }
-        }
-        Some(d) => Err(NotSolid { defect: d.clone() }),
+    if let Some(d) = first_refusal(&solidity, policy) {
+        return Err(NotSolid { defect: d.clone() });
     }
+    let open = solidity.defects.iter().any(|d| matches!(d, Defect::Open(_)));
+    if solidity.defects.iter().any(|d| matches!(d, Defect::Inverted { .. })) {
+        let mesh = flipped(&mesh);
+        let solidity = check(&mesh);
+        return match first_refusal(&solidity, Policy { flip_inverted: false, ..policy }) {
+            None => Ok(Accepted { mesh, solidity, flipped: true, open }),
+            Some(d) => Err(NotSolid { defect: d.clone() }),
+        };
+    }
+    Ok(Accepted { mesh, solidity, flipped: false, open })
 }
 
 #[cfg(test)]

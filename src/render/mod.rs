@@ -31,7 +31,6 @@ mod model;
 mod picture;
 mod renderer;
 mod scene;
-mod triangulate;
 pub mod voxels;
 
 pub use camera::Camera;
@@ -42,4 +41,3 @@ pub use model::{Content, Model};
 pub use picture::Picture;
 pub use renderer::{Prepared, Renderer, View};
 pub use scene::{Colours, Points, Polyline, Scene, SceneMesh, Shading};
-pub use triangulate::triangulate_face;

@@ -44,6 +44,26 @@ pub enum Command {
         #[arg(long, short, default_value = "out/bench")]
         out: PathBuf,
     },
+    /// Booleans: the thesis' Table 6-1 (phases, plain vs grouped, CPU vs GPU point tests,
+    /// CGAL) on stand-in pairs, and the growth from 1 k to 100 k triangles.
+    Boolean {
+        #[command(flatten)]
+        models: Models,
+        /// CPU inclusion method for the point tests.
+        #[arg(long, default_value = "octants")]
+        method: String,
+        /// Skip the plain classification (one point test per triangle; slow on big models).
+        #[arg(long)]
+        no_plain: bool,
+        /// Skip CGAL.
+        #[arg(long)]
+        no_cgal: bool,
+        /// Triangle counts of the scaling series (sphere − turned copy); 0 = none.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1_000, 4_000, 16_000, 64_000, 100_000])]
+        scaling: Vec<usize>,
+        #[command(flatten)]
+        common: Common,
+    },
     /// XOR rasterization (logic op) of random triangles against the CPU scanline rasterizer.
     Xor {
         /// Target sides to measure.
@@ -148,9 +168,10 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
     // The report folder must take files before hours of measuring start.
     let out = match &cmd {
         Command::Inclusion { out, .. } | Command::Voxelize { out, .. } => out,
-        Command::Xor { common, .. } | Command::Reduce { common, .. } | Command::Subdivide { common, .. } => {
-            &common.out
-        }
+        Command::Xor { common, .. }
+        | Command::Reduce { common, .. }
+        | Command::Subdivide { common, .. }
+        | Command::Boolean { common, .. } => &common.out,
     };
     texgeo::output::check_dir(out)?;
     let ctx = crate::open_context(device)?;
@@ -177,6 +198,27 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             anyhow::ensure!(!models.is_empty(), "no models to measure");
             let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
             finish(bench::voxelize::run(&ctx, &models, &cfg)?, &Common { runs, out })
+        }
+        Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {
+            use bench::boolean::{Config, Pair, STAND_INS};
+            let cpu_method: texgeo::inclusion::Method = method.parse()?;
+            anyhow::ensure!(
+                cpu_method.is_cpu(),
+                "--method takes a CPU inclusion method (the GPU one always runs)"
+            );
+            let pairs = models
+                .load(STAND_INS)?
+                .into_iter()
+                .map(|(thesis, name, mesh)| Ok(Pair::with_turned_copy(thesis, name, mesh)?))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let cfg = Config {
+                runs: common.runs,
+                cpu_method,
+                plain: !no_plain,
+                cgal: !no_cgal,
+                scaling: scaling.into_iter().filter(|&n| n > 0).collect(),
+            };
+            finish(bench::boolean::run(&ctx, &pairs, &cfg)?, &common)
         }
         Command::Xor { sizes, triangles, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {

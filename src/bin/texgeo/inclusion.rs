@@ -61,7 +61,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         (None, None) => anyhow::bail!("give --points FILE or --random N"),
     };
     check_size(count, args.points.is_some(), args.output.is_some())?;
-    let policy = Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted };
+    let policy =
+        Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
     let mesh = solid.mesh;
     if solid.flipped {

@@ -14,6 +14,7 @@ macro_rules! say {
 
 mod args;
 mod bench;
+mod boolean;
 mod demo;
 mod inclusion;
 mod info;
@@ -66,6 +67,8 @@ enum Command {
     Render(render::Args),
     /// An interactive window: orbit a mesh, step through subdivision levels live, voxels.
     View(view::Args),
+    /// Boolean operations on two closed solids: union, intersection, difference, symmetric difference.
+    Boolean(boolean::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -121,6 +124,7 @@ fn main() {
         Command::Sweep(a) => sweep::run(device, a),
         Command::Render(a) => render::run(device, a),
         Command::View(a) => view::run(device, a),
+        Command::Boolean(a) => boolean::run(device, a),
     };
     if let Err(e) = result {
         eprintln!("texgeo: error: {}", one_line(&e));

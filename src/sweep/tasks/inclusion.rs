@@ -90,7 +90,7 @@ impl Task for Inclusion {
     ) -> Result<(), Failure> {
         let method: Method = o.method.parse().map_err(|e| Failure::failed("options", e))?;
         // The same gate as `texgeo inclusion`: what the command refuses, the sweep refuses.
-        let policy = Policy { allow_open: o.allow_open, flip_inverted: false };
+        let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
         let mesh = &require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?.mesh;
         let (lo, hi) = mesh.bounds();
         let points = Rng::new(o.seed).points_in_box(o.points, lo, hi);
