@@ -281,7 +281,7 @@ fn bad_operands_are_refused_with_the_reason() {
     )
     .unwrap();
     let names = Names { a: "first.off", b: "second.off" };
-    for (bad, want) in [(&open, "open"), (&inverted, "inverted")] {
+    for (bad, want) in [(&open, "not closed"), (&inverted, "inverted")] {
         let e = boolean::evaluate(
             &cube,
             bad,

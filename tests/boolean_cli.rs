@@ -134,7 +134,7 @@ fn bad_operands_exit_2_and_write_nothing() {
     for (file, reason) in [
         (&open, "open"),
         (&inverted, "inverted"),
-        (&inconsistent, "not consistently oriented"),
+        (&inconsistent, "consistently oriented"),
         (&crossing, "intersects itself"),
         (&nan, "not finite"),
     ] {

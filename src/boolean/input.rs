@@ -28,13 +28,14 @@ pub enum InputError {
     Flat,
 }
 
-/// The flag that accepts a defect, as a hint (self-intersections are a Boolean's own flag).
-fn remedy(defect: &solidity::Defect) -> String {
+/// The `boolean` flag that accepts a defect, as a hint.
+fn remedy(defect: &solidity::Defect) -> &'static str {
     match defect {
-        solidity::Defect::SelfIntersecting { .. } => {
-            " (pass --allow-self-intersections to go on anyway)".to_string()
+        solidity::Defect::SelfIntersecting { .. } | solidity::Defect::CrossingShells { .. } => {
+            " (pass --allow-self-intersections to go on anyway)"
         }
-        d => d.remedy().map(|flag| format!(" (pass {flag} to accept it)")).unwrap_or_default(),
+        solidity::Defect::Inverted { .. } => " (pass --flip-inverted to reverse its faces)",
+        _ => "",
     }
 }
 

@@ -87,8 +87,8 @@ pub enum Defect {
     )]
     NestedShell { shell: usize, first_face: usize, outer: usize, winding: i32 },
     #[error(
-        "shells {a} and {b} overlap (shell {a} has vertices both inside and outside shell {b}): \
-         the winding number is not 0 or 1 where they overlap"
+        "the surface intersects itself: shells {a} and {b} overlap (shell {a} has vertices both inside \
+         and outside shell {b}), so the winding number is not 0 or 1 where they overlap"
     )]
     CrossingShells { a: usize, b: usize },
     #[error("faces {a} and {b} cross each other (the surface intersects itself)")]
