@@ -213,24 +213,6 @@ fn limits_give_clear_errors() {
     assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("classes"), "{err}");
 }
 
-#[test]
-fn rejects_non_manifold_input() {
-    let ctx = ctx();
-    let mut sub = Subdivider::new(&ctx).unwrap();
-    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-    let fin = Mesh::new(
-        vec![p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.), p(0., -1., 0.), p(0., 0., 1.)],
-        vec![vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]],
-    )
-    .unwrap();
-    let err = sub.refine(&ctx, &fin, 3, &Options::default()).unwrap_err();
-    assert!(matches!(err, SubdivError::NonManifoldEdge { .. }), "{err}");
-    // Level 0 only checks and copies.
-    let cube = shapes::cube();
-    assert_eq!(sub.refine(&ctx, &cube, 0, &Options::default()).unwrap().mesh, cube);
-    assert!(Topology::new(&cube).is_ok());
-}
-
 /// A vertex no face uses stays where it is, as in OpenSubdiv.
 #[test]
 fn isolated_vertices_stay() {

@@ -126,12 +126,7 @@ fn validate(mesh: &Mesh, refined: &Mesh, level: u32, method: Method) -> anyhow::
 /// Adds what to do about input Catmull-Clark cannot refine.
 fn explain(e: SubdivError) -> anyhow::Error {
     let hint = match &e {
-        SubdivError::NonManifoldEdge { .. }
-        | SubdivError::NonManifoldVertex { .. }
-        | SubdivError::Inconsistent { .. }
-        | SubdivError::DegenerateFace { .. } => {
-            "Catmull-Clark needs a manifold, consistently oriented mesh (see `texgeo mesh stats`)"
-        }
+        SubdivError::Feature(_) => "check the mesh's tags (t crease, t corner, t hole)",
         SubdivError::GpuLimit(_) => "try --method cpu or a lower level",
         _ => return e.into(),
     };
