@@ -206,11 +206,16 @@ fn sharp_features_match_opensubdiv() {
     for shape in shapes::sharp() {
         for level in 1..=shape.levels {
             let name = shape.name;
-            let ours = cpu::refine_surface(&shape.surface, level).unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
-            let reference = osd::refine_surface(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let ours = cpu::refine_surface(&shape.surface, level)
+                .unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
+            let reference =
+                osd::refine_surface(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
             let c = Comparison::new(&ours.mesh, &reference, TOLERANCE);
             assert!(c.is_match() && c.same_order, "{name} level {level} ({}):\n{c}", shape.covers);
-            assert!(ours.mesh.face_parts() == reference.face_parts(), "{name} level {level}: face lists differ");
+            assert!(
+                ours.mesh.face_parts() == reference.face_parts(),
+                "{name} level {level}: face lists differ"
+            );
         }
     }
 }

@@ -10,11 +10,10 @@ use common::shapes;
 use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::{Mesh, procedural};
-use texgeo::subdiv::compare::Comparison;
-use texgeo::subdiv::fragment::{self, BaseLevel, FragmentMesh};
+use texgeo::subdiv::compare::{Comparison, Matching};
+use texgeo::subdiv::fragment::{self, FragmentMesh};
 use texgeo::subdiv::gpu::{MAX_RUNS, Options, Packing, Subdivider};
-use texgeo::subdiv::topology::Topology;
-use texgeo::subdiv::{SubdivError, cpu, osd};
+use texgeo::subdiv::{SubdivError, Surface, cpu, osd};
 
 /// float32 GPU positions against f64 OpenSubdiv, after up to 5 levels (SPEC §5.4).
 const TOLERANCE: f64 = 1e-5;
@@ -41,7 +40,7 @@ fn assert_gpu_matches_opensubdiv(
     options: &Options,
 ) {
     let input = mesh.report();
-    let base_levels = BaseLevel::levels_needed(mesh);
+    let base_levels = fragment::levels_needed(mesh);
     for level in levels {
         let run =
             sub.refine(ctx, mesh, level, options).unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
@@ -141,10 +140,20 @@ fn fragment_layout_on_the_cpu_equals_the_reference() {
     for shape in shapes::all() {
         let levels = if shape.mesh.num_faces() > 500 { 1..=3 } else { 1..=4 };
         for level in levels {
-            let ours = fragment::refine(&shape.mesh, level).unwrap_or_else(|e| panic!("{}: {e}", shape.name));
+            let surface = Surface::smooth(shape.mesh.clone());
+            let ours = fragment::refine(&surface, level).unwrap_or_else(|e| panic!("{}: {e}", shape.name));
             let reference = cpu::refine(&shape.mesh, level).unwrap();
-            let c = Comparison::new(&ours, &reference, 1e-12);
+            let c = Comparison::new(&ours.mesh, &reference, 1e-12);
             assert!(c.is_match(), "{} level {level}:\n{c}", shape.name);
+        }
+    }
+    for shape in shapes::sharp() {
+        for level in 1..=shape.levels {
+            let name = shape.name;
+            let ours = fragment::refine(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let reference = cpu::refine_surface(&shape.surface, level).unwrap();
+            let c = Comparison::new(&ours.mesh, &reference.mesh, 1e-12);
+            assert!(c.is_match(), "{name} level {level} ({}):\n{c}", shape.covers);
         }
     }
 }
@@ -169,7 +178,7 @@ fn high_valence_fragments_span_rows() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
     let mesh = cone(40);
-    let fragments = FragmentMesh::new(&mesh).unwrap();
+    let fragments = FragmentMesh::new(&mesh, 4).unwrap();
     let widest = fragments.runs().iter().map(|r| r.class.len(2)).max().unwrap();
     assert!(widest > 64 * 3, "the apex fragment ({widest} texels) should span several 64-texel rows");
     let narrow = Options { row_width: Some(64) };
@@ -182,7 +191,7 @@ fn limits_give_clear_errors() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
     // One fragment over 2^24 texels: the cone's valence-40 apex at 12 fragment levels.
-    let fragments = FragmentMesh::new(&cone(40)).unwrap();
+    let fragments = FragmentMesh::new(&cone(40), 14).unwrap();
     let err = Packing::new(&fragments, 12, 16384, None).unwrap_err();
     assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("valence 40"), "{err}");
     let err = sub.refine(&ctx, &cone(40), 14, &Options::default()).unwrap_err();
@@ -260,4 +269,70 @@ fn subdivide_command() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("non-manifold edge") && stderr.contains("manifold"), "{stderr}");
+}
+
+/// Every shape of the sharp set on the GPU equals OpenSubdiv (1e-5 × diagonal), faces in
+/// OpenSubdiv's order (the comparison corresponds vertices through them), and ran its
+/// levels past the base level as fragment passes — except where the fragments cannot
+/// express the surface and the run says why.
+#[test]
+fn sharp_features_match_opensubdiv() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let mut gpu_levels = 0;
+    let mut sharp_fragments = 0;
+    for shape in shapes::sharp() {
+        let name = shape.name;
+        for level in 1..=shape.levels {
+            let run = sub
+                .refine_surface(&ctx, &shape.surface, level, &Options::default())
+                .unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
+            let reference = opensubdiv_surface(&shape.surface, level);
+            let c = Comparison::new(&run.mesh, &reference, TOLERANCE);
+            assert!(c.is_match(), "{name} level {level} ({}), GPU vs OpenSubdiv:\n{c}", shape.covers);
+            assert_ne!(
+                c.matching,
+                Matching::Positions,
+                "{name} level {level}: faces not in OpenSubdiv's order\n{c}"
+            );
+            let base = fragment::levels_needed(&shape.surface.mesh);
+            assert_eq!(run.cpu_levels + run.gpu_levels, level, "{name} level {level}");
+            if run.cpu_reasons.is_empty() {
+                assert_eq!(run.gpu_levels, level.saturating_sub(base), "{name} level {level}");
+            } else {
+                assert!(
+                    run.gpu_levels < level.saturating_sub(base).max(1),
+                    "{name} level {level}: {:?}",
+                    run.cpu_reasons
+                );
+            }
+            gpu_levels += run.gpu_levels;
+            sharp_fragments += run.sharp_fragments;
+        }
+    }
+    assert!(
+        gpu_levels > 150 && sharp_fragments > 1000,
+        "{gpu_levels} GPU levels, {sharp_fragments} sharp fragments"
+    );
+}
+
+/// Semi-sharp edges meeting a non-manifold crease outside a fragment's fan decay on the
+/// CPU first; the run says so.
+#[test]
+fn inexpressible_features_go_to_the_cpu_and_say_so() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let shape = shapes::sharp().into_iter().find(|s| s.name == "membrane_box_creased").unwrap();
+    let run = sub.refine_surface(&ctx, &shape.surface, 4, &Options::default()).unwrap();
+    assert_eq!((run.cpu_levels, run.gpu_levels), (2, 2), "{:?}", run.cpu_reasons);
+    assert!(run.cpu_reasons.iter().any(|r| r.contains("non-manifold vertex")), "{:?}", run.cpu_reasons);
+    // With an infinitely sharp edge there too, the vertex is a corner for good: no extra level.
+    let shape = shapes::sharp().into_iter().find(|s| s.name == "membrane_box_corner").unwrap();
+    let run = sub.refine_surface(&ctx, &shape.surface, 4, &Options::default()).unwrap();
+    assert_eq!((run.cpu_levels, run.gpu_levels), (1, 3), "{:?}", run.cpu_reasons);
+}
+
+/// OpenSubdiv's refinement of a surface; a missing helper fails the test.
+fn opensubdiv_surface(surface: &Surface, level: u32) -> Mesh {
+    osd::refine_surface(surface, level).unwrap_or_else(|e| panic!("{e}"))
 }

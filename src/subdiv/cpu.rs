@@ -118,6 +118,13 @@ impl Refiner {
         &self.options
     }
 
+    /// The control edge that edge `e` of the current level lies on, if it is sharp:
+    /// (sharpness, boundary, non-manifold).
+    pub(crate) fn edge_origin(&self, e: u32) -> Option<(f32, bool, bool)> {
+        let o = self.level.edge_origin.as_ref()?[e as usize];
+        (o != NONE).then(|| self.base_sharp[o as usize])
+    }
+
     /// The sharp edges of the current level (see [`SharpEdge`]).
     pub(crate) fn sharp_edges(&self) -> Vec<SharpEdge> {
         let Some(origin) = &self.level.edge_origin else { return Vec::new() };
@@ -419,11 +426,6 @@ impl Level {
         self.sharp.as_ref().map_or(0.0, |s| s.vertex[v as usize])
     }
 
-    /// True when an edge or vertex is sharp.
-    pub(crate) fn has_sharpness(&self) -> bool {
-        self.sharp.is_some()
-    }
-
     /// The sharp vertices with their sharp edges (`edge << 1 | end`), in OpenSubdiv's order.
     pub(crate) fn sharp_vertices(&self) -> impl Iterator<Item = (u32, &[u32])> + '_ {
         self.sharp.iter().flat_map(|s| (0..s.verts.len()).map(move |i| (s.verts[i], s.list(i))))
@@ -467,7 +469,9 @@ impl Level {
 
     fn into_mesh(self) -> Result<Mesh> {
         let (offsets, indices) = match (self.faces, self.holes) {
-            (Faces::Polygons(offsets), None) => (offsets.into_iter().map(|o| o as usize).collect(), self.face_verts),
+            (Faces::Polygons(offsets), None) => {
+                (offsets.into_iter().map(|o| o as usize).collect(), self.face_verts)
+            }
             (Faces::Quads, None) => ((0..=self.face_verts.len()).step_by(4).collect(), self.face_verts),
             (faces, Some(holes)) => {
                 let offsets: Vec<usize> = match faces {
@@ -533,7 +537,11 @@ impl Child {
                 edge_verts: Vec::with_capacity(edges),
                 sharp: None,
                 holes: parent.holes.as_ref().map(|_| Vec::with_capacity(nc)),
-                edge_origin: parent.edge_origin.as_ref().filter(|_| with_topology).map(|_| Vec::with_capacity(edges)),
+                edge_origin: parent
+                    .edge_origin
+                    .as_ref()
+                    .filter(|_| with_topology)
+                    .map(|_| Vec::with_capacity(edges)),
                 last_sharp_edges: Vec::new(),
                 edge_triangles: None,
             },
@@ -557,7 +565,9 @@ impl Child {
                 child.around_of = vec![NONE; nv];
                 for (i, &v) in sharp.verts.iter().enumerate() {
                     child.around_of[v as usize] = i as u32;
-                    child.around.push(SemiSharpSum::of(sharp.list(i).iter().map(|&x| sharp.edge[(x >> 1) as usize])));
+                    child
+                        .around
+                        .push(SemiSharpSum::of(sharp.list(i).iter().map(|&x| sharp.edge[(x >> 1) as usize])));
                 }
             }
             child.halves = vec![[0.0; 2]; ne];
@@ -724,7 +734,9 @@ impl Child {
             let cvs = crease::decrement(vs);
             child_s.clear();
             child_s.extend(list.iter().map(|&x| self.halves[(x >> 1) as usize][(x & 1) as usize]));
-            let neighbour = |x: u32| parent.positions[parent.edge_verts[(x >> 1) as usize][(1 - (x & 1)) as usize] as usize];
+            let neighbour = |x: u32| {
+                parent.positions[parent.edge_verts[(x >> 1) as usize][(1 - (x & 1)) as usize] as usize]
+            };
             let smooth = self.level.positions[v as usize];
             let p_rule = Rule::of(vs, list.len());
             let c_rule = Rule::of(cvs, child_s.iter().filter(|&&s| s > 0.0).count());

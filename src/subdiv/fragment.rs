@@ -1,42 +1,74 @@
 //! Fragment meshes in sector layout (2010 thesis §3.3.1, after Shiue, Jones and Peters;
-//! SPEC §5.2): the CPU base level, one fragment per centre vertex, the thesis' storage
-//! order, and one refinement step of a fragment stream on the CPU — the stencils of
-//! `glsl/subdiv/refine.frag`, in f64, so the layout is testable without a GPU.
+//! SPEC §5.2), extended with sharp features (issue 14): the CPU base level, one fragment
+//! per fan of corners around a vertex, the thesis' storage order, per-texel sharpness
+//! data, and one refinement step of a fragment stream on the CPU — the stencils of
+//! `glsl/subdiv/refine.frag`, in f64, so layout and rules are testable without a GPU.
 //!
 //! Names used throughout the subdivision code:
 //!
-//! - the *coarse* mesh P: an all-quad mesh whose vertices are the fragment centres (the
-//!   input when it is all quads, else its first Catmull-Clark level);
+//! - the *coarse* mesh P: an all-quad level of the surface whose vertices are the fragment
+//!   centres (the input when it is all quads, else its first Catmull-Clark level, or a
+//!   later one when the fragments cannot express the earlier ones, see below);
 //! - the *base level* B: P refined once on the CPU. Every B quad has exactly one corner
 //!   that is a vertex point of P, so the quads around each centre (its *owned region*)
 //!   tile B, and every ring-1 vertex of a centre is an edge or face point of valence 4
 //!   (the validity condition of SPEC §5.2);
-//! - a fragment: the 2-ring of a centre c of valence k in B, in sectors. Sector s is the
-//!   P face between spokes s and s + 1 of c; its vertex (a, b) lies a steps along spoke s
-//!   and b steps towards spoke s + 1. (0, b) of sector s is (b, 0) of sector s + 1 and
-//!   (a, −1) of sector s is (1, a) of sector s − 1.
-//! - a boundary centre (on an open mesh's border) has k faces but k + 1 spokes: its
+//! - a fragment: the 2-ring of a centre c in B over one *fan* of c's corners
+//!   (`topology`), in sectors. Sector s is the P face of the fan's s-th corner, between
+//!   spokes s and s + 1; its vertex (a, b) lies a steps along spoke s and b steps towards
+//!   spoke s + 1. (0, b) of sector s is (b, 0) of sector s + 1 and (a, −1) of sector s is
+//!   (1, a) of sector s − 1. A manifold vertex has one fan; a non-manifold vertex has one
+//!   fragment per sheet, each bounded by the non-manifold edges as by a boundary;
+//! - an open fan (on a boundary or a non-manifold edge) of k corners has k + 1 spokes: its
 //!   fragment is a half-fan whose last spoke k is stored as one extra entry per ring, so
 //!   ring r has 2kr + 1 entries instead of 2kr.
 //!
 //! Storage order (the thesis'): the centre, then ring by ring; inside ring r, sector s
 //! takes 2r consecutive entries t ∈ [0, 2r): t ≤ r → (r, t), t > r → (2r − t, r); a
 //! half-fan's extra spoke entry (r, 0) comes last.
+//!
+//! # Sharpness data
+//!
+//! A fragment with any sharp edge or vertex in its region (every half-fan: its border is
+//! infinitely sharp) is *sharp*: each vertex entry is followed by a data texel, and the
+//! pass applies OpenSubdiv's crease rules (`crease`) from it:
+//!
+//! - centre entry: (vertex sharpness, 0, 0, 0);
+//! - entry (a, b): (count, sharpness of edge (a−1, b)–(a, b), sharpness of edge
+//!   (a, b−1)–(a, b), sum), where count and sum describe the semi-sharp edges of the
+//!   vertex (what Chaikin's rule averages; kept only with Chaikin creasing). Every edge of
+//!   the fragment is stored once this way (edge (a, −1)–(a, 0) is sector s − 1's (0, a)–(1, a)).
+//!
+//! Sharpness only decays, so a fragment whose largest semi-sharp value is σ needs data
+//! for ⌈σ⌉ levels (one more with Chaikin, whose `f32` averages may leave a last bit);
+//! after that *horizon* its stream drops the data texels and it runs the smooth stencil.
+//! Fragments are sorted into runs of one class (valence, half-fan) and horizon.
+//!
+//! # What the fragments cannot express
+//!
+//! A fan of a non-manifold vertex sees only its own sheet. Its centre's rule counts the
+//! sharp edges of all sheets: where the other sheets add only infinitely sharp edges and
+//! the vertex is a corner for good, the centre's sharpness is set to infinity; where they
+//! add semi-sharp edges (which change the centre's rule or, with Chaikin, its edges'
+//! decay), the CPU refines one more level before cutting fragments, until those edges
+//! have decayed — and says so ([`FragmentMesh::reasons`]).
 
 use glam::DVec3;
 
 use crate::mesh::Mesh;
 
 use super::assemble::assemble;
+use super::cpu::{self, Refiner, SharpEdge};
+use super::crease::{self, INFINITE, Method, Rule, SemiSharpSum};
 use super::topology::{NONE, Topology};
-use super::{Result, SubdivError, cpu};
+use super::{Result, SubdivError, Surface};
 
 /// The sector structure shared by every fragment of a class: valence and half-fan flag.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Class {
     /// Boundary centres (half-fans) sort after closed ones.
     pub boundary: bool,
-    /// Number of sectors (faces around the centre).
+    /// Number of sectors (corners of the fan).
     pub valence: u32,
 }
 
@@ -102,162 +134,422 @@ impl Class {
     }
 }
 
-/// A run of fragments of one class, consecutive in every stream.
+/// Levels of sharpness data a fragment needs ([`Fragment::horizon`]) when it has an
+/// infinitely sharp edge or vertex: all of them.
+pub const FOREVER: u32 = u32::MAX;
+
+/// A run of fragments of one class and horizon, consecutive in every stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ClassRun {
     pub class: Class,
+    /// Streams `0..horizon` carry sharpness data (see the module docs).
+    pub horizon: u32,
     /// Index of the run's first fragment.
     pub first: u32,
     pub count: u32,
 }
 
-/// Where each class run starts in a stream of fragments of one ring radius.
+impl ClassRun {
+    /// True when stream `j` of a refinement with `levels` fragment levels carries data
+    /// texels (the last stream never does: nothing reads it).
+    pub fn has_data(&self, j: u32, levels: u32) -> bool {
+        j < levels && j < self.horizon
+    }
+}
+
+/// Where each class run starts in the stream of one level.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct StreamLayout {
     pub radius: u32,
+    /// Whether each run's fragments carry data texels in this stream.
+    pub data: Vec<bool>,
     /// First texel of each class run.
     pub starts: Vec<u64>,
     /// Texels of the whole stream.
     pub total: u64,
 }
 
-/// A fragment: the centre (a coarse vertex) and its class.
+impl StreamLayout {
+    /// Texels per vertex entry of run `r`: 2 with data, else 1.
+    pub fn stride(&self, r: usize) -> u64 {
+        1 + u64::from(self.data[r])
+    }
+}
+
+/// A fragment: a fan of corners around a centre (a coarse vertex).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Fragment {
     pub centre: u32,
+    /// The fan in the coarse topology.
+    pub fan: u32,
     pub class: Class,
+    /// Streams `0..horizon` carry sharpness data; 0 for a smooth fragment.
+    pub horizon: u32,
     /// Index of its run in [`FragmentMesh::runs`].
     pub run: u32,
 }
 
-/// The CPU part of the thesis' step 1: the coarse all-quad mesh P and its refinement B.
-pub struct BaseLevel {
-    /// The coarse all-quad mesh P, whose vertices are the centres.
-    pub coarse: Topology,
-    /// Positions of the base level B = P refined once: P's vertex points, then its face
-    /// points, then its edge points (OpenSubdiv's order, as `cpu::refine` numbers them).
-    pub positions: Vec<DVec3>,
-    /// Catmull-Clark levels the CPU did to reach B (1 for all-quad input, else 2).
-    pub cpu_levels: u32,
+/// The result of cutting a surface into fragments.
+pub enum Built {
+    Fragments(FragmentMesh),
+    /// The level is reached before fragments can be cut (below the base level, or the
+    /// fragments cannot express the surface before it): refine on the CPU. The reasons
+    /// say why when it is not simply below the base level.
+    Cpu(Vec<String>),
 }
 
-impl BaseLevel {
-    /// Levels the CPU must do before fragments exist: 1 for all-quad input, else 2.
-    pub fn levels_needed(mesh: &Mesh) -> u32 {
-        if mesh.faces().all(|f| f.len() == 4) { 1 } else { 2 }
-    }
-
-    /// One CPU level for all-quad input, two otherwise (SPEC §5.2). Rejects what
-    /// Catmull-Clark cannot refine (non-manifold, inconsistently oriented, degenerate).
-    pub fn new(mesh: &Mesh) -> Result<BaseLevel> {
-        let cpu_levels = BaseLevel::levels_needed(mesh);
-        let refined;
-        let coarse_mesh = if cpu_levels == 1 {
-            mesh
-        } else {
-            refined = cpu::refine(mesh, 1)?;
-            &refined
-        };
-        let coarse = Topology::new(coarse_mesh)?;
-        // `cpu::refine` numbers edge points by the same edge numbering `Topology` gives P.
-        let positions = cpu::refine(coarse_mesh, 1)?.positions().to_vec();
-        Ok(BaseLevel { coarse, positions, cpu_levels })
-    }
-}
-
-/// The base level cut into fragment meshes (SPEC §5.2).
+/// The base level cut into fragment meshes (SPEC §5.2), with its base stream.
 pub struct FragmentMesh {
     coarse: Topology,
-    base: Vec<DVec3>,
     cpu_levels: u32,
-    /// Sorted by class, then centre.
+    method: Method,
+    reasons: Vec<String>,
+    /// Sorted by class, horizon, then centre.
     fragments: Vec<Fragment>,
     runs: Vec<ClassRun>,
-    /// Fragment of each coarse vertex (`NONE` for a vertex no face uses).
-    fragment_of: Vec<u32>,
-    /// For each coarse half-edge, its index among the spokes of its origin: the sector
-    /// of the face it starts.
+    /// Fragment of each fan of the coarse topology.
+    fragment_of_fan: Vec<u32>,
+    /// Sector of each coarse corner in its fragment (fans may be rotated, see `build`).
     sector_of: Vec<u32>,
+    /// First corner of each fragment: the corner of sector 0.
+    first_corner: Vec<u32>,
+    /// Coarse faces that are holes.
+    holes: Option<Vec<bool>>,
+    /// Coarse edges lying on sharp control edges: (edge, sharpness, boundary, non-manifold).
+    sharp_edges: Vec<(u32, f32, bool, bool)>,
+    /// The base stream (ring radius 2): positions (x, y, z, 1) and data texels.
+    base: Vec<[f64; 4]>,
+    /// Coarse vertices no face uses, with their (unchanging) positions, by vertex.
+    isolated: Vec<(u32, DVec3)>,
+}
+
+/// Levels the CPU must do before fragments exist: 1 for all-quad input, else 2.
+pub fn levels_needed(mesh: &Mesh) -> u32 {
+    if mesh.faces().all(|f| f.len() == 4) { 1 } else { 2 }
 }
 
 impl FragmentMesh {
-    /// The base level and the fragments around every vertex of the coarse mesh; closed
-    /// and open manifold meshes (open ones get half-fan fragments on their border).
-    pub fn new(mesh: &Mesh) -> Result<FragmentMesh> {
-        FragmentMesh::from_base(BaseLevel::new(mesh)?)
-    }
-
-    /// The fragments around every vertex of the coarse mesh of `base`.
-    pub fn from_base(base: BaseLevel) -> Result<FragmentMesh> {
-        let BaseLevel { coarse, positions, cpu_levels } = base;
-        let mut sector_of = vec![NONE; coarse.num_half_edges()];
-        let mut fragments = Vec::new();
-        for c in 0..coarse.num_vertices() as u32 {
-            let k = coarse.num_vertex_faces(c) as u32;
-            if k == 0 {
-                continue;
-            }
-            for (s, h) in coarse.spokes(c).enumerate() {
-                sector_of[h as usize] = s as u32;
-            }
-            let class = Class { boundary: coarse.is_boundary_vertex(c), valence: k };
-            fragments.push(Fragment { centre: c, class, run: 0 });
+    /// Cuts `surface` into fragments for a refinement to `level`: the CPU refines to the
+    /// coarse level P and once more to the base level B (SPEC §5.2), more levels when the
+    /// fragments cannot express P (see the module docs), and none at all when `level` is
+    /// reached first.
+    pub fn build(surface: &Surface, level: u32) -> Result<Built> {
+        let mut refiner = Refiner::new(&surface.mesh, &surface.features, &surface.options)?;
+        if levels_needed(&surface.mesh) == 2 && level >= 2 {
+            refiner.step(true)?;
         }
-        let mesh = FragmentMesh {
-            coarse,
-            base: positions,
-            cpu_levels,
-            fragments,
-            runs: Vec::new(),
-            fragment_of: Vec::new(),
-            sector_of,
-        };
-        mesh.check_validity()?;
-        Ok(mesh.sorted())
+        let mut reasons = Vec::new();
+        loop {
+            if refiner.depth() + 1 > level || !refiner.level().is_all_quads() {
+                return Ok(Built::Cpu(reasons));
+            }
+            match FragmentMesh::cut(&mut refiner)? {
+                Ok(mut mesh) => {
+                    mesh.reasons = reasons;
+                    return Ok(Built::Fragments(mesh));
+                }
+                Err(reason) => reasons.push(format!("CPU level {}: {reason}", refiner.depth())),
+            }
+        }
     }
 
-    /// Every sector must be a coarse quad: then B's ring-1 vertices of every centre are
-    /// edge points of edges with two quads (or boundary edges of a half-fan's end spokes)
-    /// and face points of quads, all of valence 4 — the fragment condition of SPEC §5.2.
-    fn check_validity(&self) -> Result<()> {
-        for f in 0..self.coarse.num_faces() as u32 {
-            let sides = self.coarse.face_half_edges(f).len();
+    /// The fragments of a smooth mesh to `level` (tests and benchmarks).
+    pub fn new(mesh: &Mesh, level: u32) -> Result<FragmentMesh> {
+        match FragmentMesh::build(&Surface::smooth(mesh.clone()), level)? {
+            Built::Fragments(f) => Ok(f),
+            Built::Cpu(_) => Err(SubdivError::Fragment(format!("level {level} is below the base level"))),
+        }
+    }
+
+    /// With `refiner` at the coarse level P: refines it to B and cuts B into fragments, or
+    /// says (`Err(reason)`) why the fragments cannot express P — `refiner` is then at B.
+    fn cut(refiner: &mut Refiner) -> Result<std::result::Result<FragmentMesh, String>> {
+        let p = refiner.level();
+        let coarse = p.topology();
+        let holes = (0..coarse.num_faces() as u32)
+            .any(|f| p.is_hole(f))
+            .then(|| (0..coarse.num_faces() as u32).map(|f| p.is_hole(f)).collect());
+        let sharp_edges: Vec<(u32, f32, bool, bool)> = (0..coarse.num_edges() as u32)
+            .filter_map(|e| refiner.edge_origin(e).map(|(s, b, n)| (e, s, b, n)))
+            .collect();
+        let cpu_levels = refiner.depth() + 1;
+        let method = refiner.options().crease_method;
+        refiner.step(true)?;
+        let b = refiner.level();
+        let (nv, nf, nc) =
+            (coarse.num_vertices() as u32, coarse.num_faces() as u32, coarse.num_half_edges() as u32);
+        // B's sharp vertices: semi-sharp sums (Chaikin) and sharp edge lists by vertex.
+        let mut sharp_list: std::collections::HashMap<u32, &[u32]> = std::collections::HashMap::new();
+        for (v, list) in b.sharp_vertices() {
+            sharp_list.insert(v, list);
+        }
+        let semi = |v: u32| -> (f32, f32) {
+            if method != Method::Chaikin {
+                return (0.0, 0.0);
+            }
+            let s = sharp_list.get(&v).map_or(SemiSharpSum::default(), |list| {
+                SemiSharpSum::of(list.iter().map(|&x| b.edge_sharpness(x >> 1)))
+            });
+            (s.count as f32, s.sum)
+        };
+        // The B half of coarse corner h's leaving edge at its origin / at its target.
+        let half_at_origin = |h: u32| nc + 2 * coarse.edge(h) + u32::from(coarse.is_reversed(h));
+        let half_at_target = |h: u32| nc + 2 * coarse.edge(h) + u32::from(!coarse.is_reversed(h));
+
+        let isolated_flags: Vec<bool> = (0..nv).map(|v| coarse.vertex_fans(v).0.is_none()).collect();
+        let coarse_ref_isolated = |v: u32| isolated_flags[v as usize];
+        let mut fragments = Vec::new();
+        let mut first_corner = Vec::new();
+        let mut centre_sharpness = Vec::new();
+        let mut spokes_at = Vec::new();
+        for (f, fan) in coarse.fans().iter().enumerate() {
+            let c = fan.centre;
+            let corners = coarse.fan_corners(fan);
+            // The B halves of the fan's spokes at the centre.
+            spokes_at.clear();
+            spokes_at.extend(corners.iter().map(|&h| half_at_origin(h)));
+            if !fan.closed {
+                spokes_at.push(half_at_target(coarse.prev(corners[corners.len() - 1])));
+            }
+            let list: &[u32] = sharp_list.get(&c).copied().unwrap_or(&[]);
+            let mut vs = b.vertex_sharpness(c);
+            let outside: Vec<f32> = list
+                .iter()
+                .filter(|&&x| !spokes_at.contains(&(x >> 1)))
+                .map(|&x| b.edge_sharpness(x >> 1))
+                .collect();
+            if !outside.is_empty() {
+                let infinite =
+                    list.iter().filter(|&&x| crease::is_infinite(b.edge_sharpness(x >> 1))).count();
+                let corner_for_good = crease::is_infinite(vs) || infinite >= 3;
+                let semi_outside = outside.iter().any(|&s| crease::is_semi_sharp(s));
+                if corner_for_good && (method == Method::Uniform || !semi_outside) {
+                    vs = INFINITE;
+                } else {
+                    return Ok(Err(format!(
+                        "the sharp edges around non-manifold vertex {c} are not all in one of its fans \
+                         (semi-sharp ones decay on the CPU first)"
+                    )));
+                }
+            }
+            // A closed fan starts at the first sharp edge of the centre's list: its f32 sums
+            // then run in OpenSubdiv's order.
+            let mut start = 0;
+            if fan.closed
+                && let Some(&x) = list.first()
+            {
+                start = spokes_at.iter().position(|&h| h == x >> 1).unwrap_or(0);
+            }
+            let class = Class { boundary: !fan.closed, valence: corners.len() as u32 };
+            fragments.push(Fragment { centre: c, fan: f as u32, class, horizon: 0, run: 0 });
+            first_corner.push(corners[start]);
+            centre_sharpness.push(vs);
+        }
+        for f in 0..coarse.num_faces() as u32 {
+            let sides = coarse.face_half_edges(f).len();
             if sides != 4 {
                 return Err(SubdivError::Fragment(format!(
                     "coarse face {f} has {sides} sides; fragment meshes need an all-quad coarse mesh"
                 )));
             }
         }
-        Ok(())
+
+        let mut mesh = FragmentMesh {
+            coarse,
+            cpu_levels,
+            method,
+            reasons: Vec::new(),
+            fragments,
+            runs: Vec::new(),
+            fragment_of_fan: Vec::new(),
+            sector_of: Vec::new(),
+            first_corner,
+            holes,
+            sharp_edges,
+            base: Vec::new(),
+            isolated: (0..nv)
+                .filter(|&v| coarse_ref_isolated(v))
+                .map(|v| (v, b.positions()[v as usize]))
+                .collect(),
+        };
+        // Sectors in each fragment's order, then the base texels and horizons.
+        let coarse = &mesh.coarse;
+        let mut sector_of = vec![NONE; coarse.num_half_edges()];
+        for (i, frag) in mesh.fragments.iter().enumerate() {
+            let fan = coarse.fans()[frag.fan as usize];
+            let corners = coarse.fan_corners(&fan);
+            let start = corners.iter().position(|&h| h == mesh.first_corner[i]).unwrap_or(0);
+            for (s, &h) in corners[start..].iter().chain(&corners[..start]).enumerate() {
+                sector_of[h as usize] = s as u32;
+            }
+        }
+        mesh.sector_of = sector_of;
+        let texel_sets: Vec<(Vec<[f64; 4]>, u32)> = (0..mesh.fragments.len())
+            .map(|i| mesh.base_texels(i, b, centre_sharpness[i], nv, nf, &semi))
+            .collect();
+        for (frag, (_, horizon)) in mesh.fragments.iter_mut().zip(&texel_sets) {
+            frag.horizon = *horizon;
+        }
+        mesh.sort_and_stream(texel_sets);
+        Ok(Ok(mesh))
     }
 
-    /// Orders fragments by class and records the class runs.
-    fn sorted(mut self) -> FragmentMesh {
-        self.fragments.sort_by_key(|f| (f.class, f.centre));
-        self.fragment_of = vec![NONE; self.coarse.num_vertices()];
+    /// The corners of fragment `i`, sector 0 first.
+    fn corners(&self, i: usize) -> Vec<u32> {
+        let fan = self.coarse.fans()[self.fragments[i].fan as usize];
+        let corners = self.coarse.fan_corners(&fan);
+        let start = corners.iter().position(|&h| h == self.first_corner[i]).unwrap_or(0);
+        corners[start..].iter().chain(&corners[..start]).copied().collect()
+    }
+
+    /// The base texels of fragment `i` (ring radius 2, storage order, each vertex entry
+    /// followed by its data texel) and its horizon; the data texels are dropped again by
+    /// [`FragmentMesh::sort_and_stream`] for a smooth fragment.
+    fn base_texels(
+        &self,
+        i: usize,
+        b: &cpu::Level,
+        centre_sharpness: f32,
+        nv: u32,
+        nf: u32,
+        semi: &dyn Fn(u32) -> (f32, f32),
+    ) -> (Vec<[f64; 4]>, u32) {
+        let topo = &self.coarse;
+        let frag = self.fragments[i];
+        let corners = self.corners(i);
+        let k = frag.class.valence;
+        let nc = topo.num_half_edges() as u32;
+        let vertex_point = |v: u32| v;
+        let face_point = |h: u32| nv + topo.face(h);
+        let edge_point = |h: u32| nv + nf + topo.edge(h);
+        let half_at_origin = |h: u32| nc + 2 * topo.edge(h) + u32::from(topo.is_reversed(h));
+        let half_at_target = |h: u32| nc + 2 * topo.edge(h) + u32::from(!topo.is_reversed(h));
+        let last_in = if frag.class.boundary { topo.prev(corners[k as usize - 1]) } else { NONE };
+        // B vertex and the B edges (a−1, b)–(a, b), (a, b−1)–(a, b) of entry (s, a, b).
+        let entry = |s: u32, a: u32, bb: u32| -> (u32, Option<u32>, Option<u32>) {
+            if (a, bb) == (0, 0) {
+                return (vertex_point(frag.centre), None, None);
+            }
+            if s == k {
+                // A half-fan's last spoke: the border edge that enters the centre.
+                let p = last_in;
+                return if a == 1 {
+                    (edge_point(p), Some(half_at_target(p)), None)
+                } else {
+                    (vertex_point(topo.origin(p)), Some(half_at_origin(p)), None)
+                };
+            }
+            // The sector's coarse quad, seen from the centre: h runs c → c1, h1 c1 → c2,
+            // h2 c2 → c3, where c3 is the end of spoke s + 1.
+            let h = corners[s as usize];
+            let (h1, h2) = (topo.next(h), topo.next(topo.next(h)));
+            match (a, bb) {
+                (1, 0) => (edge_point(h), Some(half_at_origin(h)), None),
+                (1, 1) => (face_point(h), None, None),
+                (2, 0) => (vertex_point(topo.origin(h1)), Some(half_at_target(h)), None),
+                (2, 1) => (edge_point(h1), None, Some(half_at_origin(h1))),
+                (2, 2) => (vertex_point(topo.origin(h2)), Some(half_at_origin(h2)), Some(half_at_target(h1))),
+                (1, 2) => (edge_point(h2), Some(half_at_target(h2)), None),
+                _ => unreachable!("ring radius 2 holds only a, b ≤ 2"),
+            }
+        };
+        let mut texels = Vec::with_capacity(2 * frag.class.len(2) as usize);
+        let (mut largest, mut infinite) = (0.0f32, false);
+        let mut note = |s: f32| {
+            if crease::is_infinite(s) {
+                infinite = true;
+            } else {
+                largest = largest.max(s);
+            }
+        };
+        let positions = b.positions();
+        let mut push = |s: u32, a: u32, bb: u32, texels: &mut Vec<[f64; 4]>| {
+            let (v, ea, eb) = entry(s, a, bb);
+            let p = positions[v as usize];
+            texels.push([p.x, p.y, p.z, 1.0]);
+            let data = if (a, bb) == (0, 0) {
+                note(centre_sharpness);
+                [centre_sharpness, 0.0, 0.0, 0.0]
+            } else {
+                let ea = ea.map_or(0.0, |e| b.edge_sharpness(e));
+                let eb = eb.map_or(0.0, |e| b.edge_sharpness(e));
+                note(ea);
+                note(eb);
+                let (count, sum) = semi(v);
+                [count, ea, eb, sum]
+            };
+            texels.push(data.map(f64::from));
+        };
+        push(0, 0, 0, &mut texels);
+        for r in 1..=2 {
+            for s in 0..k {
+                for t in 0..2 * r {
+                    if t <= r { push(s, r, t, &mut texels) } else { push(s, 2 * r - t, r, &mut texels) }
+                }
+            }
+            if frag.class.boundary {
+                push(k, r, 0, &mut texels);
+            }
+        }
+        let horizon = if infinite {
+            FOREVER
+        } else if largest <= 0.0 {
+            0
+        } else {
+            // One more level with Chaikin: its f32 averages may leave a last bit.
+            largest.ceil() as u32 + u32::from(self.method == Method::Chaikin)
+        };
+        (texels, horizon)
+    }
+
+    /// Orders fragments by class and horizon, records the runs and writes the base stream.
+    fn sort_and_stream(&mut self, texel_sets: Vec<(Vec<[f64; 4]>, u32)>) {
+        let mut order: Vec<usize> = (0..self.fragments.len()).collect();
+        order.sort_by_key(|&i| {
+            let f = &self.fragments[i];
+            (f.class, f.horizon, f.centre, f.fan)
+        });
+        self.fragments = order.iter().map(|&i| self.fragments[i]).collect();
+        self.first_corner = order.iter().map(|&i| self.first_corner[i]).collect();
+        self.fragment_of_fan = vec![NONE; self.coarse.fans().len()];
         for (i, f) in self.fragments.iter_mut().enumerate() {
-            if self.runs.last().is_none_or(|r| r.class != f.class) {
-                self.runs.push(ClassRun { class: f.class, first: i as u32, count: 0 });
+            if self.runs.last().is_none_or(|r| r.class != f.class || r.horizon != f.horizon) {
+                self.runs.push(ClassRun { class: f.class, horizon: f.horizon, first: i as u32, count: 0 });
             }
             let run = self.runs.len() - 1;
             self.runs[run].count += 1;
             f.run = run as u32;
-            self.fragment_of[f.centre as usize] = i as u32;
+            self.fragment_of_fan[f.fan as usize] = i as u32;
         }
-        self
+        let total: usize = texel_sets.iter().map(|(t, h)| if *h > 0 { t.len() } else { t.len() / 2 }).sum();
+        let mut base = Vec::with_capacity(total);
+        for &i in &order {
+            let (texels, horizon) = &texel_sets[i];
+            if *horizon > 0 {
+                base.extend_from_slice(texels);
+            } else {
+                base.extend(texels.iter().step_by(2));
+            }
+        }
+        self.base = base;
     }
 
     pub fn coarse(&self) -> &Topology {
         &self.coarse
     }
 
-    /// Base-level positions (vertex points, face points, edge points of the coarse mesh).
-    pub fn base_positions(&self) -> &[DVec3] {
-        &self.base
-    }
-
+    /// Catmull-Clark levels the CPU did to reach the base level.
     pub fn cpu_levels(&self) -> u32 {
         self.cpu_levels
+    }
+
+    /// Why the CPU did more levels than the minimum (empty when it did not).
+    pub fn reasons(&self) -> &[String] {
+        &self.reasons
+    }
+
+    pub fn crease_method(&self) -> Method {
+        self.method
     }
 
     pub fn fragments(&self) -> &[Fragment] {
@@ -268,117 +560,135 @@ impl FragmentMesh {
         &self.runs
     }
 
-    /// The fragment centred on coarse vertex `v`, if a face uses `v`.
+    /// Fragments that carry sharpness data at the base level.
+    pub fn sharp_fragments(&self) -> usize {
+        self.fragments.iter().filter(|f| f.horizon > 0).count()
+    }
+
+    /// The fragment of a fan of vertex `v`, if a face uses `v`.
     pub fn fragment_of(&self, v: u32) -> Option<u32> {
-        Some(self.fragment_of[v as usize]).filter(|&f| f != NONE)
+        self.coarse.vertex_fans(v).0.map(|fan| self.fragment_of_fan[fan as usize])
     }
 
-    /// The sector of coarse half-edge `h` around its origin (its spoke number).
-    pub fn sector_of(&self, h: u32) -> u32 {
-        self.sector_of[h as usize]
+    /// The fragment and sector of coarse corner `h`.
+    pub fn corner_sector(&self, h: u32) -> (u32, u32) {
+        let (fan, _) = self.coarse.corner_fan(h);
+        (self.fragment_of_fan[fan as usize], self.sector_of[h as usize])
     }
 
-    /// The spoke number of edge `e` at its end `v` (`v` must be an end of `e`): a half-edge
-    /// leaving `v` along `e`, or, on the border, the half-fan's extra last spoke.
-    pub fn spoke_along(&self, e: u32, v: u32) -> u32 {
+    /// A fragment and its spoke along coarse edge `e` at its `end` (0: the edge's first
+    /// vertex, 1: its second).
+    pub fn spoke_along(&self, e: u32, end: usize) -> (u32, u32) {
         let h = self.coarse.edge_half_edge(e);
-        let leaving = if self.coarse.origin(h) == v { Some(h) } else { self.coarse.twin(h) };
-        match leaving {
-            Some(h) => self.sector_of[h as usize],
-            None => self.coarse.num_vertex_faces(v) as u32,
+        // The corner at h's origin leaves along e; at the other end the edge enters the
+        // face's next corner, whose spoke along it is the one after its own.
+        let leaving_end = usize::from(self.coarse.is_reversed(h));
+        if end == leaving_end {
+            return self.corner_sector(h);
+        }
+        let (f, s) = self.corner_sector(self.coarse.next(h));
+        let class = self.fragments[f as usize].class;
+        (f, if class.boundary { s + 1 } else { (s + 1) % class.valence })
+    }
+
+    /// The position of a coarse vertex no face uses (it never moves).
+    pub fn isolated_position(&self, v: u32) -> DVec3 {
+        match self.isolated.binary_search_by_key(&v, |&(w, _)| w) {
+            Ok(i) => self.isolated[i].1,
+            Err(_) => DVec3::ZERO,
         }
     }
 
-    /// Where every class run starts in a stream of fragments of ring radius `radius`.
-    pub fn layout(&self, radius: u32) -> StreamLayout {
+    pub fn is_hole(&self, f: u32) -> bool {
+        self.holes.as_ref().is_some_and(|h| h[f as usize])
+    }
+
+    /// Coarse edges on sharp control edges: (edge, sharpness, boundary, non-manifold).
+    pub fn coarse_sharp_edges(&self) -> &[(u32, f32, bool, bool)] {
+        &self.sharp_edges
+    }
+
+    /// Where every class run starts in stream `j` of a refinement with `levels` fragment
+    /// levels (ring radius [`radii`]`(levels)[j]`).
+    pub fn layout(&self, j: u32, levels: u32) -> StreamLayout {
+        let radius = radii(levels)[j as usize];
         let mut starts = Vec::with_capacity(self.runs.len());
+        let mut data = Vec::with_capacity(self.runs.len());
         let mut total = 0u64;
         for run in &self.runs {
             starts.push(total);
-            total += u64::from(run.count) * run.class.len(radius);
+            let has = run.has_data(j, levels);
+            data.push(has);
+            total += u64::from(run.count) * run.class.len(radius) * (1 + u64::from(has));
         }
-        StreamLayout { radius, starts, total }
+        StreamLayout { radius, data, starts, total }
     }
 
     /// First texel of fragment `f` in a stream with `layout`.
     pub fn fragment_start(&self, layout: &StreamLayout, f: u32) -> u64 {
         let frag = &self.fragments[f as usize];
         let run = &self.runs[frag.run as usize];
-        layout.starts[frag.run as usize] + u64::from(f - run.first) * frag.class.len(layout.radius)
+        let per = frag.class.len(layout.radius) * layout.stride(frag.run as usize);
+        layout.starts[frag.run as usize] + u64::from(f - run.first) * per
     }
 
-    /// The base-level vertex at (a, b) of sector `s` of the fragment centred on `c`, for
-    /// 0 ≤ a, b ≤ 2 (ring radius 2) in stored form (a ≥ 1, or the centre).
-    fn base_vertex(&self, c: u32, spokes: &[u32], s: u32, a: u32, b: u32) -> u32 {
-        let topo = &self.coarse;
-        let (nv, nf) = (topo.num_vertices() as u32, topo.num_faces() as u32);
-        let vertex_point = |v: u32| v;
-        let face_point = |h: u32| nv + topo.face(h);
-        let edge_point = |h: u32| nv + nf + topo.edge(h);
-        if (a, b) == (0, 0) {
-            return vertex_point(c);
-        }
-        if s as usize == spokes.len() {
-            // A half-fan's last spoke: the border edge that enters c.
-            let incoming = topo.prev(spokes[spokes.len() - 1]);
-            return if a == 1 { edge_point(incoming) } else { vertex_point(topo.origin(incoming)) };
-        }
-        // The sector's coarse quad, seen from corner c: h runs c → c1, next(h) c1 → c2, and
-        // next(next(h)) c2 → c3, where c3 is the end of spoke s + 1.
-        let h = spokes[s as usize];
-        let (h1, h2) = (topo.next(h), topo.next(topo.next(h)));
-        match (a, b) {
-            (1, 0) => edge_point(h),
-            (1, 1) => face_point(h),
-            (2, 0) => vertex_point(topo.origin(h1)),
-            (2, 1) => edge_point(h1),
-            (2, 2) => vertex_point(topo.origin(h2)),
-            (1, 2) => edge_point(h2),
-            _ => unreachable!("ring radius 2 holds only a, b ≤ 2"),
-        }
-    }
-
-    /// The base-level stream (ring radius 2), fragment after fragment, mapped by `texel`.
-    pub fn base_stream<T>(&self, texel: impl Fn(DVec3) -> T) -> Vec<T> {
-        let layout = self.layout(2);
+    /// The base-level stream (ring radius 2) of a refinement with `levels` fragment levels,
+    /// mapped texel by texel: positions by `position`, data texels by `data`.
+    pub fn base_stream<T>(
+        &self,
+        levels: u32,
+        position: impl Fn(DVec3) -> T,
+        data: impl Fn([f32; 4]) -> T,
+    ) -> Vec<T> {
+        let stored = self.layout(0, u32::MAX);
+        let layout = self.layout(0, levels);
         let mut out = Vec::with_capacity(layout.total as usize);
-        let mut spokes = Vec::new();
-        for frag in &self.fragments {
-            spokes.clear();
-            spokes.extend(self.coarse.spokes(frag.centre));
-            let c = frag.centre;
-            let mut push = |s: u32, a: u32, b: u32| {
-                out.push(texel(self.base[self.base_vertex(c, &spokes, s, a, b) as usize]));
-            };
-            // The storage order: centre, then ring by ring, sector by sector (t ≤ r → (r, t),
-            // t > r → (2r − t, r)), a half-fan's last spoke at the end of each ring.
-            push(0, 0, 0);
-            for r in 1..=2 {
-                for s in 0..frag.class.valence {
-                    for t in 0..2 * r {
-                        if t <= r { push(s, r, t) } else { push(s, 2 * r - t, r) }
+        for (r, run) in self.runs.iter().enumerate() {
+            let stride = stored.stride(r) as usize;
+            let start = stored.starts[r] as usize;
+            let end = start + (u64::from(run.count) * run.class.len(2)) as usize * stride;
+            for (i, t) in self.base[start..end].iter().enumerate() {
+                if i % stride == 1 {
+                    if layout.data[r] {
+                        out.push(data(t.map(|x| x as f32)));
                     }
-                }
-                if frag.class.boundary {
-                    push(frag.class.valence, r, 0);
+                } else {
+                    out.push(position(DVec3::new(t[0], t[1], t[2])));
                 }
             }
         }
         out
     }
 
-    /// One Catmull-Clark level of every fragment on the CPU, in f64: reads a stream of ring
-    /// radius `r_in`, writes one of radius `r_out` ≤ 2·r_in − 1. The same stencils and
-    /// addressing as the GPU pass (`glsl/subdiv/refine.frag`).
-    pub fn refine_stream(&self, input: &[DVec3], r_in: u32, r_out: u32) -> Vec<DVec3> {
-        let (lin, lout) = (self.layout(r_in), self.layout(r_out));
-        let mut out = vec![DVec3::ZERO; lout.total as usize];
+    /// One Catmull-Clark level of every fragment on the CPU, in f64 (sharpness in f32):
+    /// reads stream `j` of a refinement with `levels` fragment levels, writes stream j + 1.
+    /// The same stencils and addressing as the GPU pass (`glsl/subdiv/refine.frag`).
+    pub fn refine_stream(&self, input: &[[f64; 4]], j: u32, levels: u32) -> Vec<[f64; 4]> {
+        let (lin, lout) = (self.layout(j, levels), self.layout(j + 1, levels));
+        let mut out = vec![[0.0; 4]; lout.total as usize];
         for f in 0..self.fragments.len() as u32 {
-            let class = self.fragments[f as usize].class;
-            let (base_in, base_out) = (self.fragment_start(&lin, f), self.fragment_start(&lout, f));
-            let fetch = |s: u32, a: i64, b: i64| input[(base_in + class.index(s, a, b)) as usize];
-            for i in 0..class.len(r_out) {
-                out[(base_out + i) as usize] = stencil(class, i, fetch);
+            let frag = self.fragments[f as usize];
+            let r = frag.run as usize;
+            let view = View {
+                class: frag.class,
+                input,
+                base: self.fragment_start(&lin, f),
+                stride: lin.stride(r),
+                data: lin.data[r],
+                method: self.method,
+            };
+            let base_out = self.fragment_start(&lout, f);
+            let stride_out = lout.stride(r);
+            for i in 0..frag.class.len(lout.radius) {
+                let p = if view.data {
+                    sharp_stencil(&view, i)
+                } else {
+                    stencil(frag.class, i, |s, a, b| view.p(s, a, b))
+                };
+                out[(base_out + i * stride_out) as usize] = [p.x, p.y, p.z, 1.0];
+                if lout.data[r] {
+                    out[(base_out + i * stride_out + 1) as usize] = sharp_data(&view, i).map(f64::from);
+                }
             }
         }
         out
@@ -388,6 +698,7 @@ impl FragmentMesh {
 /// Ring radius of the stream after each fragment level: 2 at the base level, 2^j + 1
 /// after j levels (2R − 1 from R), except the last, which keeps only its 2^j owned rings.
 pub fn radii(levels: u32) -> Vec<u32> {
+    let levels = levels.min(30);
     (0..=levels)
         .map(|j| match j {
             0 => 2,
@@ -399,34 +710,262 @@ pub fn radii(levels: u32) -> Vec<u32> {
 
 /// The whole fragment-mesh algorithm on the CPU in f64 (base level, [`FragmentMesh::
 /// refine_stream`] per level, assembly): the GPU path's arithmetic without a GPU, to
-/// test the layout, stencils and welding exactly. Levels below the base level are
-/// refined by [`cpu::refine`].
-pub fn refine(mesh: &Mesh, level: u32) -> Result<Mesh> {
-    let needed = BaseLevel::levels_needed(mesh);
-    if level < needed {
-        return cpu::refine(mesh, level);
+/// test the layout, rules and welding exactly. Levels the fragments cannot reach are
+/// refined by [`cpu::refine_surface`].
+pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
+    let fragments = match FragmentMesh::build(surface, level)? {
+        Built::Fragments(f) => f,
+        Built::Cpu(_) => return cpu::refine_surface(surface, level),
+    };
+    let levels = level - fragments.cpu_levels();
+    let mut stream = fragments.base_stream(levels, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
+    for j in 0..levels {
+        stream = fragments.refine_stream(&stream, j, levels);
     }
-    let fragments = FragmentMesh::new(mesh)?;
-    let levels = level - needed;
-    let radii = radii(levels);
-    let mut stream = fragments.base_stream(|p| p);
-    for pair in radii.windows(2) {
-        stream = fragments.refine_stream(&stream, pair[0], pair[1]);
-    }
-    assemble(&fragments, &stream, radii[levels as usize], levels, |p| *p)
+    let mesh = assemble(&fragments, &stream, levels, |p| DVec3::new(p[0], p[1], p[2]))?;
+    Ok(cpu::Refined { mesh, sharp_edges: sharp_edges(&fragments, levels) })
 }
 
-/// The Catmull-Clark stencil (the thesis' masks, Ch. 2.2) of output entry `i` of a
-/// fragment of `class`, reading the previous level through `p(s, a, b)`: both output
-/// coordinates even → vertex point, one odd → edge point, both odd → face point.
+/// A fragment of the input stream: positions and (when `data`) sharpness data.
+struct View<'a> {
+    class: Class,
+    input: &'a [[f64; 4]],
+    base: u64,
+    stride: u64,
+    data: bool,
+    method: Method,
+}
+
+impl View<'_> {
+    fn p(&self, s: u32, a: i64, b: i64) -> DVec3 {
+        let t = self.input[(self.base + self.class.index(s, a, b) * self.stride) as usize];
+        DVec3::new(t[0], t[1], t[2])
+    }
+
+    /// The data texel of canonical entry (s, a, b) (a ≥ 1, b ≥ 0, or the centre).
+    fn d(&self, s: u32, a: i64, b: i64) -> [f32; 4] {
+        let t = self.input[(self.base + self.class.index(s, a, b) * 2 + 1) as usize];
+        t.map(|x| x as f32)
+    }
+
+    fn k(&self) -> u32 {
+        self.class.valence
+    }
+
+    /// The sector before `s` (closed fans wrap).
+    fn before(&self, s: u32) -> u32 {
+        if s == 0 { self.k() - 1 } else { s - 1 }
+    }
+
+    /// The spokes of the centre: (sharpness, ring-1 neighbour), in sector order.
+    fn spokes(&self) -> impl Iterator<Item = (f32, DVec3)> + '_ {
+        let n = self.k() + u32::from(self.class.boundary);
+        (0..n).map(|s| (self.d(s, 1, 0)[1], self.p(s, 1, 0)))
+    }
+
+    /// The edges of canonical vertex (s, x, y) (x ≥ 1, y ≥ 0): (sharpness, neighbour) in the
+    /// order −a, +a, +b, −b, absent ones left out (a half-fan's borders).
+    fn edges(&self, s: u32, x: i64, y: i64) -> Vec<(f32, DVec3)> {
+        let mut out =
+            vec![(self.d(s, x, y)[1], self.p(s, x - 1, y)), (self.d(s, x + 1, y)[1], self.p(s, x + 1, y))];
+        if s < self.k() {
+            out.push((self.d(s, x, y + 1)[2], self.p(s, x, y + 1)));
+        }
+        if y >= 1 {
+            out.push((self.d(s, x, y)[2], self.p(s, x, y - 1)));
+        } else if !self.class.boundary || s > 0 {
+            out.push((self.d(self.before(s), 1, x)[1], self.p(s, x, -1)));
+        }
+        out
+    }
+
+    /// Semi-sharp sum of the edges of vertex (x, y) of sector s (any x, y ≥ 0).
+    fn semi(&self, s: u32, x: i64, y: i64) -> SemiSharpSum {
+        if self.method != Method::Chaikin {
+            return SemiSharpSum::default();
+        }
+        if (x, y) == (0, 0) {
+            return SemiSharpSum::of(self.spokes().map(|(e, _)| e));
+        }
+        let d = if x == 0 {
+            // (0, y) of sector s is (y, 0) of sector s + 1.
+            let next = if s + 1 == self.k() && !self.class.boundary { 0 } else { s + 1 };
+            self.d(next, y, 0)
+        } else {
+            self.d(s, x, y)
+        };
+        SemiSharpSum { sum: d[3], count: d[0] as u32 }
+    }
+
+    /// Child sharpness of an edge of sharpness `e` at its end vertex (x, y) of sector s.
+    fn child(&self, e: f32, s: u32, x: i64, y: i64) -> f32 {
+        match self.method {
+            Method::Uniform => crease::decrement(e),
+            // Every vertex of a fragment has at least two edges.
+            Method::Chaikin => crease::chaikin(e, self.semi(s, x, y), 2),
+        }
+    }
+}
+
+/// The vertex mask at a sharp vertex: `edges` are (sharpness, neighbour) in the vertex's
+/// order, `smooth` its smooth point, `semi` its semi-sharp sum (Chaikin).
+fn vertex_rule(
+    view: &View,
+    p: DVec3,
+    vs: f32,
+    edges: &[(f32, DVec3)],
+    smooth: DVec3,
+    semi: SemiSharpSum,
+) -> DVec3 {
+    let sharp = edges.iter().filter(|e| e.0 > 0.0).count();
+    let p_rule = Rule::of(vs, sharp);
+    if p_rule.is_smooth() {
+        return smooth;
+    }
+    let child: Vec<f32> = edges
+        .iter()
+        .map(|&(e, _)| match view.method {
+            Method::Uniform => crease::decrement(e),
+            Method::Chaikin => crease::chaikin(e, semi, 2),
+        })
+        .collect();
+    let cvs = crease::decrement(vs);
+    let c_rule = Rule::of(cvs, child.iter().filter(|&&c| c > 0.0).count());
+    let mask = |rule: Rule, use_child: bool| match rule {
+        Rule::Smooth | Rule::Dart => smooth,
+        Rule::Crease => {
+            let ends: DVec3 = edges
+                .iter()
+                .zip(&child)
+                .filter(|(e, c)| if use_child { **c > 0.0 } else { e.0 > 0.0 })
+                .map(|(e, _)| e.1)
+                .sum();
+            p * 0.75 + ends * 0.125
+        }
+        Rule::Corner => p,
+    };
+    if c_rule == p_rule {
+        return mask(p_rule, false);
+    }
+    let w = f64::from(crease::fractional_weight(
+        view.method,
+        vs,
+        cvs,
+        edges.iter().zip(&child).map(|(e, &c)| (e.0, c)),
+    ));
+    mask(p_rule, false) * w + mask(c_rule, true) * (1.0 - w)
+}
+
+/// The position of output entry `i` of a sharp fragment: the smooth stencil, replaced by
+/// OpenSubdiv's crease and corner rules where the input's sharpness asks for them.
+fn sharp_stencil(view: &View, i: u64) -> DVec3 {
+    let class = view.class;
+    let smooth = stencil(class, i, |s, a, b| view.p(s, a, b));
+    let Some((s, a, b)) = class.coords(i) else {
+        // The centre.
+        let edges: Vec<(f32, DVec3)> = view.spokes().collect();
+        let vs = view.d(0, 0, 0)[0];
+        return vertex_rule(view, view.p(0, 0, 0), vs, &edges, smooth, view.semi(0, 0, 0));
+    };
+    let (a, b) = (i64::from(a), i64::from(b));
+    match (a % 2, b % 2) {
+        (0, 0) => {
+            let (x, y) = (a / 2, b / 2);
+            let edges = view.edges(s, x, y);
+            vertex_rule(view, view.p(s, x, y), 0.0, &edges, smooth, view.semi(s, x, y))
+        }
+        (1, 0) => {
+            // Parent edge (x, y)–(x + 1, y).
+            let (x, y) = (a / 2, b / 2);
+            let e = view.d(s, x + 1, y)[1];
+            edge_rule(view, e, [(s, x, y), (s, x + 1, y)], smooth)
+        }
+        (0, 1) => {
+            // Parent edge (x, y)–(x, y + 1).
+            let (x, y) = (a / 2, b / 2);
+            let e = view.d(s, x, y + 1)[2];
+            edge_rule(view, e, [(s, x, y), (s, x, y + 1)], smooth)
+        }
+        _ => smooth,
+    }
+}
+
+/// The edge mask: smooth, the midpoint while both children stay sharp, else both blended
+/// by the edge's sharpness.
+fn edge_rule(view: &View, e: f32, ends: [(u32, i64, i64); 2], smooth: DVec3) -> DVec3 {
+    if e <= 0.0 {
+        return smooth;
+    }
+    let [(s0, x0, y0), (s1, x1, y1)] = ends;
+    let mid = (view.p(s0, x0, y0) + view.p(s1, x1, y1)) * 0.5;
+    if view.child(e, s0, x0, y0) > 0.0 && view.child(e, s1, x1, y1) > 0.0 {
+        return mid;
+    }
+    let w = f64::from(e);
+    mid * w + smooth * (1.0 - w)
+}
+
+/// The data texel of output entry `i` (see the module docs).
+fn sharp_data(view: &View, i: u64) -> [f32; 4] {
+    let Some((s, a, b)) = view.class.coords(i) else {
+        return [crease::decrement(view.d(0, 0, 0)[0]), 0.0, 0.0, 0.0];
+    };
+    let (a, b) = (i64::from(a), i64::from(b));
+    // The child half of a parent edge of sharpness e that ends at vertex (x, y).
+    let half = |e: f32, x: i64, y: i64| view.child(e, s, x, y);
+    // Edge (a−1, b)–(a, b): half of a parent edge along a when b is even.
+    let ea = if b % 2 == 1 {
+        0.0
+    } else if a % 2 == 0 {
+        half(view.d(s, a / 2, b / 2)[1], a / 2, b / 2)
+    } else {
+        half(view.d(s, (a + 1) / 2, b / 2)[1], (a - 1) / 2, b / 2)
+    };
+    // Edge (a, b−1)–(a, b): half of a parent edge along b when a is even.
+    let eb = if b == 0 || a % 2 == 1 {
+        0.0
+    } else if b % 2 == 0 {
+        half(view.d(s, a / 2, b / 2)[2], a / 2, b / 2)
+    } else {
+        half(view.d(s, a / 2, (b + 1) / 2)[2], a / 2, (b - 1) / 2)
+    };
+    if view.method != Method::Chaikin {
+        return [0.0, ea, eb, 0.0];
+    }
+    // The semi-sharp edges of the new vertex: halves of its parent's edges.
+    let children: Vec<f32> = match (a % 2, b % 2) {
+        (0, 0) => {
+            let (x, y) = (a / 2, b / 2);
+            view.edges(s, x, y).iter().map(|&(e, _)| half(e, x, y)).collect()
+        }
+        (1, 0) => {
+            let (x, y) = (a / 2, b / 2);
+            let e = view.d(s, x + 1, y)[1];
+            vec![half(e, x, y), half(e, x + 1, y)]
+        }
+        (0, 1) => {
+            let (x, y) = (a / 2, b / 2);
+            let e = view.d(s, x, y + 1)[2];
+            vec![half(e, x, y), half(e, x, y + 1)]
+        }
+        _ => Vec::new(),
+    };
+    let semi = SemiSharpSum::of(children);
+    [semi.count as f32, ea, eb, semi.sum]
+}
+
+/// The smooth Catmull-Clark stencil (the thesis' masks, Ch. 2.2) of output entry `i` of a
+/// closed fragment of `class`, reading the previous level through `p(s, a, b)`: both
+/// output coordinates even → vertex point, one odd → edge point, both odd → face point.
+/// (Half-fans always carry sharpness data; their border entries get the crease rules in
+/// [`sharp_stencil`], which only reads this value where it applies.)
 pub fn stencil(class: Class, i: u64, p: impl Fn(u32, i64, i64) -> DVec3) -> DVec3 {
     let k = class.valence;
     let Some((s, a, b)) = class.coords(i) else {
-        // The centre: valence-k rule, or the boundary rule on a half-fan.
-        let c = p(0, 0, 0);
         if class.boundary {
-            return 0.75 * c + 0.125 * (p(0, 1, 0) + p(k, 1, 0));
+            return p(0, 0, 0);
         }
+        let c = p(0, 0, 0);
         let (mut edges, mut diagonals) = (DVec3::ZERO, DVec3::ZERO);
         for s in 0..k {
             edges += p(s, 1, 0);
@@ -436,28 +975,22 @@ pub fn stencil(class: Class, i: u64, p: impl Fn(u32, i64, i64) -> DVec3) -> DVec
         return c * (1.0 - 7.0 / (4.0 * n)) + edges * (1.5 / (n * n)) + diagonals * (0.25 / (n * n));
     };
     let (a, b) = (i64::from(a), i64::from(b));
-    let on_border = class.boundary && b == 0 && (s == 0 || s == k);
+    if class.boundary && b == 0 && (s == 0 || s == k) {
+        // A half-fan's border: never smooth (its edges are infinitely sharp).
+        return p(s, a / 2, 0);
+    }
     match (a % 2, b % 2) {
         (0, 0) => {
             let (a, b) = (a / 2, b / 2);
-            if on_border {
-                0.75 * p(s, a, 0) + 0.125 * (p(s, a - 1, 0) + p(s, a + 1, 0))
-            } else {
-                let edges = p(s, a + 1, b) + p(s, a - 1, b) + p(s, a, b + 1) + p(s, a, b - 1);
-                let diagonals =
-                    p(s, a + 1, b + 1) + p(s, a - 1, b + 1) + p(s, a + 1, b - 1) + p(s, a - 1, b - 1);
-                (36.0 * p(s, a, b) + 6.0 * edges + diagonals) / 64.0
-            }
+            let edges = p(s, a + 1, b) + p(s, a - 1, b) + p(s, a, b + 1) + p(s, a, b - 1);
+            let diagonals = p(s, a + 1, b + 1) + p(s, a - 1, b + 1) + p(s, a + 1, b - 1) + p(s, a - 1, b - 1);
+            (36.0 * p(s, a, b) + 6.0 * edges + diagonals) / 64.0
         }
         (1, 0) => {
             let (a, b) = (a / 2, b / 2);
             let ends = p(s, a, b) + p(s, a + 1, b);
-            if on_border {
-                0.5 * ends
-            } else {
-                let sides = p(s, a, b + 1) + p(s, a + 1, b + 1) + p(s, a, b - 1) + p(s, a + 1, b - 1);
-                (6.0 * ends + sides) / 16.0
-            }
+            let sides = p(s, a, b + 1) + p(s, a + 1, b + 1) + p(s, a, b - 1) + p(s, a + 1, b - 1);
+            (6.0 * ends + sides) / 16.0
         }
         (0, 1) => {
             let (a, b) = (a / 2, b / 2);
@@ -470,6 +1003,27 @@ pub fn stencil(class: Class, i: u64, p: impl Fn(u32, i64, i64) -> DVec3) -> DVec
             (p(s, a, b) + p(s, a + 1, b) + p(s, a + 1, b + 1) + p(s, a, b + 1)) * 0.25
         }
     }
+}
+
+/// The refined edges of a fragment refinement that lie on sharp control edges (see
+/// [`SharpEdge`]): every coarse sharp edge split into `g` segments, with the assembled
+/// mesh's vertex numbering (`assemble`).
+pub fn sharp_edges(fragments: &FragmentMesh, levels: u32) -> Vec<SharpEdge> {
+    let g = 2u32 << levels;
+    let nv = fragments.coarse.num_vertices() as u32;
+    let mut out = Vec::new();
+    for &(e, sharpness, boundary, non_manifold) in fragments.coarse_sharp_edges() {
+        let [v0, v1] = fragments.coarse.edge_vertices(e);
+        let point = |t: u32| match t {
+            0 => v0,
+            t if t == g => v1,
+            t => nv + e * (g - 1) + t - 1,
+        };
+        for t in 0..g {
+            out.push(SharpEdge { vertices: [point(t), point(t + 1)], sharpness, boundary, non_manifold });
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -1,7 +1,10 @@
 //! Catmull-Clark on the GPU with fragment meshes (2010 thesis §3.3, SPEC §5.3): the base
 //! level and the fragments on the CPU, then one full-target fragment pass per level,
 //! ping-ponging between two RGBA32F render targets, one readback, and the topological
-//! assembly on the CPU.
+//! assembly on the CPU. Sharp features (issue 14) run in the same pass: a sharp
+//! fragment's vertex entries are each followed by a data texel (its sharpness and that of
+//! its edges, `fragment`), which the pass reads to apply OpenSubdiv's crease rules and
+//! writes, decayed, for the next level — one target, one shader, one pass per level.
 //!
 //! # Packing rule
 //!
@@ -12,7 +15,9 @@
 //! a fragment may continue on the next row. Each level has its own stream (fragments
 //! grow from ring radius 2 to 3, 5, 9, …; the last level keeps only the 2^j owned rings);
 //! the pass finds a texel's run by binary search in a uniform table of run starts and its
-//! fragment by division.
+//! fragment by division. Runs also group fragments by how many levels they carry
+//! sharpness data (their *horizon*); a run's entries are one texel wide without data and
+//! two with it.
 //!
 //! # Limits
 //!
@@ -20,7 +25,7 @@
 //! as it needs (the "row split"). What does limit the path, each with a clear
 //! [`SubdivError::GpuLimit`] (use the CPU method then):
 //!
-//! - at most [`MAX_RUNS`] classes (distinct valence/half-fan pairs) per mesh;
+//! - at most [`MAX_RUNS`] classes (distinct valence, half-fan and horizon) per mesh;
 //! - one fragment at most 2^24 texels at the last level (the shader's exact float
 //!   division), i.e. k·R(R+1) < 2^24 at the last radius R = 2^j: valence below 61 680 at
 //!   level 5 of a quad mesh (R = 16), below 4 032 at level 7 (R = 64);
@@ -37,8 +42,10 @@ use crate::gpu::{
 use crate::mesh::Mesh;
 
 use super::assemble::assemble;
-use super::fragment::{BaseLevel, FragmentMesh, StreamLayout, radii};
-use super::{Result, SubdivError, cpu};
+use super::cpu::SharpEdge;
+use super::crease::Method;
+use super::fragment::{self, Built, FragmentMesh, StreamLayout};
+use super::{Result, SubdivError, Surface, cpu};
 
 /// Entries of the run table (`MAX_RUNS` in `glsl/subdiv/refine.frag`).
 pub const MAX_RUNS: usize = 256;
@@ -75,17 +82,26 @@ impl Packing {
                 fragments.runs().len()
             )));
         }
-        let layouts: Vec<StreamLayout> = radii(gpu_levels).into_iter().map(|r| fragments.layout(r)).collect();
+        let layouts: Vec<StreamLayout> = (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels)).collect();
         let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
-        let last = layouts.last().map_or(2, |l| l.radius);
-        if let Some(run) = fragments.runs().iter().max_by_key(|r| r.class.len(last))
-            && run.class.len(last) >= MAX_FRAGMENT_TEXELS
+        // The largest fragment of any stream (data texels double a fragment).
+        let widest = layouts
+            .iter()
+            .flat_map(|l| {
+                fragments
+                    .runs()
+                    .iter()
+                    .enumerate()
+                    .map(move |(r, run)| (run, l.radius, run.class.len(l.radius) * l.stride(r)))
+            })
+            .max_by_key(|&(_, _, texels)| texels);
+        if let Some((run, radius, texels)) = widest
+            && texels >= MAX_FRAGMENT_TEXELS
         {
             return Err(SubdivError::GpuLimit(format!(
-                "a fragment of valence {} at ring radius {last} ({gpu_levels} fragment levels) needs {} \
+                "a fragment of valence {} at ring radius {radius} ({gpu_levels} fragment levels) needs {texels} \
                  texels, over the pass's {MAX_FRAGMENT_TEXELS}; use fewer levels or the CPU method",
-                run.class.valence,
-                run.class.len(last)
+                run.class.valence
             )));
         }
         let max_width = if max_side == 0 { 1 } else { 1u32 << max_side.ilog2() };
@@ -155,12 +171,20 @@ impl Times {
 #[derive(Debug)]
 pub struct Run {
     pub mesh: Mesh,
+    /// The refined edges on sharp control edges (creases, boundary, non-manifold edges),
+    /// numbered as `mesh`'s vertices: what a renderer draws over the surface.
+    pub sharp_edges: Vec<SharpEdge>,
     /// Catmull-Clark levels done on the CPU and by fragment passes on the GPU.
     pub cpu_levels: u32,
     pub gpu_levels: u32,
     pub fragments: usize,
-    /// Distinct fragment classes (valence, half-fan).
+    /// Fragments carrying sharpness data (sharp features in reach, or a border).
+    pub sharp_fragments: usize,
+    /// Distinct fragment runs (valence, half-fan, horizon).
     pub classes: usize,
+    /// Why the CPU did more levels than the minimum the fragments need (see
+    /// [`FragmentMesh::reasons`]); empty when it did not.
+    pub cpu_reasons: Vec<String>,
     /// Size of each of the two targets, texels.
     pub texture: [u32; 2],
     pub times: Times,
@@ -182,31 +206,49 @@ impl Subdivider {
         Ok(Subdivider { pipeline, targets: None, readback: None })
     }
 
-    /// Refines `mesh` `level` times: the base level on the CPU, the rest as fragment
-    /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
-    /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0).
+    /// Refines `mesh` (smooth, default options) `level` times; see
+    /// [`Subdivider::refine_surface`].
     pub fn refine(&mut self, ctx: &Context, mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+        self.refine_surface(ctx, &Surface::smooth(mesh.clone()), level, options)
+    }
+
+    /// Refines `surface` `level` times: the base level on the CPU, the rest as fragment
+    /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
+    /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0), and so
+    /// are levels the fragments cannot express ([`Run::cpu_reasons`]).
+    pub fn refine_surface(
+        &mut self,
+        ctx: &Context,
+        surface: &Surface,
+        level: u32,
+        options: &Options,
+    ) -> Result<Run> {
         let start = Instant::now();
-        let needed = BaseLevel::levels_needed(mesh);
-        if level < needed {
-            let mesh = cpu::refine(mesh, level)?;
-            let total = start.elapsed();
-            let times = Times { base: total, total, ..Times::default() };
-            return Ok(Run {
-                mesh,
-                cpu_levels: level,
-                gpu_levels: 0,
-                fragments: 0,
-                classes: 0,
-                texture: [0, 0],
-                times,
-            });
-        }
-        let base = BaseLevel::new(mesh)?;
+        let fragments = match FragmentMesh::build(surface, level)? {
+            Built::Fragments(f) => f,
+            Built::Cpu(cpu_reasons) => {
+                let refined = cpu::refine_surface(surface, level)?;
+                let total = start.elapsed();
+                let times = Times { base: total, total, ..Times::default() };
+                return Ok(Run {
+                    mesh: refined.mesh,
+                    sharp_edges: refined.sharp_edges,
+                    cpu_levels: level,
+                    gpu_levels: 0,
+                    fragments: 0,
+                    sharp_fragments: 0,
+                    classes: 0,
+                    cpu_reasons,
+                    texture: [0, 0],
+                    times,
+                });
+            }
+        };
+        // The base level and the fragments are built together; the fragment build is
+        // timed again (stream and tables) in `refine_fragments`.
         let base_time = start.elapsed();
         let t = Instant::now();
-        let fragments = FragmentMesh::from_base(base)?;
-        let mut run = self.refine_fragments(ctx, &fragments, level - needed, options, t)?;
+        let mut run = self.refine_fragments(ctx, &fragments, level - fragments.cpu_levels(), options, t)?;
         run.times.base = base_time;
         run.times.total = start.elapsed();
         Ok(run)
@@ -224,10 +266,12 @@ impl Subdivider {
     ) -> Result<Run> {
         let packing = Packing::new(fragments, gpu_levels, ctx.info().max_image_2d, options.row_width)?;
         let width = packing.width;
-        let mut stream = fragments.base_stream(|p| [p.x as f32, p.y as f32, p.z as f32, 1.0]);
+        let mut stream =
+            fragments.base_stream(gpu_levels, |p| [p.x as f32, p.y as f32, p.z as f32, 1.0], |d| d);
         let rows0 = packing.rows(0);
         stream.resize((rows0 * width) as usize, [0.0; 4]);
-        // One run table per pass: (valence, half-fan, first input texel, first output texel).
+        // One run table per pass: (valence, flags, first input texel, first output texel);
+        // flags: 1 half-fan, 2 data texels in the input, 4 in the output.
         let tables = packing
             .layouts
             .windows(2)
@@ -235,12 +279,10 @@ impl Subdivider {
                 let mut table = vec![[0i32; 4]; MAX_RUNS];
                 for (r, run) in fragments.runs().iter().enumerate() {
                     let c = run.class;
-                    table[r] = [
-                        c.valence as i32,
-                        c.boundary as i32,
-                        pair[0].starts[r] as i32,
-                        pair[1].starts[r] as i32,
-                    ];
+                    let flags = i32::from(c.boundary)
+                        | i32::from(pair[0].data[r]) << 1
+                        | i32::from(pair[1].data[r]) << 2;
+                    table[r] = [c.valence as i32, flags, pair[0].starts[r] as i32, pair[1].starts[r] as i32];
                 }
                 Buffer::with_data(ctx, &table, "subdiv runs")
             })
@@ -276,6 +318,7 @@ impl Subdivider {
                     fragments.runs().len() as i32,
                     lout.total as i32,
                     packing.log2_width as i32,
+                    i32::from(fragments.crease_method() == Method::Chaikin),
                 ];
                 let input = targets.src();
                 let reads = [input];
@@ -300,10 +343,10 @@ impl Subdivider {
 
         let t = Instant::now();
         let texels = readback.view::<[f32; 4]>()?;
-        let layout = &packing.layouts[last];
-        let mesh = assemble(fragments, texels, layout.radius, gpu_levels, |p| {
+        let mesh = assemble(fragments, texels, gpu_levels, |p| {
             DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
         })?;
+        let sharp_edges = fragment::sharp_edges(fragments, gpu_levels);
         let times = Times {
             fragments: fragments_time,
             upload: ms(0, 1),
@@ -315,10 +358,13 @@ impl Subdivider {
         };
         Ok(Run {
             mesh,
+            sharp_edges,
             cpu_levels: fragments.cpu_levels(),
             gpu_levels,
             fragments: fragments.fragments().len(),
+            sharp_fragments: fragments.sharp_fragments(),
             classes: fragments.runs().len(),
+            cpu_reasons: fragments.reasons().to_vec(),
             texture: [width, packing.height],
             times,
         })
@@ -329,4 +375,9 @@ impl Subdivider {
 /// [`Subdivider`]).
 pub fn refine(ctx: &Context, mesh: &Mesh, level: u32) -> Result<Mesh> {
     Ok(Subdivider::new(ctx)?.refine(ctx, mesh, level, &Options::default())?.mesh)
+}
+
+/// Refines `surface` `level` times on the GPU with a fresh pipeline and targets.
+pub fn refine_surface(ctx: &Context, surface: &Surface, level: u32) -> Result<Run> {
+    Subdivider::new(ctx)?.refine_surface(ctx, surface, level, &Options::default())
 }

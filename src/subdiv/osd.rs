@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::mesh::{Mesh, formats};
 
-use super::{Result, Surface, SubdivError, tags};
+use super::{Result, SubdivError, Surface, tags};
 
 /// Environment variable naming the helper binary, overriding the default location.
 pub const HELPER_ENV: &str = "TEXGEO_OSD_REFINE";

@@ -80,7 +80,12 @@ pub fn read(path: impl AsRef<Path>) -> Result<Tagged> {
     let path = path.as_ref();
     if formats::Format::from_path(path)? != formats::Format::Obj {
         let mesh = formats::read(path)?;
-        return Ok(Tagged { mesh, features: Features::default(), options: TaggedOptions::default(), ignored: Vec::new() });
+        return Ok(Tagged {
+            mesh,
+            features: Features::default(),
+            options: TaggedOptions::default(),
+            ignored: Vec::new(),
+        });
     }
     let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
     read_obj(&bytes, path)
@@ -146,7 +151,10 @@ impl<'a> Parser<'a> {
         };
         let counts: Vec<usize> = counts.split('/').map(|c| c.parse().unwrap_or(usize::MAX)).collect();
         let &[nint, nfloat, nstring] = counts.as_slice() else {
-            return Err(err(format!("tag '{name}': expected 'nint/nfloat/nstring' counts, found '{}'", words[1])));
+            return Err(err(format!(
+                "tag '{name}': expected 'nint/nfloat/nstring' counts, found '{}'",
+                words[1]
+            )));
         };
         if [nint, nfloat, nstring].contains(&usize::MAX) || nint + nfloat + nstring != args.len() {
             return Err(err(format!(
@@ -171,7 +179,9 @@ impl<'a> Parser<'a> {
         let sharpness = |i: usize, items: usize| match floats.len() {
             1 => Ok(floats[0]),
             n if n == items => Ok(floats[i]),
-            n => Err(err(format!("tag '{name}': {n} sharpness values for {items} items (give 1 or {items})"))),
+            n => {
+                Err(err(format!("tag '{name}': {n} sharpness values for {items} items (give 1 or {items})")))
+            }
         };
         let one_int = |what: &str| match ints.as_slice() {
             [i] if floats.is_empty() && strings.is_empty() => Ok(*i),
@@ -276,7 +286,10 @@ impl<'a> Parser<'a> {
         match self.map.get(v as usize) {
             None => Err(self.error(
                 line,
-                format!("vertex {v} is out of range ({} vertices in the file; tags count from 0)", self.map.len()),
+                format!(
+                    "vertex {v} is out of range ({} vertices in the file; tags count from 0)",
+                    self.map.len()
+                ),
             )),
             Some(&m) => Ok((m != u32::MAX).then_some(m)),
         }

@@ -411,7 +411,8 @@ impl Topology {
 
     /// The half-edges using edge `e`, in face order.
     pub fn edge_uses(&self, e: u32) -> &[u32] {
-        &self.edge_uses[self.edge_use_offsets[e as usize] as usize..self.edge_use_offsets[e as usize + 1] as usize]
+        &self.edge_uses
+            [self.edge_use_offsets[e as usize] as usize..self.edge_use_offsets[e as usize + 1] as usize]
     }
 
     /// Number of faces using edge `e` (a face using it twice counts twice).

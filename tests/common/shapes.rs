@@ -167,7 +167,13 @@ pub struct SharpShape {
 }
 
 /// A surface from a mesh, creases `(a, b, sharpness)`, corners `(v, sharpness)`, holes.
-pub fn surface(mesh: Mesh, creases: &[(u32, u32, f32)], corners: &[(u32, f32)], holes: &[u32], options: Options) -> Surface {
+pub fn surface(
+    mesh: Mesh,
+    creases: &[(u32, u32, f32)],
+    corners: &[(u32, f32)],
+    holes: &[u32],
+    options: Options,
+) -> Surface {
     let features = Features {
         creases: creases.iter().map(|&(a, b, sharpness)| Crease { vertices: [a, b], sharpness }).collect(),
         corners: corners.iter().map(|&(vertex, sharpness)| Corner { vertex, sharpness }).collect(),
@@ -180,8 +186,11 @@ fn with(boundary: Boundary, crease_method: CreaseMethod, triangles: Triangles) -
     Options { boundary, crease_method, triangles }
 }
 
-const EDGE_ONLY: Options =
-    Options { boundary: Boundary::EdgeOnly, crease_method: CreaseMethod::Uniform, triangles: Triangles::Catmark };
+const EDGE_ONLY: Options = Options {
+    boundary: Boundary::EdgeOnly,
+    crease_method: CreaseMethod::Uniform,
+    triangles: Triangles::Catmark,
+};
 
 /// The 12 edges of `cube()` (vertex bits: x 1, y 2, z 4).
 pub fn cube_edges() -> Vec<(u32, u32)> {
@@ -204,10 +213,16 @@ pub fn grid_vertex(n: u32, i: u32, j: u32) -> u32 {
 /// A tent: a 4 × 3 grid folded along its middle row into a ridge.
 pub fn tent() -> Mesh {
     let positions = (0..=3)
-        .flat_map(|j| (0..=4).map(move |i| DVec3::new(f64::from(i), f64::from(j), if j == 1 || j == 2 { 1.0 } else { 0.0 })))
+        .flat_map(|j| {
+            (0..=4).map(move |i| {
+                DVec3::new(f64::from(i), f64::from(j), if j == 1 || j == 2 { 1.0 } else { 0.0 })
+            })
+        })
         .collect();
     let id = |i: u32, j: u32| j * 5 + i;
-    let faces = (0..3).flat_map(|j| (0..4).map(move |i| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])).collect();
+    let faces = (0..3)
+        .flat_map(|j| (0..4).map(move |i| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .collect();
     mesh(positions, faces)
 }
 
@@ -250,7 +265,8 @@ pub fn valence2_interior() -> Mesh {
     let mut positions = g.positions().to_vec();
     let v = positions.len() as u32;
     positions.push(DVec3::new(1.5, 1.5, 0.3));
-    let (a, x, b, y) = (grid_vertex(3, 1, 1), grid_vertex(3, 2, 1), grid_vertex(3, 2, 2), grid_vertex(3, 1, 2));
+    let (a, x, b, y) =
+        (grid_vertex(3, 1, 1), grid_vertex(3, 2, 1), grid_vertex(3, 2, 2), grid_vertex(3, 1, 2));
     let mut faces: Vec<Vec<u32>> = g.faces().filter(|f| f != &[a, x, b, y]).map(<[u32]>::to_vec).collect();
     faces.push(vec![v, a, x, b]);
     faces.push(vec![v, b, y, a]);
@@ -328,7 +344,8 @@ pub fn same_direction() -> Mesh {
 pub fn membrane_box() -> Mesh {
     let positions = (0..3)
         .flat_map(|k| {
-            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(x, y)| DVec3::new(x, y, f64::from(k) + 0.1 * x * y))
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                .map(|(x, y)| DVec3::new(x, y, f64::from(k) + 0.1 * x * y))
         })
         .collect();
     let r = |k: u32, i: u32| 4 * k + i % 4;
@@ -456,7 +473,13 @@ pub fn sharp() -> Vec<SharpShape> {
         },
         SharpShape {
             name: "cube_chaikin",
-            surface: surface(cube(), &[(0, 1, 2.7), (1, 3, 1.1), (3, 2, 3.9), (2, 0, 0.6), (0, 4, 2.2)], &[], &[], chaikin),
+            surface: surface(
+                cube(),
+                &[(0, 1, 2.7), (1, 3, 1.1), (3, 2, 3.9), (2, 0, 0.6), (0, 4, 2.2)],
+                &[],
+                &[],
+                chaikin,
+            ),
             levels: 4,
             covers: "Chaikin creasing along a loop and into a junction",
         },
@@ -464,7 +487,12 @@ pub fn sharp() -> Vec<SharpShape> {
             name: "tent_creases",
             surface: surface(
                 tent(),
-                &[(t(0, 1), t(1, 1), 2.0), (t(1, 1), t(2, 1), 2.0), (t(2, 1), t(3, 1), 0.5), (t(3, 1), t(4, 1), 10.0)],
+                &[
+                    (t(0, 1), t(1, 1), 2.0),
+                    (t(1, 1), t(2, 1), 2.0),
+                    (t(2, 1), t(3, 1), 0.5),
+                    (t(3, 1), t(4, 1), 10.0),
+                ],
                 &[],
                 &[],
                 e,
@@ -476,7 +504,12 @@ pub fn sharp() -> Vec<SharpShape> {
             name: "tent_corner",
             surface: surface(
                 tent(),
-                &[(t(0, 2), t(1, 2), 10.0), (t(1, 2), t(2, 2), 10.0), (t(2, 2), t(3, 2), 10.0), (t(3, 2), t(4, 2), 10.0)],
+                &[
+                    (t(0, 2), t(1, 2), 10.0),
+                    (t(1, 2), t(2, 2), 10.0),
+                    (t(2, 2), t(3, 2), 10.0),
+                    (t(3, 2), t(4, 2), 10.0),
+                ],
                 &[(t(2, 2), 3.0)],
                 &[],
                 with(Boundary::EdgeAndCorner, CreaseMethod::Uniform, Triangles::Catmark),
@@ -521,7 +554,12 @@ pub fn sharp() -> Vec<SharpShape> {
             name: "grid_boundary_none",
             surface: surface(
                 grid(4),
-                &[(g(0, 0), g(1, 0), 10.0), (g(1, 0), g(2, 0), 10.0), (g(2, 0), g(3, 0), 10.0), (g(4, 3), g(4, 4), 10.0)],
+                &[
+                    (g(0, 0), g(1, 0), 10.0),
+                    (g(1, 0), g(2, 0), 10.0),
+                    (g(2, 0), g(3, 0), 10.0),
+                    (g(4, 3), g(4, 4), 10.0),
+                ],
                 &[],
                 &[],
                 with(Boundary::None, CreaseMethod::Uniform, Triangles::Catmark),
@@ -531,7 +569,13 @@ pub fn sharp() -> Vec<SharpShape> {
         },
         SharpShape {
             name: "grid_edge_and_corner",
-            surface: surface(grid(3), &[(grid_vertex(3, 1, 1), grid_vertex(3, 2, 1), 1.5)], &[], &[], with(Boundary::EdgeAndCorner, CreaseMethod::Uniform, Triangles::Catmark)),
+            surface: surface(
+                grid(3),
+                &[(grid_vertex(3, 1, 1), grid_vertex(3, 2, 1), 1.5)],
+                &[],
+                &[],
+                with(Boundary::EdgeAndCorner, CreaseMethod::Uniform, Triangles::Catmark),
+            ),
             levels: 4,
             covers: "boundary edge-and-corner: valence-2 corners stay",
         },
@@ -565,9 +609,24 @@ pub fn sharp() -> Vec<SharpShape> {
             levels: 4,
             covers: "a valence-2 vertex folded over an edge between pentagons, half creased",
         },
-        SharpShape { name: "pole8", surface: surface(cone(8), &[], &[], &[], e), levels: 4, covers: "a pole of valence 8" },
-        SharpShape { name: "pole64", surface: surface(cone(64), &[(0, 1, 2.0)], &[], &[], e), levels: 3, covers: "a pole of valence 64" },
-        SharpShape { name: "pole360", surface: surface(cone(360), &[], &[], &[], e), levels: 3, covers: "a pole of valence 360" },
+        SharpShape {
+            name: "pole8",
+            surface: surface(cone(8), &[], &[], &[], e),
+            levels: 4,
+            covers: "a pole of valence 8",
+        },
+        SharpShape {
+            name: "pole64",
+            surface: surface(cone(64), &[(0, 1, 2.0)], &[], &[], e),
+            levels: 3,
+            covers: "a pole of valence 64",
+        },
+        SharpShape {
+            name: "pole360",
+            surface: surface(cone(360), &[], &[], &[], e),
+            levels: 3,
+            covers: "a pole of valence 360",
+        },
         SharpShape {
             name: "quad_pole8",
             surface: surface(quad_pole(8), &[], &[], &[], e),
@@ -580,10 +639,21 @@ pub fn sharp() -> Vec<SharpShape> {
             levels: 3,
             covers: "a pole of degenerate quads, valence 64",
         },
-        SharpShape { name: "fin", surface: surface(book(3), &[], &[], &[], e), levels: 4, covers: "an edge with three faces" },
+        SharpShape {
+            name: "fin",
+            surface: surface(book(3), &[], &[], &[], e),
+            levels: 4,
+            covers: "an edge with three faces",
+        },
         SharpShape {
             name: "book",
-            surface: surface(book(8), &[(0, 2, 1.5)], &[], &[], with(Boundary::EdgeAndCorner, CreaseMethod::Uniform, Triangles::Catmark)),
+            surface: surface(
+                book(8),
+                &[(0, 2, 1.5)],
+                &[],
+                &[],
+                with(Boundary::EdgeAndCorner, CreaseMethod::Uniform, Triangles::Catmark),
+            ),
             levels: 4,
             covers: "an edge with eight faces",
         },
@@ -601,27 +671,61 @@ pub fn sharp() -> Vec<SharpShape> {
         },
         SharpShape {
             name: "membrane_box_creased",
+            surface: surface(membrane_box(), &[(4, 8, 1.5)], &[], &[], e),
+            levels: 4,
+            covers: "a semi-sharp edge meeting a non-manifold crease (decays on the CPU first)",
+        },
+        SharpShape {
+            name: "membrane_box_corner",
             surface: surface(membrane_box(), &[(4, 8, 1.5), (0, 4, 10.0)], &[], &[], e),
             levels: 4,
-            covers: "semi-sharp and infinite edges meeting a non-manifold crease",
+            covers: "semi-sharp and infinite edges at a non-manifold crease vertex: a corner for good",
         },
-        SharpShape { name: "bowties", surface: surface(bowties(), &[], &[], &[], e), levels: 4, covers: "closed and open bowtie vertices" },
-        SharpShape { name: "fan", surface: surface(fan(), &[(0, 3, 2.0)], &[], &[], e), levels: 4, covers: "a fan: sheets around one vertex, a fin" },
+        SharpShape {
+            name: "bowties",
+            surface: surface(bowties(), &[], &[], &[], e),
+            levels: 4,
+            covers: "closed and open bowtie vertices",
+        },
+        SharpShape {
+            name: "fan",
+            surface: surface(fan(), &[(0, 3, 2.0)], &[], &[], e),
+            levels: 4,
+            covers: "a fan: sheets around one vertex, a fin",
+        },
         SharpShape {
             name: "tetrahedron_smooth",
-            surface: surface(tetrahedron(), &[], &[], &[], with(Boundary::EdgeOnly, CreaseMethod::Uniform, Triangles::Smooth)),
+            surface: surface(
+                tetrahedron(),
+                &[],
+                &[],
+                &[],
+                with(Boundary::EdgeOnly, CreaseMethod::Uniform, Triangles::Smooth),
+            ),
             levels: 4,
             covers: "smooth triangles",
         },
         SharpShape {
             name: "pyramid_smooth_creased",
-            surface: surface(pyramid(), &[(0, 1, 3.0), (1, 4, 0.7)], &[(4, 1.2)], &[], with(Boundary::EdgeOnly, CreaseMethod::Uniform, Triangles::Smooth)),
+            surface: surface(
+                pyramid(),
+                &[(0, 1, 3.0), (1, 4, 0.7)],
+                &[(4, 1.2)],
+                &[],
+                with(Boundary::EdgeOnly, CreaseMethod::Uniform, Triangles::Smooth),
+            ),
             levels: 4,
             covers: "smooth triangles with creases and a corner",
         },
         SharpShape {
             name: "valences_creased",
-            surface: surface(valences(), &[(0, 1, 2.0), (1, 2, 2.0), (7, 14, 10.0), (8, 14, 0.9)], &[], &[3], e),
+            surface: surface(
+                valences(),
+                &[(0, 1, 2.0), (1, 2, 2.0), (7, 14, 10.0), (8, 14, 0.9)],
+                &[],
+                &[3],
+                e,
+            ),
             levels: 4,
             covers: "n-gons and every valence 3…8 with creases and a hole",
         },

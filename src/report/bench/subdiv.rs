@@ -145,7 +145,11 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
             cpu::refine(mesh, level)?;
             Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
         })?;
-        let osd_seconds = osd::time_median(&crate::subdiv::Surface::smooth(mesh.clone()), level, settings.runs.max(1) as u32)?;
+        let osd_seconds = osd::time_median(
+            &crate::subdiv::Surface::smooth(mesh.clone()),
+            level,
+            settings.runs.max(1) as u32,
+        )?;
         let verdict = if settings.validate {
             let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
             if c.is_match() {
