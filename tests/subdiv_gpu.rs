@@ -241,22 +241,21 @@ fn isolated_vertices_stay() {
     );
 }
 
-/// `texgeo subdivide`: writes the mesh, `--validate` passes against OpenSubdiv, and a
-/// non-manifold input is a clear error with exit status 2.
+/// `texgeo subdivide`: writes the mesh, `--validate` passes against OpenSubdiv, tags and
+/// options are applied, non-manifold input is subdivided, and a bad tag is a clear error
+/// (file and line) with exit status 2.
 #[test]
 fn subdivide_command() {
     let exe = env!("CARGO_BIN_EXE_texgeo");
-    let out = std::env::temp_dir().join(format!("texgeo-subdivide-{}.off", std::process::id()));
-    let run = std::process::Command::new(exe)
-        .args(["subdivide", "builtin:pyramid", "-l", "3", "--validate", "-o"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let dir = std::env::temp_dir().join(format!("texgeo-subdivide-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("out.off");
+    let texgeo = |args: &[&str]| std::process::Command::new(exe).args(args).output().unwrap();
+    let run = texgeo(&["subdivide", "builtin:pyramid", "-l", "3", "--validate", "-o", out.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
     assert!(stdout.contains("validation passed") && stdout.contains("position error: max"), "{stdout}");
     let written = texgeo::mesh::formats::read(&out).unwrap();
-    let _ = std::fs::remove_file(&out);
     let reference = cpu::refine(&texgeo::mesh::procedural::pyramid(), 3).unwrap();
     assert_eq!(
         (written.num_vertices(), written.num_faces()),
@@ -264,11 +263,70 @@ fn subdivide_command() {
     );
     assert!(written.report().is_closed());
 
+    // Non-manifold input: OpenSubdiv's sharp rules, on the GPU.
+    let run = texgeo(&["subdivide", "builtin:two-cubes", "-l", "3", "--validate"]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success() && stdout.contains("validation passed"), "{stdout}");
+
+    // Tags: a crease, a corner, Chaikin, an ignored tag; options override tags.
+    let cube = dir.join("cube.obj");
+    let mut text = Vec::new();
+    texgeo::mesh::formats::obj::write(&mut text, &shapes::cube()).unwrap();
+    let mut text = String::from_utf8(text).unwrap();
+    text.push_str(
+        "t crease 2/1/0 0 1 2.5\nt corner 1/1/0 7 1.5\nt creasemethod 0/0/1 chaikin\nt vertexedit 1/0/0 3\n",
+    );
+    std::fs::write(&cube, &text).unwrap();
+    for method in ["gpu", "cpu"] {
+        let run = texgeo(&["subdivide", cube.to_str().unwrap(), "-l", "3", "--method", method, "--validate"]);
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(run.status.success() && stdout.contains("validation passed"), "{method}: {stdout}");
+        assert!(stdout.contains("1 crease edge(s)") && stdout.contains("creasing chaikin"), "{stdout}");
+        assert!(stdout.contains("tag 'vertexedit' ignored"), "{stdout}");
+    }
     let run =
-        std::process::Command::new(exe).args(["subdivide", "builtin:two-cubes", "-l", "2"]).output().unwrap();
+        texgeo(&["subdivide", cube.to_str().unwrap(), "-l", "2", "--crease-method", "uniform", "--validate"]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success() && stdout.contains("creasing uniform"), "{stdout}");
+
+    // A crease on vertices no edge joins: file and line, exit status 2.
+    text.push_str("t crease 2/1/0 0 7 1\n");
+    std::fs::write(&cube, &text).unwrap();
+    let run = texgeo(&["subdivide", cube.to_str().unwrap(), "-l", "2"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("non-manifold edge") && stderr.contains("manifold"), "{stderr}");
+    assert!(stderr.contains("cube.obj:20") && stderr.contains("not joined by an edge"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 12, item 7: meshes with coincident but distinct vertices. Two grids side by side
+/// with duplicated border vertices refine to pairs of vertices at the same positions; the
+/// comparison takes the refinement's own correspondence (faces in OpenSubdiv's order), so
+/// the GPU result matches OpenSubdiv — a matching by position could swap the pairs.
+#[test]
+fn coincident_vertices_match_by_the_refinement() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let seam = shapes::seam(3);
+    for level in 1..=3 {
+        let run = sub.refine(&ctx, &seam, level, &Options::default()).unwrap();
+        let reference = opensubdiv(&seam, level);
+        let c = Comparison::new(&run.mesh, &reference, TOLERANCE);
+        assert!(c.is_match(), "seam level {level}:\n{c}");
+        assert_eq!(c.matching, Matching::Faces, "seam level {level}:\n{c}");
+    }
+    // And through the command line.
+    let dir = std::env::temp_dir().join(format!("texgeo-seam-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("seam.off");
+    texgeo::mesh::formats::write(&file, &seam).unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
+        .args(["subdivide", file.to_str().unwrap(), "-l", "3", "--validate"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success() && stdout.contains("corresponding by faces"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Every shape of the sharp set on the GPU equals OpenSubdiv (1e-5 × diagonal), faces in

@@ -115,6 +115,19 @@ pub fn grid(n: u32) -> Mesh {
     mesh(positions, faces)
 }
 
+/// Two `n × n` grids side by side whose touching borders have the same positions but
+/// distinct vertices: after refinement the two borders' vertices coincide pairwise, so
+/// only the refinement's own correspondence (not positions) tells them apart.
+pub fn seam(n: u32) -> Mesh {
+    let g = grid(n);
+    let mut positions = g.positions().to_vec();
+    positions.extend(g.positions().iter().map(|p| *p + DVec3::new(f64::from(n), 0.0, 0.0)));
+    let o = g.num_vertices() as u32;
+    let mut faces: Vec<Vec<u32>> = g.faces().map(<[u32]>::to_vec).collect();
+    faces.extend(g.faces().map(|f| f.iter().map(|&v| v + o).collect::<Vec<u32>>()));
+    mesh(positions, faces)
+}
+
 /// The built-in (2,3) torus-knot tube with `2 · along · around` triangles: 75 × 8 is the
 /// 1200-triangle `builtin:knot` (the thesis' "Torusknot"), 400 × 8 the 6400 of CGAL's
 /// knot1.off.
