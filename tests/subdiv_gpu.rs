@@ -181,7 +181,7 @@ fn high_valence_fragments_span_rows() {
     let fragments = FragmentMesh::new(&mesh, 4).unwrap();
     let widest = fragments.runs().iter().map(|r| r.class.len(2)).max().unwrap();
     assert!(widest > 64 * 3, "the apex fragment ({widest} texels) should span several 64-texel rows");
-    let narrow = Options { row_width: Some(64) };
+    let narrow = Options { row_width: Some(64), ..Options::default() };
     assert_gpu_matches_opensubdiv(&ctx, &mut sub, "cone(40), 64-texel rows", &mesh, 2..=4, &narrow);
     assert_gpu_matches_opensubdiv(&ctx, &mut sub, "cone(40)", &mesh, 4..=4, &Options::default());
 }
@@ -393,4 +393,25 @@ fn inexpressible_features_go_to_the_cpu_and_say_so() {
 /// OpenSubdiv's refinement of a surface; a missing helper fails the test.
 fn opensubdiv_surface(surface: &Surface, level: u32) -> Mesh {
     osd::refine_surface(surface, level).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The sharp shader variants also compute smooth fragments exactly as the smooth one:
+/// drawing every run with them (what a GPU that skips untaken branches would do) gives
+/// the same surfaces.
+#[test]
+fn single_shader_draws_everything_the_same() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    let single = Options { single_shader: true, ..Options::default() };
+    for name in ["cube_creases", "torus_chaikin", "grid_holes"] {
+        let shape = shapes::sharp().into_iter().find(|s| s.name == name).unwrap();
+        let split = sub.refine_surface(&ctx, &shape.surface, 3, &Options::default()).unwrap();
+        let one = sub.refine_surface(&ctx, &shape.surface, 3, &single).unwrap();
+        let c = Comparison::new(&one.mesh, &split.mesh, 1e-9);
+        assert!(c.is_match() && c.same_order, "{name}:\n{c}");
+    }
+    let torus = shapes::torus(8, 6);
+    let split = sub.refine(&ctx, &torus, 4, &Options::default()).unwrap();
+    let one = sub.refine(&ctx, &torus, 4, &single).unwrap();
+    assert!(Comparison::new(&one.mesh, &split.mesh, 1e-9).same_order);
 }

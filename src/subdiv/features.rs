@@ -4,6 +4,8 @@
 //! interpolation, creasing method and the weights of triangles. A [`Surface`] is the
 //! three together: everything both refiners (CPU, GPU) and the OpenSubdiv helper need.
 
+use glam::DVec3;
+
 use crate::mesh::Mesh;
 
 pub use super::crease::Method as CreaseMethod;
@@ -70,6 +72,50 @@ pub struct Features {
 impl Features {
     pub fn is_empty(&self) -> bool {
         self.creases.is_empty() && self.corners.is_empty() && self.holes.is_empty()
+    }
+
+    /// Creases of `sharpness` on the *feature edges* of `mesh`: edges with two faces whose
+    /// normals differ by more than `degrees` (how a CAD model's sharp edges are usually
+    /// tagged before subdivision). Boundary and non-manifold edges are sharp anyway.
+    pub fn feature_edges(mesh: &Mesh, degrees: f64, sharpness: f32) -> Features {
+        let normals: Vec<DVec3> = mesh
+            .faces()
+            .map(|f| {
+                // Newell's normal: robust for non-planar polygons.
+                let mut n = DVec3::ZERO;
+                for (i, &a) in f.iter().enumerate() {
+                    let (p, q) =
+                        (mesh.positions()[a as usize], mesh.positions()[f[(i + 1) % f.len()] as usize]);
+                    n += DVec3::new(
+                        (p.y - q.y) * (p.z + q.z),
+                        (p.z - q.z) * (p.x + q.x),
+                        (p.x - q.x) * (p.y + q.y),
+                    );
+                }
+                n.normalize_or_zero()
+            })
+            .collect();
+        let mut uses: Vec<((u32, u32), u32)> = Vec::new();
+        for (f, face) in mesh.faces().enumerate() {
+            for (i, &a) in face.iter().enumerate() {
+                let b = face[(i + 1) % face.len()];
+                if a != b {
+                    uses.push(((a.min(b), a.max(b)), f as u32));
+                }
+            }
+        }
+        uses.sort_unstable();
+        let cos = degrees.to_radians().cos();
+        let creases = uses
+            .chunk_by(|x, y| x.0 == y.0)
+            .filter_map(|g| match g {
+                [(edge, f0), (_, f1)] if normals[*f0 as usize].dot(normals[*f1 as usize]) < cos => {
+                    Some(Crease { vertices: [edge.0, edge.1], sharpness })
+                }
+                _ => None,
+            })
+            .collect();
+        Features { creases, ..Features::default() }
     }
 }
 

@@ -42,7 +42,9 @@
 //! Sharpness only decays, so a fragment whose largest semi-sharp value is σ needs data
 //! for ⌈σ⌉ levels (one more with Chaikin, whose `f32` averages may leave a last bit);
 //! after that *horizon* its stream drops the data texels and it runs the smooth stencil.
-//! Fragments are sorted into runs of one class (valence, half-fan) and horizon.
+//! Fragments are sorted into runs of one horizon and class (valence, half-fan), horizon
+//! first: at every level the runs without data come first, so the GPU pass can draw them
+//! with the smooth shader variant and the rest with the sharp one (`gpu`).
 //!
 //! # What the fragments cannot express
 //!
@@ -204,7 +206,7 @@ pub struct FragmentMesh {
     cpu_levels: u32,
     method: Method,
     reasons: Vec<String>,
-    /// Sorted by class, horizon, then centre.
+    /// Sorted by horizon, class, then centre.
     fragments: Vec<Fragment>,
     runs: Vec<ClassRun>,
     /// Fragment of each fan of the coarse topology.
@@ -502,12 +504,12 @@ impl FragmentMesh {
         (texels, horizon)
     }
 
-    /// Orders fragments by class and horizon, records the runs and writes the base stream.
+    /// Orders fragments by horizon and class, records the runs and writes the base stream.
     fn sort_and_stream(&mut self, texel_sets: Vec<(Vec<[f64; 4]>, u32)>) {
         let mut order: Vec<usize> = (0..self.fragments.len()).collect();
         order.sort_by_key(|&i| {
             let f = &self.fragments[i];
-            (f.class, f.horizon, f.centre, f.fan)
+            (f.horizon, f.class, f.centre, f.fan)
         });
         self.fragments = order.iter().map(|&i| self.fragments[i]).collect();
         self.first_corner = order.iter().map(|&i| self.first_corner[i]).collect();

@@ -138,6 +138,9 @@ impl Packing {
 pub struct Options {
     /// Force the texture row width (a power of two); default ≈ √texels.
     pub row_width: Option<u32>,
+    /// Draw every run with the sharp shader variant, not only the runs with sharpness
+    /// data (what a GPU that skips untaken branches would do; slower on lavapipe).
+    pub single_shader: bool,
 }
 
 /// Where the time of one GPU subdivision went.
@@ -190,20 +193,26 @@ pub struct Run {
     pub times: Times,
 }
 
-/// The fragment pass (`glsl/subdiv/refine.frag`) with its two render targets and its
-/// readback buffer, built once and reused: like a texture-era application, which
-/// allocates its FBO textures once, not per frame. Targets grow when a mesh needs more.
+/// The fragment pass (`glsl/subdiv/refine.glsl`: its sharp and smooth variants) with its
+/// two render targets and its readback buffer, built once and reused: like a texture-era
+/// application, which allocates its FBO textures once, not per frame. Targets grow when a
+/// mesh needs more.
 pub struct Subdivider {
-    pipeline: Pipeline,
+    smooth: Pipeline,
+    /// The sharp variants: uniform and Chaikin creasing.
+    sharp: Pipeline,
+    chaikin: Pipeline,
     targets: Option<PingPong>,
     readback: Option<Buffer>,
 }
 
 impl Subdivider {
     pub fn new(ctx: &Context) -> Result<Subdivider> {
-        let pipeline =
-            Pipeline::quad(ctx, &shaders::subdiv::REFINE_FRAG, &[TexFormat::Rgba32F], Blend::Replace)?;
-        Ok(Subdivider { pipeline, targets: None, readback: None })
+        let quad = |shader| Pipeline::quad(ctx, shader, &[TexFormat::Rgba32F], Blend::Replace);
+        let smooth = quad(&shaders::subdiv::REFINE_SMOOTH_FRAG)?;
+        let sharp = quad(&shaders::subdiv::REFINE_FRAG)?;
+        let chaikin = quad(&shaders::subdiv::REFINE_CHAIKIN_FRAG)?;
+        Ok(Subdivider { smooth, sharp, chaikin, targets: None, readback: None })
     }
 
     /// Refines `mesh` (smooth, default options) `level` times; see
@@ -302,8 +311,22 @@ impl Subdivider {
         let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
             return Err(SubdivError::GpuLimit("render targets were not created".into()));
         };
-        let pipeline = &self.pipeline;
+        let smooth = &self.smooth;
+        let sharp = if fragments.crease_method() == Method::Chaikin { &self.chaikin } else { &self.sharp };
         let timer = Timestamps::new(ctx, gpu_levels + 3)?;
+        // Rows of each output stream drawn with the smooth variant: those before the first
+        // run with sharpness data in the input (runs are sorted by horizon, `fragment`).
+        let smooth_rows: Vec<u32> = (0..gpu_levels as usize)
+            .map(|j| {
+                let first_sharp = packing.layouts[j].data.iter().position(|&d| d);
+                let texel = match first_sharp {
+                    _ if options.single_shader => 0,
+                    Some(r) => packing.layouts[j + 1].starts[r],
+                    None => packing.layouts[j + 1].total,
+                };
+                ((texel / u64::from(width)) as u32).min(packing.rows(j + 1))
+            })
+            .collect();
         let t = Instant::now();
         ctx.submit(|rec| {
             rec.reset_timestamps(&timer);
@@ -318,17 +341,25 @@ impl Subdivider {
                     fragments.runs().len() as i32,
                     lout.total as i32,
                     packing.log2_width as i32,
-                    i32::from(fragments.crease_method() == Method::Chaikin),
                 ];
                 let input = targets.src();
                 let reads = [input];
-                let area = [0, 0, width, packing.rows(j + 1)];
+                let rows = packing.rows(j + 1);
+                let area = [0, 0, width, rows];
+                let split = smooth_rows[j];
                 rec.render(&[Attachment::new(targets.dst(), Load::Discard)], Some(area), &reads, |pass| {
-                    pass.bind(pipeline)?;
-                    pass.textures(&[(0, input)])?;
-                    pass.uniform(1, table)?;
-                    pass.push(&params)?;
-                    pass.quad()
+                    for (pipeline, first, count) in [(smooth, 0, split), (sharp, split, rows - split)] {
+                        if count == 0 {
+                            continue;
+                        }
+                        pass.bind(pipeline)?;
+                        pass.viewport([0, first, width, count]);
+                        pass.textures(&[(0, input)])?;
+                        pass.uniform(1, table)?;
+                        pass.push(&params)?;
+                        pass.quad()?;
+                    }
+                    Ok(())
                 })?;
                 targets.swap();
                 rec.timestamp(&timer, 2 + j as u32)?;

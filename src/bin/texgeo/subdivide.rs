@@ -73,6 +73,12 @@ pub struct Args {
     /// Triangle weights (overrides the file's `t smoothtriangles`).
     #[arg(long, value_enum)]
     triangles: Option<TrianglesArg>,
+    /// Also crease every edge whose two faces meet at more than DEGREES (feature edges).
+    #[arg(long, value_name = "DEGREES")]
+    crease_angle: Option<f64>,
+    /// Sharpness of the --crease-angle creases (10 or more: infinitely sharp).
+    #[arg(long, default_value_t = 10.0, requires = "crease_angle")]
+    crease_sharpness: f32,
     /// Also refine with OpenSubdiv (tools/setup builds its helper) and compare: vertex and
     /// face counts, max/RMS position error; exit status 1 if the tolerance is exceeded
     /// (1e-5 × bounding-box diagonal for the GPU, 1e-12 for the CPU).
@@ -203,6 +209,15 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             TrianglesArg::Catmark => Triangles::Catmark,
             TrianglesArg::Smooth => Triangles::Smooth,
         };
+    }
+    if let Some(degrees) = args.crease_angle {
+        anyhow::ensure!((0.0..=180.0).contains(&degrees), "--crease-angle must be in 0..=180 degrees");
+        anyhow::ensure!(
+            args.crease_sharpness.is_finite() && args.crease_sharpness >= 0.0,
+            "--crease-sharpness must be a finite number ≥ 0"
+        );
+        let features = Features::feature_edges(&surface.mesh, degrees, args.crease_sharpness);
+        surface.features.creases.extend(features.creases);
     }
     let mesh = &surface.mesh;
     println!("{}: {} vertices, {} faces", args.input, mesh.num_vertices(), mesh.num_faces());

@@ -1,0 +1,376 @@
+// One Catmull-Clark level of every fragment mesh at once (2010 thesis §3.3.2, SPEC §5.3,
+// issue 14): a full-target pass over the output stream, one invocation per new texel,
+// reading the previous level (ping-pong). Fragments lie back to back in the thesis'
+// storage order (centre, then ring by ring, sector by sector), a 1D stream wrapped into
+// rows of 2^n texels, grouped in runs of one class (valence, half-fan, sharpness horizon).
+// Each invocation finds its run, fragment and (sector, a, b), then applies the stencil:
+// both coordinates even -> vertex point, one odd -> edge point, both odd -> face point.
+//
+// Three variants are compiled from this file: refine_smooth.frag (SHARP 0: the smooth
+// masks only), refine.frag (SHARP 1: also the sharp rules, uniform creasing) and
+// refine_chaikin.frag (SHARP 1, CHAIKIN 1). lavapipe runs every branch of a shader on
+// every texel (SIMD lanes under masks), so rules a texel does not need still cost it; the
+// pass therefore draws the runs without sharpness data with the smooth variant and the
+// others with a sharp one (one render pass, two draws over row ranges of the same
+// stream). A sharp variant computes smooth texels the same way.
+//
+// Smooth fragments take the tensor-product masks (and the valence-k centre). In a sharp
+// fragment every vertex entry is followed by a data texel — centre: (vertex sharpness,
+// 0, 0, 0); entry (a, b): (semi-sharp count, sharpness of edge (a-1,b)-(a,b), of edge
+// (a,b-1)-(a,b), semi-sharp sum) — and the invocation applies OpenSubdiv's rules
+// (Sdc::Crease: dart, crease and corner masks, their fractional blends, uniform or
+// Chaikin decay). An invocation on a data texel writes the decayed data of its vertex for
+// the next level. The same rules as `sharp_stencil` / `sharp_data` in
+// src/subdiv/fragment.rs (there in f64, here in f32).
+//
+// No integer division: like the GPUs of the era (and llvmpipe's SIMD code, which has no
+// vector integer divide), quotients come from float division plus an exact correction.
+
+// Entries of `runs` (the Rust side uploads exactly this many; see src/subdiv/gpu.rs).
+#define MAX_RUNS 256
+#define INFINITE 10.0
+
+layout(set = 0, binding = 0) uniform sampler2D src;
+// Per class run: (valence, flags, first input texel, first output texel); flags: 1
+// half-fan, 2 data texels in the input, 4 data texels in the output.
+layout(set = 0, binding = 1, std140) uniform Runs {
+    ivec4 runs[MAX_RUNS];
+} tab;
+layout(push_constant) uniform Params {
+    int r_in;       // ring radius of the input fragments
+    int r_out;      // ring radius written by this pass
+    int run_count;  // entries of tab.runs in use
+    int total_out;  // texels of the output stream
+    int log2_width; // rows are 2^log2_width texels wide
+} pc;
+layout(location = 0) out vec4 result;
+
+// The current fragment: valence, half-fan flag, first input texel, texels per input entry.
+int K;
+int E;
+int BASE;
+#if SHARP
+int STRIDE;
+#else
+#define STRIDE 1
+#endif
+
+// floor(n / d) for 0 <= n < 2^30, 1 <= d < 2^24, exact.
+int divide(int n, int d) {
+    float fd = float(d);
+    int q = int(float(n) / fd);
+    int r = n - q * d;
+    q += int(floor(float(r) / fd));
+    r = n - q * d;
+    if (r < 0) {
+        q -= 1;
+    } else if (r >= d) {
+        q += 1;
+    }
+    return q;
+}
+
+// Entries before ring r (r >= 1), centre excluded.
+int ring_offset(int r) {
+    return K * r * (r - 1) + E * (r - 1);
+}
+
+// Storage index of vertex (a, b) of sector s, after moving (a, -1) and (0, b) to the
+// neighbouring sector. Written with selects, not branches: SIMD lanes diverge here.
+int entry(int s, int a, int b) {
+    bool below = b < 0;
+    int s1 = below ? ((s == 0) ? K - 1 : s - 1) : s;
+    int a1 = below ? 1 : a;
+    int b1 = below ? a : b;
+    bool on_next = a1 == 0;
+    int s2 = on_next ? ((s1 + 1 == K && E == 0) ? 0 : s1 + 1) : s1;
+    int a2 = on_next ? b1 : a1;
+    int b2 = on_next ? 0 : b1;
+    int r = max(a2, b2);
+    int t = (a2 == r) ? b2 : 2 * r - a2;
+    return (a2 == 0) ? 0 : 1 + ring_offset(r) + s2 * 2 * r + t;
+}
+
+vec4 fetch(int i) {
+    return texelFetch(src, ivec2(i & ((1 << pc.log2_width) - 1), i >> pc.log2_width), 0);
+}
+
+vec3 at(int s, int a, int b) {
+    return fetch(BASE + entry(s, a, b) * STRIDE).xyz;
+}
+
+#if SHARP
+// The data texel of entry (s, a, b) (sharp fragments only).
+vec4 dat(int s, int a, int b) {
+    return fetch(BASE + entry(s, a, b) * 2 + 1);
+}
+#endif
+
+vec3 centre_point() {
+    vec3 c = at(0, 0, 0);
+    if (E == 1) {
+        return c; // never used: a half-fan's centre has two infinitely sharp edges
+    }
+    vec3 edges = vec3(0.0);
+    vec3 diagonals = vec3(0.0);
+    for (int s = 0; s < K; ++s) {
+        edges += at(s, 1, 0);
+        diagonals += at(s, 1, 1);
+    }
+    float n = float(K);
+    return c * (1.0 - 7.0 / (4.0 * n)) + edges * (1.5 / (n * n)) + diagonals * (0.25 / (n * n));
+}
+
+// The 3 x 3 taps of smooth_point, T<3·row + column>: every position the sharp rules need
+// is among them.
+vec3 T0, T1, T2, T3, T4, T5, T6, T7, T8;
+
+// The smooth stencil of entry (s, a, b) (a >= 1): the masks are tensor products of 1D
+// ones (B-spline subdivision): per axis, an even output coordinate takes (1/8, 3/4, 1/8)
+// of the input at c/2 - 1, c/2, c/2 + 1, an odd one (1/2, 1/2) of c/2 and c/2 + 1. On a
+// half-fan's border only b = 0 is read (its value is never used there: border edges are
+// infinitely sharp). Taps of weight 0 read the centre tap again, so every address stays
+// valid.
+vec3 smooth_point(int s, int a, int b) {
+    bool border = E == 1 && b == 0 && (s == 0 || s == K);
+    int a0 = a >> 1;
+    int b0 = b >> 1;
+    bool a_even = (a & 1) == 0;
+    bool b_even = (b & 1) == 0;
+    ivec3 ta = ivec3(a_even ? a0 - 1 : a0, a0, a0 + 1);
+    vec3 wa = a_even ? vec3(0.125, 0.75, 0.125) : vec3(0.0, 0.5, 0.5);
+    ivec3 tb = border ? ivec3(0) : ivec3(b_even ? b0 - 1 : b0, b0, b0 + 1);
+    vec3 wb = border ? vec3(0.0, 1.0, 0.0) : (b_even ? vec3(0.125, 0.75, 0.125) : vec3(0.0, 0.5, 0.5));
+    T0 = at(s, ta.x, tb.x);
+    T1 = at(s, ta.y, tb.x);
+    T2 = at(s, ta.z, tb.x);
+    T3 = at(s, ta.x, tb.y);
+    T4 = at(s, ta.y, tb.y);
+    T5 = at(s, ta.z, tb.y);
+    T6 = at(s, ta.x, tb.z);
+    T7 = at(s, ta.y, tb.z);
+    T8 = at(s, ta.z, tb.z);
+    return wb.x * (wa.x * T0 + wa.y * T1 + wa.z * T2) + wb.y * (wa.x * T3 + wa.y * T4 + wa.z * T5) +
+           wb.z * (wa.x * T6 + wa.y * T7 + wa.z * T8);
+}
+
+#if SHARP
+// ---- Sharpness (OpenSubdiv's Sdc::Crease), four values at a time ----
+
+vec4 decrement4(vec4 s) {
+    vec4 d = mix(s - 1.0, vec4(0.0), lessThanEqual(s, vec4(1.0)));
+    return mix(d, vec4(INFINITE), greaterThanEqual(s, vec4(INFINITE)));
+}
+
+// Child sharpness of edges of sharpness s at a vertex whose semi-sharp edges count
+// semi.x and sum semi.y (Chaikin: 3/4 of its own, 1/4 of the others' mean, minus 1).
+vec4 child4(vec4 s, vec2 semi) {
+#if CHAIKIN
+    vec4 others = (vec4(semi.y) - s) / max(semi.x - 1.0, 1.0);
+    vec4 c = (semi.x > 1.0) ? 0.75 * s + 0.25 * others : s;
+    c = max(c - 1.0, vec4(0.0));
+    c = mix(c, vec4(0.0), lessThanEqual(s, vec4(0.0)));
+    return mix(c, vec4(INFINITE), greaterThanEqual(s, vec4(INFINITE)));
+#else
+    return decrement4(s);
+#endif
+}
+
+float child1(float s, vec2 semi) {
+    return child4(vec4(s), semi).x;
+}
+
+// 0 smooth, 1 dart, 2 crease, 3 corner.
+int rule(float vertex, float sharp_edges) {
+    return vertex > 0.0 ? 3 : min(int(sharp_edges), 3);
+}
+
+// 1 where an edge's sharpness decays to 0 this level.
+vec4 decays4(vec4 parent, vec4 child) {
+#if CHAIKIN
+    bvec4 gone = lessThanEqual(child, vec4(0.0));
+#else
+    bvec4 gone = lessThanEqual(parent, vec4(1.0));
+#endif
+    return vec4(greaterThan(parent, vec4(0.0))) * vec4(gone);
+}
+
+// Semi-sharp (count, sum) of four edges (absent ones are 0).
+vec2 semi4(vec4 e) {
+    vec4 semi = vec4(greaterThan(e, vec4(0.0))) * vec4(lessThan(e, vec4(INFINITE)));
+    return vec2(dot(semi, vec4(1.0)), dot(semi, e));
+}
+
+// OpenSubdiv's vertex-vertex mask at a vertex p of sharpness vs: the parent's rule, and
+// where it changes the child's, blended by the fractional weight. `sharp` and `csharp`
+// count the sharp edges of parent and child, `ends` and `cends` sum their neighbours,
+// `count` and `sum` the sharpness that decays (the vertex's added here); sm is the
+// smooth point.
+vec3 vertex_mask(vec3 p, float vs, float sharp, float csharp, vec3 ends, vec3 cends, float count, float sum, vec3 sm) {
+    int pr = rule(vs, sharp);
+    float cvs = decrement4(vec4(vs)).x;
+    int cr = rule(cvs, csharp);
+    vec3 pm = (pr == 2) ? 0.75 * p + 0.125 * ends : p;
+    vec3 cm = (cr <= 1) ? sm : ((cr == 2) ? 0.75 * p + 0.125 * cends : p);
+    if (vs > 0.0 && cvs <= 0.0) {
+        count += 1.0;
+        sum += vs;
+    }
+    float w = count > 0.0 ? min(sum / count, 1.0) : 0.0;
+    return (pr <= 1) ? sm : ((cr == pr) ? pm : w * pm + (1.0 - w) * cm);
+}
+
+// The centre of a sharp fragment: the vertex mask over its K (+ E) spokes.
+vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
+    float sharp = 0.0;
+    float csharp = 0.0;
+    float count = 0.0;
+    float sum = 0.0;
+    vec3 ends = vec3(0.0);
+    vec3 cends = vec3(0.0);
+    for (int s = 0; s < K + E; ++s) {
+        float e = dat(s, 1, 0).y;
+        float c = child1(e, semi);
+        vec3 q = at(s, 1, 0);
+        float d = decays4(vec4(e), vec4(c)).x;
+        sharp += float(e > 0.0);
+        csharp += float(c > 0.0);
+        ends += float(e > 0.0) * q;
+        cends += float(c > 0.0) * q;
+        count += d;
+        sum += d * e;
+    }
+    return vertex_mask(at(0, 0, 0), vs, sharp, csharp, ends, cends, count, sum, sm);
+}
+#endif // SHARP
+
+void main() {
+    int lin = (int(gl_FragCoord.y) << pc.log2_width) + int(gl_FragCoord.x);
+    if (lin >= pc.total_out) {
+        result = vec4(0.0);
+        return;
+    }
+    // The class run holding this texel: the last one starting at or before it.
+    int lo = 0;
+    int hi = pc.run_count - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) >> 1;
+        if (tab.runs[mid].w <= lin) {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    ivec4 run = tab.runs[lo];
+    K = run.x;
+    E = run.y & 1;
+#if SHARP
+    bool data_in = (run.y & 2) != 0;
+    int data_out = (run.y >> 2) & 1;
+    STRIDE = data_in ? 2 : 1;
+#else
+    int data_out = 0; // the smooth variant draws only runs without data
+#endif
+    int len_out = 1 + K * (pc.r_out + 1) * pc.r_out + E * pc.r_out;
+    int len_in = 1 + K * (pc.r_in + 1) * pc.r_in + E * pc.r_in;
+    int u = lin - run.w;
+    int frag = divide(u, len_out << data_out);
+    int rem = u - frag * (len_out << data_out);
+    int i = rem >> data_out;
+#if SHARP
+    bool is_data = (rem & data_out) != 0;
+#endif
+    BASE = run.z + frag * len_in * STRIDE;
+
+    int s = 0;
+    int a = 0;
+    int b = 0;
+    if (i > 0) {
+        // Ring r: the largest r with ring_offset(r) <= q (quadratic, then corrected).
+        int q = i - 1;
+        float k = float(K);
+        float d = float(K - E);
+        int r = max(1, int((d + sqrt(d * d + 4.0 * k * float(E + q))) / (2.0 * k)));
+        if (ring_offset(r + 1) <= q) {
+            r += 1;
+        }
+        if (ring_offset(r) > q) {
+            r -= 1;
+        }
+        int w = q - ring_offset(r);
+        s = divide(w, 2 * r);
+        int t = w - s * 2 * r;
+        a = (s == K || t <= r) ? r : 2 * r - t;
+        b = (s == K) ? 0 : min(t, r);
+    }
+    vec3 sm = (i == 0) ? centre_point() : smooth_point(s, a, b);
+#if SHARP
+    if (data_in) {
+        // The data texels every rule below reads: the parent cell (x, y), its +a and +b
+        // neighbours, and the edge (x, -1)-(x, 0) stored in the sector before.
+        int x = a >> 1;
+        int y = b >> 1;
+        bool a_even = (a & 1) == 0;
+        bool b_even = (b & 1) == 0;
+        vec4 d00 = dat(s, x, y);
+        vec4 d10 = dat(s, x + 1, y);
+        vec4 d01 = dat(s, x, y + 1);
+        vec4 dm = dat((s == 0) ? K - 1 : s - 1, 1, x);
+        // Semi-sharp (count, sum) at (x, y), (x + 1, y), (x, y + 1); the centre's from its spokes.
+        vec2 semi_c = vec2(0.0);
+#if CHAIKIN
+        for (int k = 0; k < K + E; ++k) {
+            semi_c += semi4(vec4(dat(k, 1, 0).y, 0.0, 0.0, 0.0));
+        }
+#endif
+        vec2 semi00 = (i == 0 || (x == 0 && y == 0)) ? semi_c : d00.xw;
+        vec2 semi10 = d10.xw;
+        vec2 semi01 = d01.xw;
+        // The edges of vertex (x, y): -a, +a, -b, +b (0 where absent: a half-fan's border).
+        bool minus_b = y >= 1 || E == 0 || s > 0;
+        vec4 e = vec4(d00.y, d10.y, (y >= 1) ? d00.z : (minus_b ? dm.y : 0.0), (s < K) ? d01.z : 0.0);
+        vec4 c = child4(e, semi00);
+        // The parent edge of an edge point: along a (x, y)-(x + 1, y) or along b (x, y)-(x, y + 1).
+        float pe = a_even ? d01.z : d10.y;
+        vec2 semi_end = a_even ? semi01 : semi10;
+        if (is_data) {
+            // The decayed data of this texel's vertex.
+            float ea = b_even ? child1(a_even ? d00.y : d10.y, semi00) : 0.0;
+            float eb = (b >= 1 && a_even) ? child1(b_even ? d00.z : d01.z, semi00) : 0.0;
+            vec2 semi = vec2(0.0);
+#if CHAIKIN
+            // The semi-sharp edges of the new vertex: halves of its parent's edges.
+            semi = (a_even && b_even) ? semi4(c)
+                 : (a_even != b_even) ? semi4(vec4(child1(pe, semi00), child1(pe, semi_end), 0.0, 0.0))
+                 : vec2(0.0);
+#endif
+            result = (i == 0) ? vec4(decrement4(vec4(d00.x)).x, 0.0, 0.0, 0.0) : vec4(semi.x, ea, eb, semi.y);
+            return;
+        }
+        vec3 p;
+        if (i == 0) {
+            p = sharp_centre(sm, d00.x, semi_c);
+        } else if (a_even && b_even) {
+            // Vertex point of (x, y): neighbours -a, +a, -b, +b are taps 3, 5, 1, 7.
+            vec4 sharp = vec4(greaterThan(e, vec4(0.0)));
+            vec4 csharp = vec4(greaterThan(c, vec4(0.0)));
+            vec3 ends = sharp.x * T3 + sharp.y * T5 + sharp.z * T1 + sharp.w * T7;
+            vec3 cends = csharp.x * T3 + csharp.y * T5 + csharp.z * T1 + csharp.w * T7;
+            vec4 d = decays4(e, c);
+            p = vertex_mask(T4, 0.0, dot(sharp, vec4(1.0)), dot(csharp, vec4(1.0)), ends, cends, dot(d, vec4(1.0)),
+                            dot(d, e), sm);
+        } else if (a_even != b_even) {
+            // Edge point: the midpoint while both halves stay sharp, else blended with the
+            // smooth point by the edge's sharpness. Its ends are taps 4 and 5 (along a) or 7.
+            vec3 mid = 0.5 * (T4 + (a_even ? T7 : T5));
+            bool crease = child1(pe, semi00) > 0.0 && child1(pe, semi_end) > 0.0;
+            p = (pe <= 0.0) ? sm : (crease ? mid : pe * mid + (1.0 - pe) * sm);
+        } else {
+            p = sm;
+        }
+        result = vec4(p, 1.0);
+        return;
+    }
+#endif
+    result = vec4(sm, 1.0);
+}
