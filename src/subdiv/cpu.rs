@@ -431,6 +431,11 @@ impl Level {
         self.sharp.iter().flat_map(|s| (0..s.verts.len()).map(move |i| (s.verts[i], s.list(i))))
     }
 
+    /// True when an edge or vertex is sharp (boundaries included).
+    pub(crate) fn has_sharpness(&self) -> bool {
+        self.sharp.is_some()
+    }
+
     pub(crate) fn is_hole(&self, f: u32) -> bool {
         self.holes.as_ref().is_some_and(|h| h[f as usize])
     }

@@ -219,8 +219,12 @@ pub struct FragmentMesh {
     holes: Option<Vec<bool>>,
     /// Coarse edges lying on sharp control edges: (edge, sharpness, boundary, non-manifold).
     sharp_edges: Vec<(u32, f32, bool, bool)>,
-    /// The base stream (ring radius 2): positions (x, y, z, 1) and data texels.
-    base: Vec<[f64; 4]>,
+    /// Base-level positions (B).
+    base_positions: Vec<DVec3>,
+    /// The base stream (ring radius 2), fragment after fragment in sorted order: the B
+    /// vertex of each entry, and its data texel (sharp fragments only).
+    base_vertices: Vec<u32>,
+    base_data: Vec<[f32; 4]>,
     /// Coarse vertices no face uses, with their (unchanging) positions, by vertex.
     isolated: Vec<(u32, DVec3)>,
 }
@@ -276,7 +280,9 @@ impl FragmentMesh {
             .collect();
         let cpu_levels = refiner.depth() + 1;
         let method = refiner.options().crease_method;
-        refiner.step(true)?;
+        // B's topology is needed only for its sharpness (and for another CPU level, which
+        // only sharp features can ask for).
+        refiner.step(p.has_sharpness())?;
         let b = refiner.level();
         let (nv, nf, nc) =
             (coarse.num_vertices() as u32, coarse.num_faces() as u32, coarse.num_half_edges() as u32);
@@ -368,7 +374,9 @@ impl FragmentMesh {
             first_corner,
             holes,
             sharp_edges,
-            base: Vec::new(),
+            base_positions: Vec::new(),
+            base_vertices: Vec::new(),
+            base_data: Vec::new(),
             isolated: (0..nv)
                 .filter(|&v| coarse_ref_isolated(v))
                 .map(|v| (v, b.positions()[v as usize]))
@@ -386,13 +394,15 @@ impl FragmentMesh {
             }
         }
         mesh.sector_of = sector_of;
-        let texel_sets: Vec<(Vec<[f64; 4]>, u32)> = (0..mesh.fragments.len())
-            .map(|i| mesh.base_texels(i, b, centre_sharpness[i], nv, nf, &semi))
+        let sharp = b.has_sharpness() || centre_sharpness.iter().any(|&s| s > 0.0);
+        let entries: Vec<(Vec<u32>, Vec<[f32; 4]>, u32)> = (0..mesh.fragments.len())
+            .map(|i| mesh.base_entries(i, b, sharp, centre_sharpness[i], nv, nf, &semi))
             .collect();
-        for (frag, (_, horizon)) in mesh.fragments.iter_mut().zip(&texel_sets) {
+        for (frag, (_, _, horizon)) in mesh.fragments.iter_mut().zip(&entries) {
             frag.horizon = *horizon;
         }
-        mesh.sort_and_stream(texel_sets);
+        mesh.base_positions = b.positions().to_vec();
+        mesh.sort_and_stream(entries);
         Ok(Ok(mesh))
     }
 
@@ -404,18 +414,20 @@ impl FragmentMesh {
         corners[start..].iter().chain(&corners[..start]).copied().collect()
     }
 
-    /// The base texels of fragment `i` (ring radius 2, storage order, each vertex entry
-    /// followed by its data texel) and its horizon; the data texels are dropped again by
-    /// [`FragmentMesh::sort_and_stream`] for a smooth fragment.
-    fn base_texels(
+    /// The base entries of fragment `i` (ring radius 2, storage order): each entry's B
+    /// vertex, its data texel (only for a sharp fragment) and the fragment's horizon. With
+    /// `sharp` false the base level has no sharpness at all and no data is made.
+    #[allow(clippy::too_many_arguments)]
+    fn base_entries(
         &self,
         i: usize,
         b: &cpu::Level,
+        sharp: bool,
         centre_sharpness: f32,
         nv: u32,
         nf: u32,
         semi: &dyn Fn(u32) -> (f32, f32),
-    ) -> (Vec<[f64; 4]>, u32) {
+    ) -> (Vec<u32>, Vec<[f32; 4]>, u32) {
         let topo = &self.coarse;
         let frag = self.fragments[i];
         let corners = self.corners(i);
@@ -455,7 +467,9 @@ impl FragmentMesh {
                 _ => unreachable!("ring radius 2 holds only a, b ≤ 2"),
             }
         };
-        let mut texels = Vec::with_capacity(2 * frag.class.len(2) as usize);
+        let len = frag.class.len(2) as usize;
+        let mut vertices = Vec::with_capacity(len);
+        let mut data = Vec::with_capacity(if sharp { len } else { 0 });
         let (mut largest, mut infinite) = (0.0f32, false);
         let mut note = |s: f32| {
             if crease::is_infinite(s) {
@@ -464,12 +478,13 @@ impl FragmentMesh {
                 largest = largest.max(s);
             }
         };
-        let positions = b.positions();
-        let mut push = |s: u32, a: u32, bb: u32, texels: &mut Vec<[f64; 4]>| {
+        let mut push = |s: u32, a: u32, bb: u32| {
             let (v, ea, eb) = entry(s, a, bb);
-            let p = positions[v as usize];
-            texels.push([p.x, p.y, p.z, 1.0]);
-            let data = if (a, bb) == (0, 0) {
+            vertices.push(v);
+            if !sharp {
+                return;
+            }
+            data.push(if (a, bb) == (0, 0) {
                 note(centre_sharpness);
                 [centre_sharpness, 0.0, 0.0, 0.0]
             } else {
@@ -479,18 +494,17 @@ impl FragmentMesh {
                 note(eb);
                 let (count, sum) = semi(v);
                 [count, ea, eb, sum]
-            };
-            texels.push(data.map(f64::from));
+            });
         };
-        push(0, 0, 0, &mut texels);
+        push(0, 0, 0);
         for r in 1..=2 {
             for s in 0..k {
                 for t in 0..2 * r {
-                    if t <= r { push(s, r, t, &mut texels) } else { push(s, 2 * r - t, r, &mut texels) }
+                    if t <= r { push(s, r, t) } else { push(s, 2 * r - t, r) }
                 }
             }
             if frag.class.boundary {
-                push(k, r, 0, &mut texels);
+                push(k, r, 0);
             }
         }
         let horizon = if infinite {
@@ -501,11 +515,14 @@ impl FragmentMesh {
             // One more level with Chaikin: its f32 averages may leave a last bit.
             largest.ceil() as u32 + u32::from(self.method == Method::Chaikin)
         };
-        (texels, horizon)
+        if horizon == 0 {
+            data.clear();
+        }
+        (vertices, data, horizon)
     }
 
-    /// Orders fragments by horizon and class, records the runs and writes the base stream.
-    fn sort_and_stream(&mut self, texel_sets: Vec<(Vec<[f64; 4]>, u32)>) {
+    /// Orders fragments by horizon and class, records the runs and lays out the base stream.
+    fn sort_and_stream(&mut self, entries: Vec<(Vec<u32>, Vec<[f32; 4]>, u32)>) {
         let mut order: Vec<usize> = (0..self.fragments.len()).collect();
         order.sort_by_key(|&i| {
             let f = &self.fragments[i];
@@ -523,17 +540,12 @@ impl FragmentMesh {
             f.run = run as u32;
             self.fragment_of_fan[f.fan as usize] = i as u32;
         }
-        let total: usize = texel_sets.iter().map(|(t, h)| if *h > 0 { t.len() } else { t.len() / 2 }).sum();
-        let mut base = Vec::with_capacity(total);
+        self.base_vertices = Vec::with_capacity(entries.iter().map(|e| e.0.len()).sum());
+        self.base_data = Vec::with_capacity(entries.iter().map(|e| e.1.len()).sum());
         for &i in &order {
-            let (texels, horizon) = &texel_sets[i];
-            if *horizon > 0 {
-                base.extend_from_slice(texels);
-            } else {
-                base.extend(texels.iter().step_by(2));
-            }
+            self.base_vertices.extend_from_slice(&entries[i].0);
+            self.base_data.extend_from_slice(&entries[i].1);
         }
-        self.base = base;
     }
 
     pub fn coarse(&self) -> &Topology {
@@ -642,20 +654,23 @@ impl FragmentMesh {
         position: impl Fn(DVec3) -> T,
         data: impl Fn([f32; 4]) -> T,
     ) -> Vec<T> {
-        let stored = self.layout(0, u32::MAX);
         let layout = self.layout(0, levels);
         let mut out = Vec::with_capacity(layout.total as usize);
+        let (mut entry, mut datum) = (0usize, 0usize);
         for (r, run) in self.runs.iter().enumerate() {
-            let stride = stored.stride(r) as usize;
-            let start = stored.starts[r] as usize;
-            let end = start + (u64::from(run.count) * run.class.len(2)) as usize * stride;
-            for (i, t) in self.base[start..end].iter().enumerate() {
-                if i % stride == 1 {
-                    if layout.data[r] {
-                        out.push(data(t.map(|x| x as f32)));
-                    }
-                } else {
-                    out.push(position(DVec3::new(t[0], t[1], t[2])));
+            let len = (u64::from(run.count) * run.class.len(2)) as usize;
+            let vertices = &self.base_vertices[entry..entry + len];
+            entry += len;
+            if run.horizon == 0 {
+                out.extend(vertices.iter().map(|&v| position(self.base_positions[v as usize])));
+                continue;
+            }
+            let texels = &self.base_data[datum..datum + len];
+            datum += len;
+            for (&v, &d) in vertices.iter().zip(texels) {
+                out.push(position(self.base_positions[v as usize]));
+                if layout.data[r] {
+                    out.push(data(d));
                 }
             }
         }
