@@ -6,22 +6,23 @@
 // Each invocation finds its run, fragment and (sector, a, b), then applies the stencil:
 // both coordinates even -> vertex point, one odd -> edge point, both odd -> face point.
 //
-// Three variants are compiled from this file: refine_smooth.frag (SHARP 0: the smooth
-// masks only), refine.frag (SHARP 1: also the sharp rules, uniform creasing) and
-// refine_chaikin.frag (SHARP 1, CHAIKIN 1). lavapipe runs every branch of a shader on
-// every texel (SIMD lanes under masks), so rules a texel does not need still cost it; the
-// pass therefore draws the runs without sharpness data with the smooth variant and the
-// others with a sharp one (one render pass, two draws over row ranges of the same
-// stream). A sharp variant computes smooth texels the same way.
+// Smooth fragments take the tensor-product masks (and the valence-k centre). A sharp
+// fragment also has a data texel per vertex entry, in the same order in a data block
+// after all positions — centre: (vertex sharpness, 0, 0, 0); entry (a, b): (semi-sharp
+// count, sharpness of edge (a-1,b)-(a,b), of edge (a,b-1)-(a,b), semi-sharp sum) — from
+// which the pass applies OpenSubdiv's rules (Sdc::Crease: dart, crease and corner masks,
+// their fractional blends, uniform or Chaikin decay), and writes, for the data block of
+// the next level, the decayed data of each new vertex. The same rules as
+// `sharp_stencil` / `sharp_data` in src/subdiv/fragment.rs (there in f64, here in f32).
 //
-// Smooth fragments take the tensor-product masks (and the valence-k centre). In a sharp
-// fragment every vertex entry is followed by a data texel — centre: (vertex sharpness,
-// 0, 0, 0); entry (a, b): (semi-sharp count, sharpness of edge (a-1,b)-(a,b), of edge
-// (a,b-1)-(a,b), semi-sharp sum) — and the invocation applies OpenSubdiv's rules
-// (Sdc::Crease: dart, crease and corner masks, their fractional blends, uniform or
-// Chaikin decay). An invocation on a data texel writes the decayed data of its vertex for
-// the next level. The same rules as `sharp_stencil` / `sharp_data` in
-// src/subdiv/fragment.rs (there in f64, here in f32).
+// Variants compiled from this file: refine_smooth.frag (positions, smooth masks only),
+// refine.frag and refine_chaikin.frag (SHARP: positions with the sharp rules, uniform or
+// Chaikin creasing) and refine_data.frag, refine_data_chaikin.frag (DATA: the data
+// block). lavapipe runs every branch of a shader on every texel (SIMD lanes under masks),
+// so code a texel does not need still costs it; each pass therefore draws three row
+// ranges of its output, in one render pass: the runs without input data with the smooth
+// variant, the others with a sharp one, and the data block (which starts on a row of its
+// own) with a data one. A sharp variant computes smooth texels the same way.
 //
 // No integer division: like the GPUs of the era (and llvmpipe's SIMD code, which has no
 // vector integer divide), quotients come from float division plus an exact correction.
@@ -31,29 +32,28 @@
 #define INFINITE 10.0
 
 layout(set = 0, binding = 0) uniform sampler2D src;
-// Per class run: (valence, flags, first input texel, first output texel); flags: 1
-// half-fan, 2 data texels in the input, 4 data texels in the output.
+// Per class run: (valence, flags, first input position texel, first output position
+// texel); flags: 1 half-fan, 2 data in the input, 4 data in the output. And (first input
+// data texel, first output data texel or -1, 0, 0).
 layout(set = 0, binding = 1, std140) uniform Runs {
     ivec4 runs[MAX_RUNS];
+    ivec4 data[MAX_RUNS];
 } tab;
 layout(push_constant) uniform Params {
-    int r_in;       // ring radius of the input fragments
-    int r_out;      // ring radius written by this pass
-    int run_count;  // entries of tab.runs in use
-    int total_out;  // texels of the output stream
-    int log2_width; // rows are 2^log2_width texels wide
+    int r_in;         // ring radius of the input fragments
+    int r_out;        // ring radius written by this pass
+    int run_count;    // entries of tab.runs in use
+    int positions_out; // position texels of the output stream
+    int total_out;    // texels of the output stream (positions, padding, data)
+    int log2_width;   // rows are 2^log2_width texels wide
 } pc;
 layout(location = 0) out vec4 result;
 
-// The current fragment: valence, half-fan flag, first input texel, texels per input entry.
+// The current fragment: valence, half-fan flag, first input position and data texels.
 int K;
 int E;
 int BASE;
-#if SHARP
-int STRIDE;
-#else
-#define STRIDE 1
-#endif
+int DBASE;
 
 // floor(n / d) for 0 <= n < 2^30, 1 <= d < 2^24, exact.
 int divide(int n, int d) {
@@ -96,13 +96,13 @@ vec4 fetch(int i) {
 }
 
 vec3 at(int s, int a, int b) {
-    return fetch(BASE + entry(s, a, b) * STRIDE).xyz;
+    return fetch(BASE + entry(s, a, b)).xyz;
 }
 
 #if SHARP
 // The data texel of entry (s, a, b) (sharp fragments only).
 vec4 dat(int s, int a, int b) {
-    return fetch(BASE + entry(s, a, b) * 2 + 1);
+    return fetch(DBASE + entry(s, a, b));
 }
 #endif
 
@@ -246,16 +246,27 @@ vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
 
 void main() {
     int lin = (int(gl_FragCoord.y) << pc.log2_width) + int(gl_FragCoord.x);
-    if (lin >= pc.total_out) {
+#if DATA
+    bool valid = lin < pc.total_out;
+#else
+    bool valid = lin < pc.positions_out;
+#endif
+    if (!valid) {
         result = vec4(0.0);
         return;
     }
-    // The class run holding this texel: the last one starting at or before it.
+    // The class run holding this texel: the last one starting at or before it (position
+    // starts, or data starts where runs without output data have -1).
     int lo = 0;
     int hi = pc.run_count - 1;
     while (lo < hi) {
         int mid = (lo + hi + 1) >> 1;
-        if (tab.runs[mid].w <= lin) {
+#if DATA
+        int start = tab.data[mid].y;
+#else
+        int start = tab.runs[mid].w;
+#endif
+        if (start <= lin) {
             lo = mid;
         } else {
             hi = mid - 1;
@@ -264,23 +275,18 @@ void main() {
     ivec4 run = tab.runs[lo];
     K = run.x;
     E = run.y & 1;
-#if SHARP
-    bool data_in = (run.y & 2) != 0;
-    int data_out = (run.y >> 2) & 1;
-    STRIDE = data_in ? 2 : 1;
+#if DATA
+    int start_out = tab.data[lo].y;
 #else
-    int data_out = 0; // the smooth variant draws only runs without data
+    int start_out = run.w;
 #endif
     int len_out = 1 + K * (pc.r_out + 1) * pc.r_out + E * pc.r_out;
     int len_in = 1 + K * (pc.r_in + 1) * pc.r_in + E * pc.r_in;
-    int u = lin - run.w;
-    int frag = divide(u, len_out << data_out);
-    int rem = u - frag * (len_out << data_out);
-    int i = rem >> data_out;
-#if SHARP
-    bool is_data = (rem & data_out) != 0;
-#endif
-    BASE = run.z + frag * len_in * STRIDE;
+    int u = lin - start_out;
+    int frag = divide(u, len_out);
+    int i = u - frag * len_out;
+    BASE = run.z + frag * len_in;
+    DBASE = tab.data[lo].x + frag * len_in;
 
     int s = 0;
     int a = 0;
@@ -303,7 +309,15 @@ void main() {
         a = (s == K || t <= r) ? r : 2 * r - t;
         b = (s == K) ? 0 : min(t, r);
     }
+#if DATA
+    bool data_in = true;
+    vec3 sm = vec3(0.0);
+#elif SHARP
+    bool data_in = (run.y & 2) != 0;
     vec3 sm = (i == 0) ? centre_point() : smooth_point(s, a, b);
+#else
+    vec3 sm = (i == 0) ? centre_point() : smooth_point(s, a, b);
+#endif
 #if SHARP
     if (data_in) {
         // The data texels every rule below reads: the parent cell (x, y), its +a and +b
@@ -333,20 +347,20 @@ void main() {
         // The parent edge of an edge point: along a (x, y)-(x + 1, y) or along b (x, y)-(x, y + 1).
         float pe = a_even ? d01.z : d10.y;
         vec2 semi_end = a_even ? semi01 : semi10;
-        if (is_data) {
-            // The decayed data of this texel's vertex.
-            float ea = b_even ? child1(a_even ? d00.y : d10.y, semi00) : 0.0;
-            float eb = (b >= 1 && a_even) ? child1(b_even ? d00.z : d01.z, semi00) : 0.0;
-            vec2 semi = vec2(0.0);
+#if DATA
+        // The decayed data of this texel's vertex.
+        float ea = b_even ? child1(a_even ? d00.y : d10.y, semi00) : 0.0;
+        float eb = (b >= 1 && a_even) ? child1(b_even ? d00.z : d01.z, semi00) : 0.0;
+        vec2 semi = vec2(0.0);
 #if CHAIKIN
-            // The semi-sharp edges of the new vertex: halves of its parent's edges.
-            semi = (a_even && b_even) ? semi4(c)
-                 : (a_even != b_even) ? semi4(vec4(child1(pe, semi00), child1(pe, semi_end), 0.0, 0.0))
-                 : vec2(0.0);
+        // The semi-sharp edges of the new vertex: halves of its parent's edges.
+        semi = (a_even && b_even) ? semi4(c)
+             : (a_even != b_even) ? semi4(vec4(child1(pe, semi00), child1(pe, semi_end), 0.0, 0.0))
+             : vec2(0.0);
 #endif
-            result = (i == 0) ? vec4(decrement4(vec4(d00.x)).x, 0.0, 0.0, 0.0) : vec4(semi.x, ea, eb, semi.y);
-            return;
-        }
+        result = (i == 0) ? vec4(decrement4(vec4(d00.x)).x, 0.0, 0.0, 0.0) : vec4(semi.x, ea, eb, semi.y);
+        return;
+#else
         vec3 p;
         if (i == 0) {
             p = sharp_centre(sm, d00.x, semi_c);
@@ -370,6 +384,7 @@ void main() {
         }
         result = vec4(p, 1.0);
         return;
+#endif
     }
 #endif
     result = vec4(sm, 1.0);

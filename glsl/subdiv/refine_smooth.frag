@@ -3,5 +3,6 @@
 // One Catmull-Clark level of fragment meshes without sharpness data: the smooth masks
 // only (see refine.glsl).
 #define SHARP 0
+#define DATA 0
 #define CHAIKIN 0
 #include "refine.glsl"

@@ -42,7 +42,7 @@ pub fn assemble<T: Sync>(
     position: impl Fn(&T) -> DVec3 + Sync,
 ) -> Result<Mesh> {
     let owned = 1u64 << levels;
-    let layout = fragments.layout(levels, levels);
+    let layout = fragments.layout(levels, levels, 1);
     let radius = layout.radius;
     if owned > u64::from(radius) || (stream.len() as u64) < layout.total {
         return Err(SubdivError::Fragment(format!(

@@ -30,8 +30,9 @@
 //! # Sharpness data
 //!
 //! A fragment with any sharp edge or vertex in its region (every half-fan: its border is
-//! infinitely sharp) is *sharp*: each vertex entry is followed by a data texel, and the
-//! pass applies OpenSubdiv's crease rules (`crease`) from it:
+//! infinitely sharp) is *sharp*: each of its vertex entries has a data texel, in the same
+//! order in a data block after all positions, and the pass applies OpenSubdiv's crease
+//! rules (`crease`) from them:
 //!
 //! - centre entry: (vertex sharpness, 0, 0, 0);
 //! - entry (a, b): (count, sharpness of edge (a−1, b)–(a, b), sharpness of edge
@@ -159,23 +160,23 @@ impl ClassRun {
     }
 }
 
-/// Where each class run starts in the stream of one level.
+/// Where each class run starts in the stream of one level: first the positions of every
+/// run, then (from an aligned texel on) the data texels of the runs that carry them, in
+/// the same order.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct StreamLayout {
     pub radius: u32,
     /// Whether each run's fragments carry data texels in this stream.
     pub data: Vec<bool>,
-    /// First texel of each class run.
+    /// First position texel of each class run.
     pub starts: Vec<u64>,
+    /// First data texel of each class run that carries data.
+    pub data_starts: Vec<u64>,
+    /// Texels of all positions; the data block starts at `data_start` ≥ `positions`.
+    pub positions: u64,
+    pub data_start: u64,
     /// Texels of the whole stream.
     pub total: u64,
-}
-
-impl StreamLayout {
-    /// Texels per vertex entry of run `r`: 2 with data, else 1.
-    pub fn stride(&self, r: usize) -> u64 {
-        1 + u64::from(self.data[r])
-    }
 }
 
 /// A fragment: a fan of corners around a centre (a coarse vertex).
@@ -623,56 +624,69 @@ impl FragmentMesh {
     }
 
     /// Where every class run starts in stream `j` of a refinement with `levels` fragment
-    /// levels (ring radius [`radii`]`(levels)[j]`).
-    pub fn layout(&self, j: u32, levels: u32) -> StreamLayout {
+    /// levels (ring radius [`radii`]`(levels)[j]`), the data block starting at a multiple
+    /// of `align` texels (a texture row, so that it can be drawn on its own).
+    pub fn layout(&self, j: u32, levels: u32, align: u64) -> StreamLayout {
         let radius = radii(levels)[j as usize];
         let mut starts = Vec::with_capacity(self.runs.len());
         let mut data = Vec::with_capacity(self.runs.len());
-        let mut total = 0u64;
+        let mut positions = 0u64;
         for run in &self.runs {
-            starts.push(total);
-            let has = run.has_data(j, levels);
-            data.push(has);
-            total += u64::from(run.count) * run.class.len(radius) * (1 + u64::from(has));
+            starts.push(positions);
+            data.push(run.has_data(j, levels));
+            positions += u64::from(run.count) * run.class.len(radius);
         }
-        StreamLayout { radius, data, starts, total }
+        let data_start =
+            if data.contains(&true) { positions.div_ceil(align.max(1)) * align.max(1) } else { positions };
+        let mut data_starts = Vec::with_capacity(self.runs.len());
+        let mut total = data_start;
+        for (run, &has) in self.runs.iter().zip(&data) {
+            data_starts.push(total);
+            if has {
+                total += u64::from(run.count) * run.class.len(radius);
+            }
+        }
+        StreamLayout { radius, data, starts, data_starts, positions, data_start, total }
     }
 
-    /// First texel of fragment `f` in a stream with `layout`.
+    /// First position texel of fragment `f` in a stream with `layout`.
     pub fn fragment_start(&self, layout: &StreamLayout, f: u32) -> u64 {
         let frag = &self.fragments[f as usize];
         let run = &self.runs[frag.run as usize];
-        let per = frag.class.len(layout.radius) * layout.stride(frag.run as usize);
-        layout.starts[frag.run as usize] + u64::from(f - run.first) * per
+        layout.starts[frag.run as usize] + u64::from(f - run.first) * frag.class.len(layout.radius)
     }
 
-    /// The base-level stream (ring radius 2) of a refinement with `levels` fragment levels,
-    /// mapped texel by texel: positions by `position`, data texels by `data`.
+    /// First data texel of fragment `f` in a stream with `layout` (its run must carry data).
+    pub fn fragment_data_start(&self, layout: &StreamLayout, f: u32) -> u64 {
+        let frag = &self.fragments[f as usize];
+        let run = &self.runs[frag.run as usize];
+        layout.data_starts[frag.run as usize] + u64::from(f - run.first) * frag.class.len(layout.radius)
+    }
+
+    /// The base-level stream (ring radius 2) of a refinement with `levels` fragment levels
+    /// and data aligned to `align` texels, mapped texel by texel: positions by `position`,
+    /// data texels (and the padding before them, as zeros) by `data`.
     pub fn base_stream<T>(
         &self,
         levels: u32,
+        align: u64,
         position: impl Fn(DVec3) -> T,
         data: impl Fn([f32; 4]) -> T,
     ) -> Vec<T> {
-        let layout = self.layout(0, levels);
+        let layout = self.layout(0, levels, align);
         let mut out = Vec::with_capacity(layout.total as usize);
-        let (mut entry, mut datum) = (0usize, 0usize);
+        out.extend(self.base_vertices.iter().map(|&v| position(self.base_positions[v as usize])));
+        out.extend((layout.positions..layout.data_start).map(|_| data([0.0; 4])));
+        let mut datum = 0usize;
         for (r, run) in self.runs.iter().enumerate() {
-            let len = (u64::from(run.count) * run.class.len(2)) as usize;
-            let vertices = &self.base_vertices[entry..entry + len];
-            entry += len;
             if run.horizon == 0 {
-                out.extend(vertices.iter().map(|&v| position(self.base_positions[v as usize])));
                 continue;
             }
-            let texels = &self.base_data[datum..datum + len];
-            datum += len;
-            for (&v, &d) in vertices.iter().zip(texels) {
-                out.push(position(self.base_positions[v as usize]));
-                if layout.data[r] {
-                    out.push(data(d));
-                }
+            let len = (u64::from(run.count) * run.class.len(2)) as usize;
+            if layout.data[r] {
+                out.extend(self.base_data[datum..datum + len].iter().map(|&d| data(d)));
             }
+            datum += len;
         }
         out
     }
@@ -681,7 +695,7 @@ impl FragmentMesh {
     /// reads stream `j` of a refinement with `levels` fragment levels, writes stream j + 1.
     /// The same stencils and addressing as the GPU pass (`glsl/subdiv/refine.frag`).
     pub fn refine_stream(&self, input: &[[f64; 4]], j: u32, levels: u32) -> Vec<[f64; 4]> {
-        let (lin, lout) = (self.layout(j, levels), self.layout(j + 1, levels));
+        let (lin, lout) = (self.layout(j, levels, 1), self.layout(j + 1, levels, 1));
         let mut out = vec![[0.0; 4]; lout.total as usize];
         for f in 0..self.fragments.len() as u32 {
             let frag = self.fragments[f as usize];
@@ -690,21 +704,23 @@ impl FragmentMesh {
                 class: frag.class,
                 input,
                 base: self.fragment_start(&lin, f),
-                stride: lin.stride(r),
+                data_base: if lin.data[r] { self.fragment_data_start(&lin, f) } else { 0 },
                 data: lin.data[r],
                 method: self.method,
             };
             let base_out = self.fragment_start(&lout, f);
-            let stride_out = lout.stride(r);
             for i in 0..frag.class.len(lout.radius) {
                 let p = if view.data {
                     sharp_stencil(&view, i)
                 } else {
                     stencil(frag.class, i, |s, a, b| view.p(s, a, b))
                 };
-                out[(base_out + i * stride_out) as usize] = [p.x, p.y, p.z, 1.0];
-                if lout.data[r] {
-                    out[(base_out + i * stride_out + 1) as usize] = sharp_data(&view, i).map(f64::from);
+                out[(base_out + i) as usize] = [p.x, p.y, p.z, 1.0];
+            }
+            if lout.data[r] {
+                let data_out = self.fragment_data_start(&lout, f);
+                for i in 0..frag.class.len(lout.radius) {
+                    out[(data_out + i) as usize] = sharp_data(&view, i).map(f64::from);
                 }
             }
         }
@@ -735,7 +751,7 @@ pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
         Built::Cpu(_) => return cpu::refine_surface(surface, level),
     };
     let levels = level - fragments.cpu_levels();
-    let mut stream = fragments.base_stream(levels, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
+    let mut stream = fragments.base_stream(levels, 1, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
     for j in 0..levels {
         stream = fragments.refine_stream(&stream, j, levels);
     }
@@ -747,21 +763,22 @@ pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
 struct View<'a> {
     class: Class,
     input: &'a [[f64; 4]],
+    /// First position and first data texel of the fragment.
     base: u64,
-    stride: u64,
+    data_base: u64,
     data: bool,
     method: Method,
 }
 
 impl View<'_> {
     fn p(&self, s: u32, a: i64, b: i64) -> DVec3 {
-        let t = self.input[(self.base + self.class.index(s, a, b) * self.stride) as usize];
+        let t = self.input[(self.base + self.class.index(s, a, b)) as usize];
         DVec3::new(t[0], t[1], t[2])
     }
 
     /// The data texel of canonical entry (s, a, b) (a ≥ 1, b ≥ 0, or the centre).
     fn d(&self, s: u32, a: i64, b: i64) -> [f32; 4] {
-        let t = self.input[(self.base + self.class.index(s, a, b) * 2 + 1) as usize];
+        let t = self.input[(self.data_base + self.class.index(s, a, b)) as usize];
         t.map(|x| x as f32)
     }
 

@@ -82,18 +82,13 @@ impl Packing {
                 fragments.runs().len()
             )));
         }
-        let layouts: Vec<StreamLayout> = (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels)).collect();
-        let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
-        // The largest fragment of any stream (data texels double a fragment).
-        let widest = layouts
+        let unaligned: Vec<StreamLayout> =
+            (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels, 1)).collect();
+        let texels = unaligned.iter().map(|l| l.total).max().unwrap_or(0).max(1);
+        // The largest fragment of any stream.
+        let widest = unaligned
             .iter()
-            .flat_map(|l| {
-                fragments
-                    .runs()
-                    .iter()
-                    .enumerate()
-                    .map(move |(r, run)| (run, l.radius, run.class.len(l.radius) * l.stride(r)))
-            })
+            .flat_map(|l| fragments.runs().iter().map(move |run| (run, l.radius, run.class.len(l.radius))))
             .max_by_key(|&(_, _, texels)| texels);
         if let Some((run, radius, texels)) = widest
             && texels >= MAX_FRAGMENT_TEXELS
@@ -117,6 +112,10 @@ impl Packing {
                     as u32
             }
         };
+        // Data blocks start on a row of their own (one draw each, see the module docs).
+        let layouts: Vec<StreamLayout> =
+            (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels, u64::from(width))).collect();
+        let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
         let height = texels.div_ceil(u64::from(width));
         if texels > MAX_STREAM_TEXELS || height > u64::from(max_side) {
             return Err(SubdivError::GpuLimit(format!(
@@ -199,9 +198,9 @@ pub struct Run {
 /// mesh needs more.
 pub struct Subdivider {
     smooth: Pipeline,
-    /// The sharp variants: uniform and Chaikin creasing.
-    sharp: Pipeline,
-    chaikin: Pipeline,
+    /// The sharp variants, positions and data: uniform, then Chaikin creasing.
+    sharp: [Pipeline; 2],
+    data: [Pipeline; 2],
     targets: Option<PingPong>,
     readback: Option<Buffer>,
 }
@@ -210,9 +209,10 @@ impl Subdivider {
     pub fn new(ctx: &Context) -> Result<Subdivider> {
         let quad = |shader| Pipeline::quad(ctx, shader, &[TexFormat::Rgba32F], Blend::Replace);
         let smooth = quad(&shaders::subdiv::REFINE_SMOOTH_FRAG)?;
-        let sharp = quad(&shaders::subdiv::REFINE_FRAG)?;
-        let chaikin = quad(&shaders::subdiv::REFINE_CHAIKIN_FRAG)?;
-        Ok(Subdivider { smooth, sharp, chaikin, targets: None, readback: None })
+        let sharp = [quad(&shaders::subdiv::REFINE_FRAG)?, quad(&shaders::subdiv::REFINE_CHAIKIN_FRAG)?];
+        let data =
+            [quad(&shaders::subdiv::REFINE_DATA_FRAG)?, quad(&shaders::subdiv::REFINE_DATA_CHAIKIN_FRAG)?];
+        Ok(Subdivider { smooth, sharp, data, targets: None, readback: None })
     }
 
     /// Refines `mesh` (smooth, default options) `level` times; see
@@ -275,23 +275,34 @@ impl Subdivider {
     ) -> Result<Run> {
         let packing = Packing::new(fragments, gpu_levels, ctx.info().max_image_2d, options.row_width)?;
         let width = packing.width;
-        let mut stream =
-            fragments.base_stream(gpu_levels, |p| [p.x as f32, p.y as f32, p.z as f32, 1.0], |d| d);
+        let mut stream = fragments.base_stream(
+            gpu_levels,
+            u64::from(width),
+            |p| [p.x as f32, p.y as f32, p.z as f32, 1.0],
+            |d| d,
+        );
         let rows0 = packing.rows(0);
         stream.resize((rows0 * width) as usize, [0.0; 4]);
-        // One run table per pass: (valence, flags, first input texel, first output texel);
-        // flags: 1 half-fan, 2 data texels in the input, 4 in the output.
+        // One run table per pass: (valence, flags, first input texel, first output texel),
+        // flags 1 half-fan, 2 data in the input, 4 in the output; then (first input data
+        // texel, first output data texel or -1, 0, 0).
         let tables = packing
             .layouts
             .windows(2)
             .map(|pair| {
-                let mut table = vec![[0i32; 4]; MAX_RUNS];
+                let (lin, lout) = (&pair[0], &pair[1]);
+                let mut table = vec![[0i32; 4]; 2 * MAX_RUNS];
                 for (r, run) in fragments.runs().iter().enumerate() {
                     let c = run.class;
-                    let flags = i32::from(c.boundary)
-                        | i32::from(pair[0].data[r]) << 1
-                        | i32::from(pair[1].data[r]) << 2;
-                    table[r] = [c.valence as i32, flags, pair[0].starts[r] as i32, pair[1].starts[r] as i32];
+                    let flags =
+                        i32::from(c.boundary) | i32::from(lin.data[r]) << 1 | i32::from(lout.data[r]) << 2;
+                    table[r] = [c.valence as i32, flags, lin.starts[r] as i32, lout.starts[r] as i32];
+                    table[MAX_RUNS + r] = [
+                        if lin.data[r] { lin.data_starts[r] as i32 } else { 0 },
+                        if lout.data[r] { lout.data_starts[r] as i32 } else { -1 },
+                        0,
+                        0,
+                    ];
                 }
                 Buffer::with_data(ctx, &table, "subdiv runs")
             })
@@ -311,20 +322,27 @@ impl Subdivider {
         let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
             return Err(SubdivError::GpuLimit("render targets were not created".into()));
         };
-        let smooth = &self.smooth;
-        let sharp = if fragments.crease_method() == Method::Chaikin { &self.chaikin } else { &self.sharp };
+        let chaikin = usize::from(fragments.crease_method() == Method::Chaikin);
+        let (smooth, sharp, data) = (&self.smooth, &self.sharp[chaikin], &self.data[chaikin]);
         let timer = Timestamps::new(ctx, gpu_levels + 3)?;
-        // Rows of each output stream drawn with the smooth variant: those before the first
-        // run with sharpness data in the input (runs are sorted by horizon, `fragment`).
-        let smooth_rows: Vec<u32> = (0..gpu_levels as usize)
+        // The row ranges of each output stream and the variant that draws each: the runs
+        // without input data (first: runs are sorted by horizon, `fragment`) with the
+        // smooth variant, the other positions with the sharp one, the data block with the
+        // data one.
+        let w = u64::from(width);
+        let draws: Vec<[(&Pipeline, u32, u32); 3]> = (0..gpu_levels as usize)
             .map(|j| {
-                let first_sharp = packing.layouts[j].data.iter().position(|&d| d);
-                let texel = match first_sharp {
+                let (lin, lout) = (&packing.layouts[j], &packing.layouts[j + 1]);
+                let position_rows = lout.positions.div_ceil(w) as u32;
+                let first_sharp = lin.data.iter().position(|&d| d);
+                let split = match first_sharp {
                     _ if options.single_shader => 0,
-                    Some(r) => packing.layouts[j + 1].starts[r],
-                    None => packing.layouts[j + 1].total,
+                    Some(r) => (lout.starts[r] / w) as u32,
+                    None => position_rows,
                 };
-                ((texel / u64::from(width)) as u32).min(packing.rows(j + 1))
+                let data_row = (lout.data_start / w) as u32;
+                let data_rows = if lout.data.contains(&true) { packing.rows(j + 1) - data_row } else { 0 };
+                [(smooth, 0, split), (sharp, split, position_rows - split), (data, data_row, data_rows)]
             })
             .collect();
         let t = Instant::now();
@@ -339,16 +357,15 @@ impl Subdivider {
                     lin.radius as i32,
                     lout.radius as i32,
                     fragments.runs().len() as i32,
+                    lout.positions as i32,
                     lout.total as i32,
                     packing.log2_width as i32,
                 ];
                 let input = targets.src();
                 let reads = [input];
-                let rows = packing.rows(j + 1);
-                let area = [0, 0, width, rows];
-                let split = smooth_rows[j];
+                let area = [0, 0, width, packing.rows(j + 1)];
                 rec.render(&[Attachment::new(targets.dst(), Load::Discard)], Some(area), &reads, |pass| {
-                    for (pipeline, first, count) in [(smooth, 0, split), (sharp, split, rows - split)] {
+                    for &(pipeline, first, count) in &draws[j] {
                         if count == 0 {
                             continue;
                         }
