@@ -74,6 +74,10 @@ fn refine_parts(mesh: &Mesh, features: &Features, options: &Options, levels: u32
     refiner.finish()
 }
 
+/// A sharp control edge that refined edges descend from: (sharpness, boundary,
+/// non-manifold), see [`SharpEdge`].
+pub(crate) type SharpOrigin = (f32, bool, bool);
+
 /// Level-by-level refinement, for the fragment path's CPU base level (which needs the
 /// levels' topology and sharpness) and for [`refine_surface`].
 pub(crate) struct Refiner {
@@ -83,7 +87,7 @@ pub(crate) struct Refiner {
     finished: bool,
     options: Options,
     /// The sharp edges of the base level (see [`SharpEdge`]), indexed by `edge_origin`.
-    base_sharp: Vec<(f32, bool, bool)>,
+    base_sharp: Vec<SharpOrigin>,
 }
 
 impl Refiner {
@@ -120,7 +124,7 @@ impl Refiner {
 
     /// The control edge that edge `e` of the current level lies on, if it is sharp:
     /// (sharpness, boundary, non-manifold).
-    pub(crate) fn edge_origin(&self, e: u32) -> Option<(f32, bool, bool)> {
+    pub(crate) fn edge_origin(&self, e: u32) -> Option<SharpOrigin> {
         let o = self.level.edge_origin.as_ref()?[e as usize];
         (o != NONE).then(|| self.base_sharp[o as usize])
     }
@@ -206,7 +210,7 @@ impl Level {
         topo: &Topology,
         features: &Features,
         options: &Options,
-    ) -> Result<(Level, Vec<(f32, bool, bool)>)> {
+    ) -> Result<(Level, Vec<SharpOrigin>)> {
         let (offsets, indices) = mesh.face_parts();
         let (nv, ne, nf) = (topo.num_vertices(), topo.num_edges(), topo.num_faces());
         let feature = |m: String| SubdivError::Feature(m);

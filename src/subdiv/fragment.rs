@@ -194,7 +194,7 @@ pub struct Fragment {
 
 /// The result of cutting a surface into fragments.
 pub enum Built {
-    Fragments(FragmentMesh),
+    Fragments(Box<FragmentMesh>),
     /// The level is reached before fragments can be cut (below the base level, or the
     /// fragments cannot express the surface before it): refine on the CPU. The reasons
     /// say why when it is not simply below the base level.
@@ -253,7 +253,7 @@ impl FragmentMesh {
             match FragmentMesh::cut(&mut refiner)? {
                 Ok(mut mesh) => {
                     mesh.reasons = reasons;
-                    return Ok(Built::Fragments(mesh));
+                    return Ok(Built::Fragments(Box::new(mesh)));
                 }
                 Err(reason) => reasons.push(format!("CPU level {}: {reason}", refiner.depth())),
             }
@@ -263,7 +263,7 @@ impl FragmentMesh {
     /// The fragments of a smooth mesh to `level` (tests and benchmarks).
     pub fn new(mesh: &Mesh, level: u32) -> Result<FragmentMesh> {
         match FragmentMesh::build(&Surface::smooth(mesh.clone()), level)? {
-            Built::Fragments(f) => Ok(f),
+            Built::Fragments(f) => Ok(*f),
             Built::Cpu(_) => Err(SubdivError::Fragment(format!("level {level} is below the base level"))),
         }
     }
