@@ -415,3 +415,41 @@ fn single_shader_draws_everything_the_same() {
     let one = sub.refine(&ctx, &torus, 4, &single).unwrap();
     assert!(Comparison::new(&one.mesh, &split.mesh, 1e-9).same_order);
 }
+
+/// The refined edges on sharp control edges (what a picture draws as creases) are the
+/// same on the GPU path and the CPU reference: each lies on a tagged crease, a boundary or
+/// a non-manifold edge, and their ends coincide.
+#[test]
+fn sharp_edges_for_pictures() {
+    let ctx = ctx();
+    let mut sub = Subdivider::new(&ctx).unwrap();
+    for name in ["cube_creases", "tent_creases", "fin"] {
+        let shape = shapes::sharp().into_iter().find(|s| s.name == name).unwrap();
+        let cpu = cpu::refine_surface(&shape.surface, 3).unwrap();
+        let gpu = sub.refine_surface(&ctx, &shape.surface, 3, &Options::default()).unwrap();
+        assert_eq!(gpu.sharp_edges.len(), cpu.sharp_edges.len(), "{name}");
+        assert!(!cpu.sharp_edges.is_empty(), "{name}");
+        let (lo, hi) = cpu.mesh.bounds();
+        let tolerance = TOLERANCE * (hi - lo).length();
+        let ends = |mesh: &Mesh, e: &texgeo::subdiv::cpu::SharpEdge| e.vertices.map(|v| mesh.positions()[v as usize]);
+        for g in &gpu.sharp_edges {
+            let [a, b] = ends(&gpu.mesh, g);
+            let found = cpu.sharp_edges.iter().any(|c| {
+                let [p, q] = ends(&cpu.mesh, c);
+                let same = |x: DVec3, y: DVec3| x.distance(y) <= tolerance;
+                c.sharpness == g.sharpness && ((same(a, p) && same(b, q)) || (same(a, q) && same(b, p)))
+            });
+            assert!(found, "{name}: GPU sharp edge {g:?} has no CPU counterpart");
+        }
+        if name == "cube_creases" {
+            // The four tagged top edges, split 2^3 times each, with their sharpness.
+            let tagged: Vec<f32> = cpu.sharp_edges.iter().map(|e| e.sharpness).collect();
+            assert_eq!(tagged.len(), 4 * 8);
+            assert!(cpu.sharp_edges.iter().all(|e| !e.boundary && !e.non_manifold));
+            assert_eq!(tagged.iter().filter(|&&s| s == 10.0).count(), 8);
+        }
+        if name == "fin" {
+            assert!(cpu.sharp_edges.iter().any(|e| e.non_manifold) && cpu.sharp_edges.iter().any(|e| e.boundary));
+        }
+    }
+}

@@ -131,8 +131,8 @@ impl Refiner {
 
     /// The sharp edges of the current level (see [`SharpEdge`]).
     pub(crate) fn sharp_edges(&self) -> Vec<SharpEdge> {
-        let Some(origin) = &self.level.edge_origin else { return Vec::new() };
         let mut out = Vec::new();
+        let origin = self.level.edge_origin.as_deref().unwrap_or(&[]);
         for (e, &o) in origin.iter().enumerate() {
             if o != NONE {
                 let (sharpness, boundary, non_manifold) = self.base_sharp[o as usize];
