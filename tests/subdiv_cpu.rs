@@ -94,6 +94,24 @@ fn matches_committed_reference_files() {
     }
 }
 
+/// The committed OpenSubdiv outputs of sharp shapes (OBJ inputs with tags): reading the
+/// tags gives the test shape back, and the CPU reference equals OpenSubdiv's output.
+#[test]
+fn matches_committed_sharp_references() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
+    for (name, level) in shapes::committed_sharp_references() {
+        let shape = shapes::sharp().into_iter().find(|s| s.name == name).unwrap();
+        let input = texgeo::subdiv::tags::read(dir.join(format!("{name}.obj"))).unwrap();
+        let surface = input.surface(Default::default());
+        assert_eq!(surface, shape.surface, "reference/subdiv/{name}.obj is not the test shape {name}");
+        let path = dir.join(format!("{name}-level{level}.off"));
+        let reference = texgeo::mesh::formats::read(&path).unwrap_or_else(|e| panic!("{e}"));
+        let ours = cpu::refine_surface(&surface, level).unwrap();
+        let c = Comparison::new(&ours.mesh, &reference, TOLERANCE);
+        assert!(c.is_match() && c.same_order, "{}:\n{c}", path.display());
+    }
+}
+
 /// V − E + F of every refined level equals the input's (closed and open meshes).
 #[test]
 fn euler_characteristic_is_preserved() {

@@ -430,6 +430,20 @@ pub fn fan() -> Mesh {
     mesh(positions, faces)
 }
 
+/// The committed OpenSubdiv outputs of sharp shapes (`reference/subdiv/<name>.obj` with
+/// tags, `<name>-level<level>.off`): shape name, level.
+pub fn committed_sharp_references() -> Vec<(&'static str, u32)> {
+    vec![
+        ("cube_creases", 2),
+        ("torus_chaikin", 2),
+        ("grid_holes", 2),
+        ("grid_boundary_none", 2),
+        ("membrane_box", 2),
+        ("quad_pole8", 2),
+        ("tetrahedron_smooth", 2),
+    ]
+}
+
 /// The sharp set.
 pub fn sharp() -> Vec<SharpShape> {
     let e = EDGE_ONLY;
