@@ -295,7 +295,7 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             "fragments with data",
             "GPU path, no creases",
             "GPU path, creased",
-            "ratio",
+            "ratio (median of pairs)",
             "passes, no creases",
             "passes, creased",
             "passes ratio",
@@ -310,20 +310,30 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             let creases = features.creases.len();
             let creased = Surface { features, ..smooth.clone() };
             let (mut plain, mut sharp) = (Vec::new(), Vec::new());
+            let (mut ratios, mut pass_ratios) = (Vec::new(), Vec::new());
             let mut fragments = (0, 0);
             for k in 0..=settings.runs.max(1) {
-                // Alternate, so that both see the same load on a shared machine.
+                // Alternate, so that both see the same load on a shared machine; the ratio
+                // is the median of the pairs' ratios.
                 let a = subdivider.refine_surface(ctx, &smooth, level, &Options::default())?;
                 let b = subdivider.refine_surface(ctx, &creased, level, &Options::default())?;
                 fragments = (b.sharp_fragments, b.fragments);
                 if k > 0 {
+                    ratios.push(b.times.total.as_secs_f64() / a.times.total.as_secs_f64().max(1e-9));
+                    pass_ratios.push(
+                        b.times.passes_total().as_secs_f64() / a.times.passes_total().as_secs_f64().max(1e-9),
+                    );
                     plain.push(a.times);
                     sharp.push(b.times);
                 }
             }
             let (p, s) = (median_times(&plain), median_times(&sharp));
-            let ratio = s.total.as_secs_f64() / p.total.as_secs_f64().max(1e-9);
-            let passes = s.passes_total().as_secs_f64() / p.passes_total().as_secs_f64().max(1e-9);
+            let median = |v: &mut Vec<f64>| {
+                v.sort_by(f64::total_cmp);
+                let n = v.len();
+                if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+            };
+            let (ratio, passes) = (median(&mut ratios), median(&mut pass_ratios));
             table.row(vec![
                 model.name.clone(),
                 model.mesh.num_faces().to_string(),
