@@ -2,9 +2,21 @@
 //! level and the fragments on the CPU, then one full-target fragment pass per level,
 //! ping-ponging between two RGBA32F render targets, one readback, and the topological
 //! assembly on the CPU. Sharp features (issue 14) run in the same pass: a sharp
-//! fragment's vertex entries are each followed by a data texel (its sharpness and that of
-//! its edges, `fragment`), which the pass reads to apply OpenSubdiv's crease rules and
-//! writes, decayed, for the next level — one target, one shader, one pass per level.
+//! fragment's vertex entries each have a data texel (its sharpness and that of its edges,
+//! `fragment`), which the pass reads to apply OpenSubdiv's crease rules and writes,
+//! decayed, for the next level — one target, one shader source, one pass per level.
+//!
+//! # Shader variants
+//!
+//! lavapipe executes every branch of a shader for every texel (its SIMD lanes run under
+//! masks), so rules a texel does not need would still cost it: with one shader, sharp
+//! rules made smooth fragments 3× slower. `glsl/subdiv/refine.glsl` is therefore compiled
+//! into variants — smooth positions, sharp positions (uniform or Chaikin creasing), data
+//! texels (uniform or Chaikin) — and each pass draws, in one render pass, the row ranges of
+//! its output stream that need each: runs without input data (first in the stream), the
+//! other runs' positions, and the data block (which starts on a row of its own). Every
+//! sharp variant also computes smooth texels exactly ([`Options::single_shader`] draws all
+//! positions with it).
 //!
 //! # Packing rule
 //!
@@ -16,8 +28,8 @@
 //! grow from ring radius 2 to 3, 5, 9, …; the last level keeps only the 2^j owned rings);
 //! the pass finds a texel's run by binary search in a uniform table of run starts and its
 //! fragment by division. Runs also group fragments by how many levels they carry
-//! sharpness data (their *horizon*); a run's entries are one texel wide without data and
-//! two with it.
+//! sharpness data (their *horizon*), smallest horizon first; after all positions, from
+//! the next row on, come the data texels of the runs that carry them, in the same order.
 //!
 //! # Limits
 //!
