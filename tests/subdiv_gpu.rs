@@ -431,7 +431,9 @@ fn sharp_edges_for_pictures() {
         assert!(!cpu.sharp_edges.is_empty(), "{name}");
         let (lo, hi) = cpu.mesh.bounds();
         let tolerance = TOLERANCE * (hi - lo).length();
-        let ends = |mesh: &Mesh, e: &texgeo::subdiv::cpu::SharpEdge| e.vertices.map(|v| mesh.positions()[v as usize]);
+        let ends = |mesh: &Mesh, e: &texgeo::subdiv::cpu::SharpEdge| {
+            e.vertices.map(|v| mesh.positions()[v as usize])
+        };
         for g in &gpu.sharp_edges {
             let [a, b] = ends(&gpu.mesh, g);
             let found = cpu.sharp_edges.iter().any(|c| {
@@ -449,7 +451,9 @@ fn sharp_edges_for_pictures() {
             assert_eq!(tagged.iter().filter(|&&s| s == 10.0).count(), 8);
         }
         if name == "fin" {
-            assert!(cpu.sharp_edges.iter().any(|e| e.non_manifold) && cpu.sharp_edges.iter().any(|e| e.boundary));
+            assert!(
+                cpu.sharp_edges.iter().any(|e| e.non_manifold) && cpu.sharp_edges.iter().any(|e| e.boundary)
+            );
         }
     }
 }

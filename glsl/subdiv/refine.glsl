@@ -8,7 +8,8 @@
 //
 // Smooth fragments take the tensor-product masks (and the valence-k centre). A sharp
 // fragment also has a data texel per vertex entry, in the same order in a data block
-// after all positions — centre: (vertex sharpness, 0, 0, 0); entry (a, b): (semi-sharp
+// after all positions — centre: (vertex sharpness, 0, 0, 0); entry (a, b) with uniform
+// creasing: the sharpness of its edges towards -a, +a, -b, +b; with Chaikin's: (semi-sharp
 // count, sharpness of edge (a-1,b)-(a,b), of edge (a,b-1)-(a,b), semi-sharp sum) — from
 // which the pass applies OpenSubdiv's rules (Sdc::Crease: dart, crease and corner masks,
 // their fractional blends, uniform or Chaikin decay), and writes, for the data block of
@@ -229,7 +230,12 @@ vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
     vec3 ends = vec3(0.0);
     vec3 cends = vec3(0.0);
     for (int s = 0; s < K + E; ++s) {
+        // The spoke is the -a edge of its ring-1 entry.
+#if CHAIKIN
         float e = dat(s, 1, 0).y;
+#else
+        float e = dat(s, 1, 0).x;
+#endif
         float c = child1(e, semi);
         vec3 q = at(s, 1, 0);
         float d = decays4(vec4(e), vec4(c)).x;
@@ -320,12 +326,13 @@ void main() {
 #endif
 #if SHARP
     if (data_in) {
-        // The data texels every rule below reads: the parent cell (x, y), its +a and +b
-        // neighbours, and the edge (x, -1)-(x, 0) stored in the sector before.
         int x = a >> 1;
         int y = b >> 1;
         bool a_even = (a & 1) == 0;
         bool b_even = (b & 1) == 0;
+#if CHAIKIN
+        // The data texels every rule below reads: the parent cell (x, y), its +a and +b
+        // neighbours, and the edge (x, -1)-(x, 0) stored in the sector before.
         vec4 d00 = dat(s, x, y);
         vec4 d10 = dat(s, x + 1, y);
         vec4 d01 = dat(s, x, y + 1);
@@ -384,6 +391,48 @@ void main() {
         }
         result = vec4(p, 1.0);
         return;
+#endif
+#else
+        // Uniform creasing: one data texel serves every rule — the parent vertex (x, y)
+        // of a vertex point, the far end (x + 1, y) of a parent edge along a (its -a edge),
+        // the near end (x, y) of one along b (its +b edge); the centre's for i == 0.
+        vec4 d = dat(s, (!a_even && b_even) ? x + 1 : x, y);
+        float pe = a_even ? d.w : d.x;
+        float ce = decrement4(vec4(pe)).x;
+#if DATA
+        // The decayed edges of the new vertex: its parent vertex's, or its parent edge's
+        // halves (the other two lie inside a face).
+        result = (i == 0) ? vec4(decrement4(vec4(d.x)).x, 0.0, 0.0, 0.0)
+               : (a_even && b_even) ? decrement4(d)
+               : (!a_even && b_even) ? vec4(ce, ce, 0.0, 0.0)
+               : (a_even && !b_even) ? vec4(0.0, 0.0, ce, ce)
+               : vec4(0.0);
+        return;
+#else
+        vec3 p;
+        if (i == 0) {
+            p = sharp_centre(sm, d.x, vec2(0.0));
+        } else if (a_even && b_even) {
+            // Vertex point of (x, y): neighbours -a, +a, -b, +b are taps 3, 5, 1, 7.
+            vec4 c = decrement4(d);
+            vec4 sharp = vec4(greaterThan(d, vec4(0.0)));
+            vec4 csharp = vec4(greaterThan(c, vec4(0.0)));
+            vec3 ends = sharp.x * T3 + sharp.y * T5 + sharp.z * T1 + sharp.w * T7;
+            vec3 cends = csharp.x * T3 + csharp.y * T5 + csharp.z * T1 + csharp.w * T7;
+            vec4 g = decays4(d, c);
+            p = vertex_mask(T4, 0.0, dot(sharp, vec4(1.0)), dot(csharp, vec4(1.0)), ends, cends, dot(g, vec4(1.0)),
+                            dot(g, d), sm);
+        } else if (a_even != b_even) {
+            // Edge point: the midpoint while the halves stay sharp, else blended with the
+            // smooth point by the edge's sharpness. Its ends are taps 4 and 5 (along a) or 7.
+            vec3 mid = 0.5 * (T4 + (a_even ? T7 : T5));
+            p = (pe <= 0.0) ? sm : ((ce > 0.0) ? mid : pe * mid + (1.0 - pe) * sm);
+        } else {
+            p = sm;
+        }
+        result = vec4(p, 1.0);
+        return;
+#endif
 #endif
     }
 #endif

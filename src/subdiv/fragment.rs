@@ -440,18 +440,20 @@ impl FragmentMesh {
         let half_at_origin = |h: u32| nc + 2 * topo.edge(h) + u32::from(topo.is_reversed(h));
         let half_at_target = |h: u32| nc + 2 * topo.edge(h) + u32::from(!topo.is_reversed(h));
         let last_in = if frag.class.boundary { topo.prev(corners[k as usize - 1]) } else { NONE };
-        // B vertex and the B edges (a−1, b)–(a, b), (a, b−1)–(a, b) of entry (s, a, b).
-        let entry = |s: u32, a: u32, bb: u32| -> (u32, Option<u32>, Option<u32>) {
+        // B vertex and the B edges −a, +a, −b, +b of entry (s, a, b) (`None`: an edge inside
+        // a coarse face, always smooth, or one outside the fan, never read).
+        let entry = |s: u32, a: u32, bb: u32| -> (u32, [Option<u32>; 4]) {
             if (a, bb) == (0, 0) {
-                return (vertex_point(frag.centre), None, None);
+                return (vertex_point(frag.centre), [None; 4]);
             }
+            let (ho, ht) = (|h: u32| Some(half_at_origin(h)), |h: u32| Some(half_at_target(h)));
             if s == k {
-                // A half-fan's last spoke: the border edge that enters the centre.
+                // A half-fan's last spoke: the border edge p that enters the centre.
                 let p = last_in;
                 return if a == 1 {
-                    (edge_point(p), Some(half_at_target(p)), None)
+                    (edge_point(p), [ht(p), ho(p), None, None])
                 } else {
-                    (vertex_point(topo.origin(p)), Some(half_at_origin(p)), None)
+                    (vertex_point(topo.origin(p)), [ho(p), None, None, None])
                 };
             }
             // The sector's coarse quad, seen from the centre: h runs c → c1, h1 c1 → c2,
@@ -459,12 +461,12 @@ impl FragmentMesh {
             let h = corners[s as usize];
             let (h1, h2) = (topo.next(h), topo.next(topo.next(h)));
             match (a, bb) {
-                (1, 0) => (edge_point(h), Some(half_at_origin(h)), None),
-                (1, 1) => (face_point(h), None, None),
-                (2, 0) => (vertex_point(topo.origin(h1)), Some(half_at_target(h)), None),
-                (2, 1) => (edge_point(h1), None, Some(half_at_origin(h1))),
-                (2, 2) => (vertex_point(topo.origin(h2)), Some(half_at_origin(h2)), Some(half_at_target(h1))),
-                (1, 2) => (edge_point(h2), Some(half_at_target(h2)), None),
+                (1, 0) => (edge_point(h), [ho(h), ht(h), None, None]),
+                (1, 1) => (face_point(h), [None; 4]),
+                (2, 0) => (vertex_point(topo.origin(h1)), [ht(h), None, None, ho(h1)]),
+                (2, 1) => (edge_point(h1), [None, None, ho(h1), ht(h1)]),
+                (2, 2) => (vertex_point(topo.origin(h2)), [ho(h2), None, ht(h1), None]),
+                (1, 2) => (edge_point(h2), [ht(h2), ho(h2), None, None]),
                 _ => unreachable!("ring radius 2 holds only a, b ≤ 2"),
             }
         };
@@ -479,8 +481,9 @@ impl FragmentMesh {
                 largest = largest.max(s);
             }
         };
+        let chaikin = self.method == Method::Chaikin;
         let mut push = |s: u32, a: u32, bb: u32| {
-            let (v, ea, eb) = entry(s, a, bb);
+            let (v, edges) = entry(s, a, bb);
             vertices.push(v);
             if !sharp {
                 return;
@@ -489,12 +492,15 @@ impl FragmentMesh {
                 note(centre_sharpness);
                 [centre_sharpness, 0.0, 0.0, 0.0]
             } else {
-                let ea = ea.map_or(0.0, |e| b.edge_sharpness(e));
-                let eb = eb.map_or(0.0, |e| b.edge_sharpness(e));
-                note(ea);
-                note(eb);
-                let (count, sum) = semi(v);
-                [count, ea, eb, sum]
+                let e = edges.map(|e| e.map_or(0.0, |e| b.edge_sharpness(e)));
+                e.iter().for_each(|&s| note(s));
+                if chaikin {
+                    // (count, −a, −b, sum); a spoke's −b edge is stored in the sector before.
+                    let (count, sum) = semi(v);
+                    [count, e[0], if bb == 0 { 0.0 } else { e[2] }, sum]
+                } else {
+                    e
+                }
             });
         };
         push(0, 0, 0);
@@ -794,23 +800,47 @@ impl View<'_> {
     /// The spokes of the centre: (sharpness, ring-1 neighbour), in sector order.
     fn spokes(&self) -> impl Iterator<Item = (f32, DVec3)> + '_ {
         let n = self.k() + u32::from(self.class.boundary);
-        (0..n).map(|s| (self.d(s, 1, 0)[1], self.p(s, 1, 0)))
+        // The spoke is the −a edge of its ring-1 entry (both formats keep it in channel
+        // 0 and 1 respectively, see the module docs).
+        let channel = usize::from(self.method == Method::Chaikin);
+        (0..n).map(move |s| (self.d(s, 1, 0)[channel], self.p(s, 1, 0)))
+    }
+
+    /// Sharpness of the edge (x, y)–(x + 1, y) of sector s (x, y ≥ 0).
+    fn edge_along_a(&self, s: u32, x: i64, y: i64) -> f32 {
+        match self.method {
+            Method::Uniform => self.d(s, x + 1, y)[0],
+            Method::Chaikin => self.d(s, x + 1, y)[1],
+        }
+    }
+
+    /// Sharpness of the edge (x, y)–(x, y + 1) of sector s (x ≥ 1, y ≥ 0).
+    fn edge_along_b(&self, s: u32, x: i64, y: i64) -> f32 {
+        match self.method {
+            Method::Uniform => self.d(s, x, y)[3],
+            Method::Chaikin => self.d(s, x, y + 1)[2],
+        }
     }
 
     /// The edges of canonical vertex (s, x, y) (x ≥ 1, y ≥ 0): (sharpness, neighbour) in the
-    /// order −a, +a, +b, −b, absent ones left out (a half-fan's borders).
+    /// order −a, +a, −b, +b; absent ones (a half-fan's borders) have sharpness 0.
     fn edges(&self, s: u32, x: i64, y: i64) -> Vec<(f32, DVec3)> {
-        let mut out =
-            vec![(self.d(s, x, y)[1], self.p(s, x - 1, y)), (self.d(s, x + 1, y)[1], self.p(s, x + 1, y))];
-        if s < self.k() {
-            out.push((self.d(s, x, y + 1)[2], self.p(s, x, y + 1)));
-        }
-        if y >= 1 {
-            out.push((self.d(s, x, y)[2], self.p(s, x, y - 1)));
-        } else if !self.class.boundary || s > 0 {
-            out.push((self.d(self.before(s), 1, x)[1], self.p(s, x, -1)));
-        }
-        out
+        let neighbours = [self.p(s, x - 1, y), self.p(s, x + 1, y), self.p(s, x, y - 1), self.p(s, x, y + 1)];
+        let sharpness = match self.method {
+            Method::Uniform => self.d(s, x, y),
+            Method::Chaikin => {
+                let minus_b = if y >= 1 {
+                    self.d(s, x, y)[2]
+                } else if !self.class.boundary || s > 0 {
+                    self.d(self.before(s), 1, x)[1]
+                } else {
+                    0.0
+                };
+                let plus_b = if s < self.k() { self.d(s, x, y + 1)[2] } else { 0.0 };
+                [self.d(s, x, y)[1], self.d(s, x + 1, y)[1], minus_b, plus_b]
+            }
+        };
+        sharpness.into_iter().zip(neighbours).collect()
     }
 
     /// Semi-sharp sum of the edges of vertex (x, y) of sector s (any x, y ≥ 0).
@@ -911,13 +941,13 @@ fn sharp_stencil(view: &View, i: u64) -> DVec3 {
         (1, 0) => {
             // Parent edge (x, y)–(x + 1, y).
             let (x, y) = (a / 2, b / 2);
-            let e = view.d(s, x + 1, y)[1];
+            let e = view.edge_along_a(s, x, y);
             edge_rule(view, e, [(s, x, y), (s, x + 1, y)], smooth)
         }
         (0, 1) => {
             // Parent edge (x, y)–(x, y + 1).
             let (x, y) = (a / 2, b / 2);
-            let e = view.d(s, x, y + 1)[2];
+            let e = view.edge_along_b(s, x, y);
             edge_rule(view, e, [(s, x, y), (s, x, y + 1)], smooth)
         }
         _ => smooth,
@@ -945,6 +975,23 @@ fn sharp_data(view: &View, i: u64) -> [f32; 4] {
         return [crease::decrement(view.d(0, 0, 0)[0]), 0.0, 0.0, 0.0];
     };
     let (a, b) = (i64::from(a), i64::from(b));
+    if view.method == Method::Uniform {
+        // The new vertex's four edges: halves of its parent vertex's edges, or the two
+        // halves of its parent edge (the others lie inside a face: smooth).
+        let (x, y) = (a / 2, b / 2);
+        return match (a % 2, b % 2) {
+            (0, 0) => view.d(s, x, y).map(crease::decrement),
+            (1, 0) => {
+                let e = crease::decrement(view.edge_along_a(s, x, y));
+                [e, e, 0.0, 0.0]
+            }
+            (0, 1) => {
+                let e = crease::decrement(view.edge_along_b(s, x, y));
+                [0.0, 0.0, e, e]
+            }
+            _ => [0.0; 4],
+        };
+    }
     // The child half of a parent edge of sharpness e that ends at vertex (x, y).
     let half = |e: f32, x: i64, y: i64| view.child(e, s, x, y);
     // Edge (a−1, b)–(a, b): half of a parent edge along a when b is even.

@@ -83,8 +83,8 @@ pub enum Command {
         #[arg(long)]
         validate: bool,
         /// Instead of Table 5: sharp features — each model with its feature edges creased
-        /// against itself without creases (default models: fandisk.off when fetched,
-        /// builtin:l-prism, builtin:cube).
+        /// against itself without creases (default models: fandisk.off and
+        /// couplingdown.off when fetched, builtin:l-prism).
         #[arg(long)]
         creases: bool,
         /// With --creases: edges whose faces meet at more than this many degrees are creased.
