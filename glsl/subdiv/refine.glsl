@@ -6,14 +6,15 @@
 // Each invocation finds its run, fragment and (sector, a, b), then applies the stencil:
 // both coordinates even -> vertex point, one odd -> edge point, both odd -> face point.
 //
-// Smooth fragments take the tensor-product masks (and the valence-k centre). A sharp
-// fragment also has a data texel per vertex entry, in the same order in a data block
-// after all positions — centre: (vertex sharpness, 0, 0, 0); entry (a, b) with uniform
-// creasing: the sharpness of its edges towards -a, +a, -b, +b; with Chaikin's: (semi-sharp
-// count, sharpness of edge (a-1,b)-(a,b), of edge (a,b-1)-(a,b), semi-sharp sum) — from
-// which the pass applies OpenSubdiv's rules (Sdc::Crease: dart, crease and corner masks,
-// their fractional blends, uniform or Chaikin decay), and writes, for the data block of
-// the next level, the decayed data of each new vertex. The same rules as
+// Smooth fragments take the tensor-product masks (and the valence-k centre). Inside the
+// part of a fragment a pass evaluates, only spoke edges can be sharp and only the centre
+// can have a vertex sharpness (src/subdiv/fragment.rs explains why), so a sharp
+// fragment's data lives on its spokes: a data block after all positions holds the
+// centre, (vertex sharpness, 0, 0, 0), then for each spoke s and each vertex a = 1..R
+// along it, (sharpness of segment (a-1)-a, semi-sharp count, semi-sharp sum, 0) at
+// 1 + s·R + a - 1. From it the pass applies OpenSubdiv's rules (Sdc::Crease: dart, crease
+// and corner masks, their fractional blends, uniform or Chaikin decay) at the centre and
+// along the spokes, and writes the next level's data block. The same rules as
 // `sharp_stencil` / `sharp_data` in src/subdiv/fragment.rs (there in f64, here in f32).
 //
 // Variants compiled from this file: refine_smooth.frag (positions, smooth masks only),
@@ -101,9 +102,10 @@ vec3 at(int s, int a, int b) {
 }
 
 #if SHARP
-// The data texel of entry (s, a, b) (sharp fragments only).
-vec4 dat(int s, int a, int b) {
-    return fetch(DBASE + entry(s, a, b));
+// The data of vertex (a, 0) of spoke s, a >= 1 (sharp fragments only): segment
+// (a-1)-a, semi-sharp count and sum.
+vec4 spoke(int s, int a) {
+    return fetch(DBASE + 1 + s * pc.r_in + a - 1);
 }
 #endif
 
@@ -202,6 +204,14 @@ vec2 semi4(vec4 e) {
     return vec2(dot(semi, vec4(1.0)), dot(semi, e));
 }
 
+// The centre's semi-sharp (count, sum): its spokes' first segments (Chaikin; set in main).
+vec2 CENTRE_SEMI;
+
+// Semi-sharp (count, sum) at vertex (a, 0) of spoke s, the centre for a = 0 (Chaikin).
+vec2 semi_at(int s, int a) {
+    return (a == 0) ? CENTRE_SEMI : spoke(s, a).yz;
+}
+
 // OpenSubdiv's vertex-vertex mask at a vertex p of sharpness vs: the parent's rule, and
 // where it changes the child's, blended by the fractional weight. `sharp` and `csharp`
 // count the sharp edges of parent and child, `ends` and `cends` sum their neighbours,
@@ -221,8 +231,8 @@ vec3 vertex_mask(vec3 p, float vs, float sharp, float csharp, vec3 ends, vec3 ce
     return (pr <= 1) ? sm : ((cr == pr) ? pm : w * pm + (1.0 - w) * cm);
 }
 
-// The centre of a sharp fragment: the vertex mask over its K (+ E) spokes.
-vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
+// The centre of a sharp fragment: the vertex mask over its spokes.
+vec3 sharp_centre(vec3 sm) {
     float sharp = 0.0;
     float csharp = 0.0;
     float count = 0.0;
@@ -230,13 +240,8 @@ vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
     vec3 ends = vec3(0.0);
     vec3 cends = vec3(0.0);
     for (int s = 0; s < K + E; ++s) {
-        // The spoke is the -a edge of its ring-1 entry.
-#if CHAIKIN
-        float e = dat(s, 1, 0).y;
-#else
-        float e = dat(s, 1, 0).x;
-#endif
-        float c = child1(e, semi);
+        float e = spoke(s, 1).x;
+        float c = child1(e, CENTRE_SEMI);
         vec3 q = at(s, 1, 0);
         float d = decays4(vec4(e), vec4(c)).x;
         sharp += float(e > 0.0);
@@ -246,7 +251,7 @@ vec3 sharp_centre(vec3 sm, float vs, vec2 semi) {
         count += d;
         sum += d * e;
     }
-    return vertex_mask(at(0, 0, 0), vs, sharp, csharp, ends, cends, count, sum, sm);
+    return vertex_mask(at(0, 0, 0), fetch(DBASE).x, sharp, csharp, ends, cends, count, sum, sm);
 }
 #endif // SHARP
 
@@ -281,18 +286,45 @@ void main() {
     ivec4 run = tab.runs[lo];
     K = run.x;
     E = run.y & 1;
-#if DATA
-    int start_out = tab.data[lo].y;
-#else
-    int start_out = run.w;
+#if SHARP
+    CENTRE_SEMI = vec2(0.0);
+#if CHAIKIN
+    // (Computed below once DBASE is known.)
 #endif
+#endif
+#if DATA
+    // A data texel: the centre's, or vertex a of spoke s.
+    int dlen_out = 1 + (K + E) * pc.r_out;
+    int u = lin - tab.data[lo].y;
+    int frag = divide(u, dlen_out);
+    int e = u - frag * dlen_out;
+    DBASE = tab.data[lo].x + frag * (1 + (K + E) * pc.r_in);
+#if CHAIKIN
+    for (int k = 0; k < K + E; ++k) {
+        CENTRE_SEMI += semi4(vec4(spoke(k, 1).x, 0.0, 0.0, 0.0));
+    }
+#endif
+    int s = divide(max(e - 1, 0), pc.r_out);
+    int a = e - s * pc.r_out;
+    // Segment (a-1)-a: half of the parent segment (a+1)/2 at the parent vertex a/2 (a
+    // even) or (a-1)/2 (a odd); the next segment a-(a+1) likewise.
+    int end = a >> 1;
+    float segment = child1(spoke(s, (a + 1) >> 1).x, semi_at(s, end));
+    vec2 semi = vec2(0.0);
+#if CHAIKIN
+    int next_end = ((a & 1) == 0) ? end : end + 1;
+    float next = child1(spoke(s, end + 1).x, semi_at(s, next_end));
+    semi = semi4(vec4(segment, next, 0.0, 0.0));
+#endif
+    result = (e == 0) ? vec4(decrement4(vec4(fetch(DBASE).x)).x, 0.0, 0.0, 0.0) : vec4(segment, semi, 0.0);
+#else
     int len_out = 1 + K * (pc.r_out + 1) * pc.r_out + E * pc.r_out;
     int len_in = 1 + K * (pc.r_in + 1) * pc.r_in + E * pc.r_in;
-    int u = lin - start_out;
+    int u = lin - run.w;
     int frag = divide(u, len_out);
     int i = u - frag * len_out;
     BASE = run.z + frag * len_in;
-    DBASE = tab.data[lo].x + frag * len_in;
+    DBASE = tab.data[lo].x + frag * (1 + (K + E) * pc.r_in);
 
     int s = 0;
     int a = 0;
@@ -315,126 +347,45 @@ void main() {
         a = (s == K || t <= r) ? r : 2 * r - t;
         b = (s == K) ? 0 : min(t, r);
     }
-#if DATA
-    bool data_in = true;
-    vec3 sm = vec3(0.0);
-#elif SHARP
-    bool data_in = (run.y & 2) != 0;
-    vec3 sm = (i == 0) ? centre_point() : smooth_point(s, a, b);
-#else
-    vec3 sm = (i == 0) ? centre_point() : smooth_point(s, a, b);
-#endif
+    vec3 p = (i == 0) ? centre_point() : smooth_point(s, a, b);
 #if SHARP
-    if (data_in) {
-        int x = a >> 1;
-        int y = b >> 1;
-        bool a_even = (a & 1) == 0;
-        bool b_even = (b & 1) == 0;
-#if CHAIKIN
-        // The data texels every rule below reads: the parent cell (x, y), its +a and +b
-        // neighbours, and the edge (x, -1)-(x, 0) stored in the sector before.
-        vec4 d00 = dat(s, x, y);
-        vec4 d10 = dat(s, x + 1, y);
-        vec4 d01 = dat(s, x, y + 1);
-        vec4 dm = dat((s == 0) ? K - 1 : s - 1, 1, x);
-        // Semi-sharp (count, sum) at (x, y), (x + 1, y), (x, y + 1); the centre's from its spokes.
-        vec2 semi_c = vec2(0.0);
+    if ((run.y & 2) != 0) {
 #if CHAIKIN
         for (int k = 0; k < K + E; ++k) {
-            semi_c += semi4(vec4(dat(k, 1, 0).y, 0.0, 0.0, 0.0));
+            CENTRE_SEMI += semi4(vec4(spoke(k, 1).x, 0.0, 0.0, 0.0));
         }
 #endif
-        vec2 semi00 = (i == 0 || (x == 0 && y == 0)) ? semi_c : d00.xw;
-        vec2 semi10 = d10.xw;
-        vec2 semi01 = d01.xw;
-        // The edges of vertex (x, y): -a, +a, -b, +b (0 where absent: a half-fan's border).
-        bool minus_b = y >= 1 || E == 0 || s > 0;
-        vec4 e = vec4(d00.y, d10.y, (y >= 1) ? d00.z : (minus_b ? dm.y : 0.0), (s < K) ? d01.z : 0.0);
-        vec4 c = child4(e, semi00);
-        // The parent edge of an edge point: along a (x, y)-(x + 1, y) or along b (x, y)-(x, y + 1).
-        float pe = a_even ? d01.z : d10.y;
-        vec2 semi_end = a_even ? semi01 : semi10;
-#if DATA
-        // The decayed data of this texel's vertex.
-        float ea = b_even ? child1(a_even ? d00.y : d10.y, semi00) : 0.0;
-        float eb = (b >= 1 && a_even) ? child1(b_even ? d00.z : d01.z, semi00) : 0.0;
-        vec2 semi = vec2(0.0);
-#if CHAIKIN
-        // The semi-sharp edges of the new vertex: halves of its parent's edges.
-        semi = (a_even && b_even) ? semi4(c)
-             : (a_even != b_even) ? semi4(vec4(child1(pe, semi00), child1(pe, semi_end), 0.0, 0.0))
-             : vec2(0.0);
-#endif
-        result = (i == 0) ? vec4(decrement4(vec4(d00.x)).x, 0.0, 0.0, 0.0) : vec4(semi.x, ea, eb, semi.y);
-        return;
-#else
-        vec3 p;
+        // Along spoke s (b = 0): the vertex point of (x, 0), or the edge point of segment
+        // (x, 0)-(x + 1, 0); taps 3, 4, 5 are (x - 1, 0), (x, 0), (x + 1, 0) for the
+        // first, 4 and 5 are (x, 0), (x + 1, 0) for the second. Elsewhere every edge is
+        // smooth.
+        int x = a >> 1;
+        vec4 d0 = spoke(s, max(x, 1));
+        vec4 d1 = spoke(s, x + 1);
+        vec2 semi0 = (x == 0) ? CENTRE_SEMI : d0.yz;
+        vec3 q;
         if (i == 0) {
-            p = sharp_centre(sm, d00.x, semi_c);
-        } else if (a_even && b_even) {
-            // Vertex point of (x, y): neighbours -a, +a, -b, +b are taps 3, 5, 1, 7.
+            q = sharp_centre(p);
+        } else if ((a & 1) == 0) {
+            // Segments x and x + 1 (none at x = 0: not a spoke vertex).
+            vec4 e = vec4(d0.x, d1.x, 0.0, 0.0);
+            vec4 c = child4(e, semi0);
             vec4 sharp = vec4(greaterThan(e, vec4(0.0)));
             vec4 csharp = vec4(greaterThan(c, vec4(0.0)));
-            vec3 ends = sharp.x * T3 + sharp.y * T5 + sharp.z * T1 + sharp.w * T7;
-            vec3 cends = csharp.x * T3 + csharp.y * T5 + csharp.z * T1 + csharp.w * T7;
-            vec4 d = decays4(e, c);
-            p = vertex_mask(T4, 0.0, dot(sharp, vec4(1.0)), dot(csharp, vec4(1.0)), ends, cends, dot(d, vec4(1.0)),
-                            dot(d, e), sm);
-        } else if (a_even != b_even) {
-            // Edge point: the midpoint while both halves stay sharp, else blended with the
-            // smooth point by the edge's sharpness. Its ends are taps 4 and 5 (along a) or 7.
-            vec3 mid = 0.5 * (T4 + (a_even ? T7 : T5));
-            bool crease = child1(pe, semi00) > 0.0 && child1(pe, semi_end) > 0.0;
-            p = (pe <= 0.0) ? sm : (crease ? mid : pe * mid + (1.0 - pe) * sm);
+            vec3 ends = sharp.x * T3 + sharp.y * T5;
+            vec3 cends = csharp.x * T3 + csharp.y * T5;
+            vec4 g = decays4(e, c);
+            q = vertex_mask(T4, 0.0, dot(sharp, vec4(1.0)), dot(csharp, vec4(1.0)), ends, cends, dot(g, vec4(1.0)),
+                            dot(g, e), p);
         } else {
-            p = sm;
+            float pe = d1.x;
+            vec3 mid = 0.5 * (T4 + T5);
+            bool crease = child1(pe, semi0) > 0.0 && child1(pe, d1.yz) > 0.0;
+            q = (pe <= 0.0) ? p : (crease ? mid : pe * mid + (1.0 - pe) * p);
         }
-        result = vec4(p, 1.0);
-        return;
-#endif
-#else
-        // Uniform creasing: one data texel serves every rule — the parent vertex (x, y)
-        // of a vertex point, the far end (x + 1, y) of a parent edge along a (its -a edge),
-        // the near end (x, y) of one along b (its +b edge); the centre's for i == 0.
-        vec4 d = dat(s, (!a_even && b_even) ? x + 1 : x, y);
-        float pe = a_even ? d.w : d.x;
-        float ce = decrement4(vec4(pe)).x;
-#if DATA
-        // The decayed edges of the new vertex: its parent vertex's, or its parent edge's
-        // halves (the other two lie inside a face).
-        result = (i == 0) ? vec4(decrement4(vec4(d.x)).x, 0.0, 0.0, 0.0)
-               : (a_even && b_even) ? decrement4(d)
-               : (!a_even && b_even) ? vec4(ce, ce, 0.0, 0.0)
-               : (a_even && !b_even) ? vec4(0.0, 0.0, ce, ce)
-               : vec4(0.0);
-        return;
-#else
-        vec3 p;
-        if (i == 0) {
-            p = sharp_centre(sm, d.x, vec2(0.0));
-        } else if (a_even && b_even) {
-            // Vertex point of (x, y): neighbours -a, +a, -b, +b are taps 3, 5, 1, 7.
-            vec4 c = decrement4(d);
-            vec4 sharp = vec4(greaterThan(d, vec4(0.0)));
-            vec4 csharp = vec4(greaterThan(c, vec4(0.0)));
-            vec3 ends = sharp.x * T3 + sharp.y * T5 + sharp.z * T1 + sharp.w * T7;
-            vec3 cends = csharp.x * T3 + csharp.y * T5 + csharp.z * T1 + csharp.w * T7;
-            vec4 g = decays4(d, c);
-            p = vertex_mask(T4, 0.0, dot(sharp, vec4(1.0)), dot(csharp, vec4(1.0)), ends, cends, dot(g, vec4(1.0)),
-                            dot(g, d), sm);
-        } else if (a_even != b_even) {
-            // Edge point: the midpoint while the halves stay sharp, else blended with the
-            // smooth point by the edge's sharpness. Its ends are taps 4 and 5 (along a) or 7.
-            vec3 mid = 0.5 * (T4 + (a_even ? T7 : T5));
-            p = (pe <= 0.0) ? sm : ((ce > 0.0) ? mid : pe * mid + (1.0 - pe) * sm);
-        } else {
-            p = sm;
-        }
-        result = vec4(p, 1.0);
-        return;
-#endif
-#endif
+        p = (b == 0) ? q : p;
     }
 #endif
-    result = vec4(sm, 1.0);
+    result = vec4(p, 1.0);
+#endif
 }

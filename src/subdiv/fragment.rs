@@ -29,20 +29,24 @@
 //!
 //! # Sharpness data
 //!
-//! A fragment with any sharp edge or vertex in its region (every half-fan: its border is
-//! infinitely sharp) is *sharp*: each of its vertex entries has a data texel, in the same
-//! order in a data block after all positions, and the pass applies OpenSubdiv's crease
-//! rules (`crease`) from them:
+//! Inside the part of a fragment the passes evaluate, every edge is either a piece of a
+//! spoke (a coarse edge at the centre) or was born inside a coarse face, and an edge born
+//! inside a face is smooth for good; only the centre can have a vertex sharpness (the
+//! coarse faces' other corners stay out of reach: at level j they lie on ring 2^(j+1),
+//! beyond the stream's 2^j + 1). So a fragment's sharpness lives on its spokes. A
+//! fragment with any sharp spoke or a sharp centre (every half-fan: its borders are
+//! infinitely sharp) is *sharp*: it has a data block after all positions, one texel per
+//! entry, `1 + (k + e)·R` of them at ring radius R:
 //!
-//! - centre entry: (vertex sharpness, 0, 0, 0);
-//! - entry (a, b): (count, sharpness of edge (a−1, b)–(a, b), sharpness of edge
-//!   (a, b−1)–(a, b), sum), where count and sum describe the semi-sharp edges of the
-//!   vertex (what Chaikin's rule averages; kept only with Chaikin creasing). Every edge of
-//!   the fragment is stored once this way (edge (a, −1)–(a, 0) is sector s − 1's (0, a)–(1, a)).
+//! - the centre: (vertex sharpness, 0, 0, 0);
+//! - entry `1 + s·R + (a − 1)`, the vertex (a, 0) of spoke s: (sharpness of the spoke
+//!   segment (a−1, 0)–(a, 0), count and sum of the vertex's semi-sharp edges, 0) — the
+//!   count and sum are what Chaikin's rule averages (a spoke vertex's two segments,
+//!   except at the base level's ring 2, a coarse vertex, whose every edge counts).
 //!
 //! Sharpness only decays, so a fragment whose largest semi-sharp value is σ needs data
 //! for ⌈σ⌉ levels (one more with Chaikin, whose `f32` averages may leave a last bit);
-//! after that *horizon* its stream drops the data texels and it runs the smooth stencil.
+//! after that *horizon* its stream drops the data block and it runs the smooth stencil.
 //! Fragments are sorted into runs of one horizon and class (valence, half-fan), horizon
 //! first: at every level the runs without data come first, so the GPU pass can draw them
 //! with the smooth shader variant and the rest with the sharp one (`gpu`).
@@ -85,6 +89,17 @@ impl Class {
     /// Entries of a fragment of ring radius `radius`: the centre and rings 1..=radius.
     pub fn len(self, radius: u32) -> u64 {
         1 + self.ring_offset(u64::from(radius) + 1)
+    }
+
+    /// Spokes: one per sector, one more on a half-fan.
+    pub fn spokes(self) -> u32 {
+        self.valence + u32::from(self.boundary)
+    }
+
+    /// Entries of a sharp fragment's data block at ring radius `radius`: the centre and
+    /// `radius` vertices along each spoke.
+    pub fn data_len(self, radius: u32) -> u64 {
+        1 + u64::from(self.spokes()) * u64::from(radius)
     }
 
     /// Storage index of vertex (a, b) of sector `s`, after moving (0, b) and (a, −1) to the
@@ -472,7 +487,7 @@ impl FragmentMesh {
         };
         let len = frag.class.len(2) as usize;
         let mut vertices = Vec::with_capacity(len);
-        let mut data = Vec::with_capacity(if sharp { len } else { 0 });
+        let mut data = Vec::with_capacity(if sharp { frag.class.data_len(2) as usize } else { 0 });
         let (mut largest, mut infinite) = (0.0f32, false);
         let mut note = |s: f32| {
             if crease::is_infinite(s) {
@@ -481,37 +496,28 @@ impl FragmentMesh {
                 largest = largest.max(s);
             }
         };
-        let chaikin = self.method == Method::Chaikin;
-        let mut push = |s: u32, a: u32, bb: u32| {
-            let (v, edges) = entry(s, a, bb);
-            vertices.push(v);
-            if !sharp {
-                return;
-            }
-            data.push(if (a, bb) == (0, 0) {
-                note(centre_sharpness);
-                [centre_sharpness, 0.0, 0.0, 0.0]
-            } else {
-                let e = edges.map(|e| e.map_or(0.0, |e| b.edge_sharpness(e)));
-                e.iter().for_each(|&s| note(s));
-                if chaikin {
-                    // (count, −a, −b, sum); a spoke's −b edge is stored in the sector before.
-                    let (count, sum) = semi(v);
-                    [count, e[0], if bb == 0 { 0.0 } else { e[2] }, sum]
-                } else {
-                    e
-                }
-            });
-        };
-        push(0, 0, 0);
+        vertices.push(entry(0, 0, 0).0);
         for r in 1..=2 {
             for s in 0..k {
                 for t in 0..2 * r {
-                    if t <= r { push(s, r, t) } else { push(s, 2 * r - t, r) }
+                    vertices.push(if t <= r { entry(s, r, t).0 } else { entry(s, 2 * r - t, r).0 });
                 }
             }
             if frag.class.boundary {
-                push(k, r, 0);
+                vertices.push(entry(k, r, 0).0);
+            }
+        }
+        if sharp {
+            note(centre_sharpness);
+            data.push([centre_sharpness, 0.0, 0.0, 0.0]);
+            for s in 0..frag.class.spokes() {
+                for a in 1..=2 {
+                    let (v, edges) = entry(s, a, 0);
+                    let segment = edges[0].map_or(0.0, |e| b.edge_sharpness(e));
+                    note(segment);
+                    let (count, sum) = semi(v);
+                    data.push([segment, count, sum, 0.0]);
+                }
             }
         }
         let horizon = if infinite {
@@ -649,7 +655,7 @@ impl FragmentMesh {
         for (run, &has) in self.runs.iter().zip(&data) {
             data_starts.push(total);
             if has {
-                total += u64::from(run.count) * run.class.len(radius);
+                total += u64::from(run.count) * run.class.data_len(radius);
             }
         }
         StreamLayout { radius, data, starts, data_starts, positions, data_start, total }
@@ -666,7 +672,7 @@ impl FragmentMesh {
     pub fn fragment_data_start(&self, layout: &StreamLayout, f: u32) -> u64 {
         let frag = &self.fragments[f as usize];
         let run = &self.runs[frag.run as usize];
-        layout.data_starts[frag.run as usize] + u64::from(f - run.first) * frag.class.len(layout.radius)
+        layout.data_starts[frag.run as usize] + u64::from(f - run.first) * frag.class.data_len(layout.radius)
     }
 
     /// The base-level stream (ring radius 2) of a refinement with `levels` fragment levels
@@ -688,7 +694,7 @@ impl FragmentMesh {
             if run.horizon == 0 {
                 continue;
             }
-            let len = (u64::from(run.count) * run.class.len(2)) as usize;
+            let len = (u64::from(run.count) * run.class.data_len(2)) as usize;
             if layout.data[r] {
                 out.extend(self.base_data[datum..datum + len].iter().map(|&d| data(d)));
             }
@@ -711,6 +717,7 @@ impl FragmentMesh {
                 input,
                 base: self.fragment_start(&lin, f),
                 data_base: if lin.data[r] { self.fragment_data_start(&lin, f) } else { 0 },
+                radius: lin.radius,
                 data: lin.data[r],
                 method: self.method,
             };
@@ -725,8 +732,8 @@ impl FragmentMesh {
             }
             if lout.data[r] {
                 let data_out = self.fragment_data_start(&lout, f);
-                for i in 0..frag.class.len(lout.radius) {
-                    out[(data_out + i) as usize] = sharp_data(&view, i).map(f64::from);
+                for i in 0..frag.class.data_len(lout.radius) {
+                    out[(data_out + i) as usize] = sharp_data(&view, i, lout.radius).map(f64::from);
                 }
             }
         }
@@ -765,13 +772,14 @@ pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
     Ok(cpu::Refined { mesh, sharp_edges: sharp_edges(&fragments, levels) })
 }
 
-/// A fragment of the input stream: positions and (when `data`) sharpness data.
+/// A fragment of the input stream: positions and (when `data`) its spokes' sharpness.
 struct View<'a> {
     class: Class,
     input: &'a [[f64; 4]],
-    /// First position and first data texel of the fragment.
+    /// First position and first data texel of the fragment, and its ring radius.
     base: u64,
     data_base: u64,
+    radius: u32,
     data: bool,
     method: Method,
 }
@@ -782,91 +790,42 @@ impl View<'_> {
         DVec3::new(t[0], t[1], t[2])
     }
 
-    /// The data texel of canonical entry (s, a, b) (a ≥ 1, b ≥ 0, or the centre).
-    fn d(&self, s: u32, a: i64, b: i64) -> [f32; 4] {
-        let t = self.input[(self.data_base + self.class.index(s, a, b)) as usize];
-        t.map(|x| x as f32)
+    fn datum(&self, i: u64) -> [f32; 4] {
+        self.input[(self.data_base + i) as usize].map(|x| x as f32)
     }
 
-    fn k(&self) -> u32 {
-        self.class.valence
+    /// Sharpness of the centre.
+    fn centre_sharpness(&self) -> f32 {
+        self.datum(0)[0]
     }
 
-    /// The sector before `s` (closed fans wrap).
-    fn before(&self, s: u32) -> u32 {
-        if s == 0 { self.k() - 1 } else { s - 1 }
+    /// The data of vertex (a, 0) of spoke s (a ≥ 1): segment (a−1)–a and semi-sharp sum.
+    fn spoke(&self, s: u32, a: i64) -> ([f32; 4], SemiSharpSum) {
+        let d = self.datum(1 + u64::from(s) * u64::from(self.radius) + (a as u64 - 1));
+        (d, SemiSharpSum { count: d[1] as u32, sum: d[2] })
     }
 
-    /// The spokes of the centre: (sharpness, ring-1 neighbour), in sector order.
+    /// Sharpness of the spoke segment (a−1, 0)–(a, 0) of spoke s.
+    fn segment(&self, s: u32, a: i64) -> f32 {
+        self.spoke(s, a).0[0]
+    }
+
+    /// The spokes at the centre: (sharpness, ring-1 neighbour), in sector order.
     fn spokes(&self) -> impl Iterator<Item = (f32, DVec3)> + '_ {
-        let n = self.k() + u32::from(self.class.boundary);
-        // The spoke is the −a edge of its ring-1 entry (both formats keep it in channel
-        // 0 and 1 respectively, see the module docs).
-        let channel = usize::from(self.method == Method::Chaikin);
-        (0..n).map(move |s| (self.d(s, 1, 0)[channel], self.p(s, 1, 0)))
+        (0..self.class.spokes()).map(move |s| (self.segment(s, 1), self.p(s, 1, 0)))
     }
 
-    /// Sharpness of the edge (x, y)–(x + 1, y) of sector s (x, y ≥ 0).
-    fn edge_along_a(&self, s: u32, x: i64, y: i64) -> f32 {
-        match self.method {
-            Method::Uniform => self.d(s, x + 1, y)[0],
-            Method::Chaikin => self.d(s, x + 1, y)[1],
-        }
+    /// Semi-sharp sum at vertex (a, 0) of spoke s (the centre for a = 0).
+    fn semi(&self, s: u32, a: i64) -> SemiSharpSum {
+        if a == 0 { SemiSharpSum::of(self.spokes().map(|(e, _)| e)) } else { self.spoke(s, a).1 }
     }
 
-    /// Sharpness of the edge (x, y)–(x, y + 1) of sector s (x ≥ 1, y ≥ 0).
-    fn edge_along_b(&self, s: u32, x: i64, y: i64) -> f32 {
-        match self.method {
-            Method::Uniform => self.d(s, x, y)[3],
-            Method::Chaikin => self.d(s, x, y + 1)[2],
-        }
-    }
-
-    /// The edges of canonical vertex (s, x, y) (x ≥ 1, y ≥ 0): (sharpness, neighbour) in the
-    /// order −a, +a, −b, +b; absent ones (a half-fan's borders) have sharpness 0.
-    fn edges(&self, s: u32, x: i64, y: i64) -> Vec<(f32, DVec3)> {
-        let neighbours = [self.p(s, x - 1, y), self.p(s, x + 1, y), self.p(s, x, y - 1), self.p(s, x, y + 1)];
-        let sharpness = match self.method {
-            Method::Uniform => self.d(s, x, y),
-            Method::Chaikin => {
-                let minus_b = if y >= 1 {
-                    self.d(s, x, y)[2]
-                } else if !self.class.boundary || s > 0 {
-                    self.d(self.before(s), 1, x)[1]
-                } else {
-                    0.0
-                };
-                let plus_b = if s < self.k() { self.d(s, x, y + 1)[2] } else { 0.0 };
-                [self.d(s, x, y)[1], self.d(s, x + 1, y)[1], minus_b, plus_b]
-            }
-        };
-        sharpness.into_iter().zip(neighbours).collect()
-    }
-
-    /// Semi-sharp sum of the edges of vertex (x, y) of sector s (any x, y ≥ 0).
-    fn semi(&self, s: u32, x: i64, y: i64) -> SemiSharpSum {
-        if self.method != Method::Chaikin {
-            return SemiSharpSum::default();
-        }
-        if (x, y) == (0, 0) {
-            return SemiSharpSum::of(self.spokes().map(|(e, _)| e));
-        }
-        let d = if x == 0 {
-            // (0, y) of sector s is (y, 0) of sector s + 1.
-            let next = if s + 1 == self.k() && !self.class.boundary { 0 } else { s + 1 };
-            self.d(next, y, 0)
-        } else {
-            self.d(s, x, y)
-        };
-        SemiSharpSum { sum: d[3], count: d[0] as u32 }
-    }
-
-    /// Child sharpness of an edge of sharpness `e` at its end vertex (x, y) of sector s.
-    fn child(&self, e: f32, s: u32, x: i64, y: i64) -> f32 {
+    /// Child sharpness of a segment of sharpness `e` at its end (a, 0) of spoke s.
+    fn child(&self, e: f32, s: u32, a: i64) -> f32 {
         match self.method {
             Method::Uniform => crease::decrement(e),
             // Every vertex of a fragment has at least two edges.
-            Method::Chaikin => crease::chaikin(e, self.semi(s, x, y), 2),
+            Method::Chaikin => crease::chaikin(e, self.semi(s, a), 2),
         }
     }
 }
@@ -921,118 +880,68 @@ fn vertex_rule(
 }
 
 /// The position of output entry `i` of a sharp fragment: the smooth stencil, replaced by
-/// OpenSubdiv's crease and corner rules where the input's sharpness asks for them.
+/// OpenSubdiv's crease and corner rules at the centre and along the spokes (elsewhere
+/// every edge is smooth, see the module docs).
 fn sharp_stencil(view: &View, i: u64) -> DVec3 {
     let class = view.class;
     let smooth = stencil(class, i, |s, a, b| view.p(s, a, b));
     let Some((s, a, b)) = class.coords(i) else {
-        // The centre.
         let edges: Vec<(f32, DVec3)> = view.spokes().collect();
-        let vs = view.d(0, 0, 0)[0];
-        return vertex_rule(view, view.p(0, 0, 0), vs, &edges, smooth, view.semi(0, 0, 0));
+        return vertex_rule(view, view.p(0, 0, 0), view.centre_sharpness(), &edges, smooth, view.semi(0, 0));
     };
-    let (a, b) = (i64::from(a), i64::from(b));
-    match (a % 2, b % 2) {
-        (0, 0) => {
-            let (x, y) = (a / 2, b / 2);
-            let edges = view.edges(s, x, y);
-            vertex_rule(view, view.p(s, x, y), 0.0, &edges, smooth, view.semi(s, x, y))
-        }
-        (1, 0) => {
-            // Parent edge (x, y)–(x + 1, y).
-            let (x, y) = (a / 2, b / 2);
-            let e = view.edge_along_a(s, x, y);
-            edge_rule(view, e, [(s, x, y), (s, x + 1, y)], smooth)
-        }
-        (0, 1) => {
-            // Parent edge (x, y)–(x, y + 1).
-            let (x, y) = (a / 2, b / 2);
-            let e = view.edge_along_b(s, x, y);
-            edge_rule(view, e, [(s, x, y), (s, x, y + 1)], smooth)
-        }
-        _ => smooth,
-    }
-}
-
-/// The edge mask: smooth, the midpoint while both children stay sharp, else both blended
-/// by the edge's sharpness.
-fn edge_rule(view: &View, e: f32, ends: [(u32, i64, i64); 2], smooth: DVec3) -> DVec3 {
-    if e <= 0.0 {
+    if b != 0 {
         return smooth;
     }
-    let [(s0, x0, y0), (s1, x1, y1)] = ends;
-    let mid = (view.p(s0, x0, y0) + view.p(s1, x1, y1)) * 0.5;
-    if view.child(e, s0, x0, y0) > 0.0 && view.child(e, s1, x1, y1) > 0.0 {
-        return mid;
+    let a = i64::from(a);
+    let x = a / 2;
+    if a % 2 == 0 {
+        // Vertex point of (x, 0): its spoke segments; the edges across the spoke are smooth.
+        let edges =
+            [(view.segment(s, x), view.p(s, x - 1, 0)), (view.segment(s, x + 1), view.p(s, x + 1, 0))];
+        vertex_rule(view, view.p(s, x, 0), 0.0, &edges, smooth, view.semi(s, x))
+    } else {
+        // Edge point of the segment (x, 0)–(x + 1, 0): the midpoint while both halves stay
+        // sharp, else midpoint and smooth point blended by the segment's sharpness.
+        let e = view.segment(s, x + 1);
+        if e <= 0.0 {
+            return smooth;
+        }
+        let mid = (view.p(s, x, 0) + view.p(s, x + 1, 0)) * 0.5;
+        if view.child(e, s, x) > 0.0 && view.child(e, s, x + 1) > 0.0 {
+            return mid;
+        }
+        let w = f64::from(e);
+        mid * w + smooth * (1.0 - w)
     }
-    let w = f64::from(e);
-    mid * w + smooth * (1.0 - w)
 }
 
-/// The data texel of output entry `i` (see the module docs).
-fn sharp_data(view: &View, i: u64) -> [f32; 4] {
-    let Some((s, a, b)) = view.class.coords(i) else {
-        return [crease::decrement(view.d(0, 0, 0)[0]), 0.0, 0.0, 0.0];
-    };
-    let (a, b) = (i64::from(a), i64::from(b));
-    if view.method == Method::Uniform {
-        // The new vertex's four edges: halves of its parent vertex's edges, or the two
-        // halves of its parent edge (the others lie inside a face: smooth).
-        let (x, y) = (a / 2, b / 2);
-        return match (a % 2, b % 2) {
-            (0, 0) => view.d(s, x, y).map(crease::decrement),
-            (1, 0) => {
-                let e = crease::decrement(view.edge_along_a(s, x, y));
-                [e, e, 0.0, 0.0]
-            }
-            (0, 1) => {
-                let e = crease::decrement(view.edge_along_b(s, x, y));
-                [0.0, 0.0, e, e]
-            }
-            _ => [0.0; 4],
-        };
+/// Data texel `i` of a sharp fragment's data block at output ring radius `radius` (see
+/// the module docs).
+fn sharp_data(view: &View, i: u64, radius: u32) -> [f32; 4] {
+    if i == 0 {
+        return [crease::decrement(view.centre_sharpness()), 0.0, 0.0, 0.0];
     }
-    // The child half of a parent edge of sharpness e that ends at vertex (x, y).
-    let half = |e: f32, x: i64, y: i64| view.child(e, s, x, y);
-    // Edge (a−1, b)–(a, b): half of a parent edge along a when b is even.
-    let ea = if b % 2 == 1 {
-        0.0
-    } else if a % 2 == 0 {
-        half(view.d(s, a / 2, b / 2)[1], a / 2, b / 2)
-    } else {
-        half(view.d(s, (a + 1) / 2, b / 2)[1], (a - 1) / 2, b / 2)
+    let s = ((i - 1) / u64::from(radius)) as u32;
+    let a = ((i - 1) % u64::from(radius)) as i64 + 1;
+    // The output segment (a−1, a): half of the parent segment ⌈a/2⌉ at the parent vertex
+    // a/2 (a even) or (a−1)/2 (a odd); the next one (a, a+1) likewise.
+    let half = |a: i64| {
+        let parent = view.segment(s, (a + 1) / 2);
+        let end = if a % 2 == 0 { a / 2 } else { (a - 1) / 2 };
+        view.child(parent, s, end)
     };
-    // Edge (a, b−1)–(a, b): half of a parent edge along b when a is even.
-    let eb = if b == 0 || a % 2 == 1 {
-        0.0
-    } else if b % 2 == 0 {
-        half(view.d(s, a / 2, b / 2)[2], a / 2, b / 2)
-    } else {
-        half(view.d(s, a / 2, (b + 1) / 2)[2], a / 2, (b - 1) / 2)
-    };
+    let segment = half(a);
     if view.method != Method::Chaikin {
-        return [0.0, ea, eb, 0.0];
+        return [segment, 0.0, 0.0, 0.0];
     }
-    // The semi-sharp edges of the new vertex: halves of its parent's edges.
-    let children: Vec<f32> = match (a % 2, b % 2) {
-        (0, 0) => {
-            let (x, y) = (a / 2, b / 2);
-            view.edges(s, x, y).iter().map(|&(e, _)| half(e, x, y)).collect()
-        }
-        (1, 0) => {
-            let (x, y) = (a / 2, b / 2);
-            let e = view.d(s, x + 1, y)[1];
-            vec![half(e, x, y), half(e, x + 1, y)]
-        }
-        (0, 1) => {
-            let (x, y) = (a / 2, b / 2);
-            let e = view.d(s, x, y + 1)[2];
-            vec![half(e, x, y), half(e, x, y + 1)]
-        }
-        _ => Vec::new(),
+    // The new vertex's semi-sharp edges: its two segments.
+    let next = {
+        let parent = view.segment(s, a / 2 + 1);
+        let end = if a % 2 == 0 { a / 2 } else { (a + 1) / 2 };
+        view.child(parent, s, end)
     };
-    let semi = SemiSharpSum::of(children);
-    [semi.count as f32, ea, eb, semi.sum]
+    let semi = SemiSharpSum::of([segment, next]);
+    [segment, semi.count as f32, semi.sum, 0.0]
 }
 
 /// The smooth Catmull-Clark stencil (the thesis' masks, Ch. 2.2) of output entry `i` of a
