@@ -84,7 +84,7 @@ pub enum Command {
         validate: bool,
         /// Instead of Table 5: sharp features — each model with its feature edges creased
         /// against itself without creases (default models: fandisk.off and
-        /// couplingdown.off when fetched, builtin:l-prism).
+        /// couplingdown.off when fetched, builtin:knot).
         #[arg(long)]
         creases: bool,
         /// With --creases: edges whose faces meet at more than this many degrees are creased.
