@@ -709,6 +709,27 @@ pub fn sharp() -> Vec<SharpShape> {
             covers: "semi-sharp and infinite edges at a non-manifold crease vertex: a corner for good",
         },
         SharpShape {
+            name: "repeated_vertex",
+            surface: surface(
+                mesh(
+                    vec![
+                        DVec3::new(0.0, 0.0, 0.0),
+                        DVec3::new(1.0, 0.0, 0.0),
+                        DVec3::new(0.0, 1.0, 0.0),
+                        DVec3::new(1.0, 1.0, 0.3),
+                        DVec3::new(2.0, 0.5, 0.2),
+                    ],
+                    vec![vec![0, 1, 0, 2], vec![1, 3, 2, 0], vec![1, 4, 3]],
+                ),
+                &[(1, 3, 1.5)],
+                &[],
+                &[],
+                e,
+            ),
+            levels: 4,
+            covers: "a face using a vertex twice (repeated, non-manifold edges)",
+        },
+        SharpShape {
             name: "bowties",
             surface: surface(bowties(), &[], &[], &[], e),
             levels: 4,
