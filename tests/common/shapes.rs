@@ -667,6 +667,12 @@ pub fn sharp() -> Vec<SharpShape> {
             covers: "a pole of degenerate quads, valence 64",
         },
         SharpShape {
+            name: "quad_pole360",
+            surface: surface(quad_pole(360), &[], &[], &[], e),
+            levels: 3,
+            covers: "a pole of degenerate quads, valence 360",
+        },
+        SharpShape {
             name: "fin",
             surface: surface(book(3), &[], &[], &[], e),
             levels: 4,
