@@ -179,10 +179,7 @@ fn hash(mesh: &Mesh) -> Fnv {
 /// Refusals (input Catmull-Clark cannot refine, levels too large) and failures.
 fn refusal(e: SubdivError) -> Failure {
     let reason = match &e {
-        SubdivError::DegenerateFace { .. } => "degenerate-face",
-        SubdivError::NonManifoldEdge { .. } => "non-manifold-edge",
-        SubdivError::NonManifoldVertex { .. } => "non-manifold-vertex",
-        SubdivError::Inconsistent { .. } => "inconsistent-orientation",
+        SubdivError::Feature(_) => "feature-tags",
         SubdivError::TooLarge { .. } | SubdivError::Memory { .. } => "too-large",
         SubdivError::Fragment(_) => "fragment-mesh",
         SubdivError::GpuLimit(_) => "gpu-limit",
