@@ -149,6 +149,11 @@ impl Show {
             let (grid, volume) = binvox::read(&self.input)?;
             return Ok(Content::Voxels(grid, volume));
         }
+        if !self.voxels && self.boolean.is_none() && self.others.is_empty() {
+            // One mesh, with the sharp features of its OBJ tags (drawn as crease edges).
+            let tagged = crate::mesh::load_tagged(&self.input)?;
+            return Ok(Content::Surface(tagged.surface(Default::default())));
+        }
         let mesh = crate::mesh::load(&self.input)?;
         if let (Some(b), Some(op)) = (&self.boolean, self.op) {
             let other = crate::mesh::load(b)?;
@@ -158,9 +163,6 @@ impl Show {
         }
         if self.voxels {
             return Ok(Content::Voxelize(mesh, self.res));
-        }
-        if self.others.is_empty() {
-            return Ok(Content::Mesh(mesh));
         }
         let mut meshes = vec![(mesh, PALETTE[0])];
         for (i, other) in self.others.iter().enumerate() {

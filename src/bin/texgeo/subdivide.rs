@@ -9,7 +9,6 @@ use std::time::Instant;
 use texgeo::mesh::{Mesh, formats};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::gpu::{Options, Run, Subdivider};
-use texgeo::subdiv::tags::{self, Tagged, TaggedOptions};
 use texgeo::subdiv::{Boundary, CreaseMethod, Features, SubdivError, Surface, Triangles, cpu, crease, osd};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -185,19 +184,6 @@ fn check_size(
     Ok(())
 }
 
-/// Reads the input with its tags (a built-in model has none).
-fn load(input: &str) -> anyhow::Result<Tagged> {
-    if input.starts_with("builtin:") {
-        return Ok(Tagged {
-            mesh: crate::mesh::load(input)?,
-            features: Features::default(),
-            options: TaggedOptions::default(),
-            ignored: Vec::new(),
-        });
-    }
-    Ok(tags::read(input)?)
-}
-
 /// One line on the sharp features and options in force.
 fn describe_features(surface: &Surface) {
     let f = &surface.features;
@@ -231,7 +217,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         formats::Format::from_path(out)?;
         texgeo::output::check_file(out)?;
     }
-    let tagged = load(&args.input)?;
+    let tagged = crate::mesh::load_tagged(&args.input)?;
     for ignored in &tagged.ignored {
         say!("{}:{}: tag '{}' ignored: {}", args.input, ignored.line, ignored.name, ignored.why);
     }
