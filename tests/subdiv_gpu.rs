@@ -10,6 +10,7 @@ use common::shapes;
 use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::{Mesh, procedural};
+use texgeo::subdiv::assemble;
 use texgeo::subdiv::compare::{Comparison, Matching};
 use texgeo::subdiv::fragment::{self, FragmentMesh};
 use texgeo::subdiv::gpu::{MAX_RUNS, Options, Packing, Subdivider};
@@ -141,7 +142,7 @@ fn fragment_layout_on_the_cpu_equals_the_reference() {
         let levels = if shape.mesh.num_faces() > 500 { 1..=3 } else { 1..=4 };
         for level in levels {
             let surface = Surface::smooth(shape.mesh.clone());
-            let ours = fragment::refine(&surface, level).unwrap_or_else(|e| panic!("{}: {e}", shape.name));
+            let ours = assemble::refine(&surface, level).unwrap_or_else(|e| panic!("{}: {e}", shape.name));
             let reference = cpu::refine(&shape.mesh, level).unwrap();
             let c = Comparison::new(&ours.mesh, &reference, 1e-12);
             assert!(c.is_match(), "{} level {level}:\n{c}", shape.name);
@@ -150,7 +151,7 @@ fn fragment_layout_on_the_cpu_equals_the_reference() {
     for shape in shapes::sharp() {
         for level in 1..=shape.levels {
             let name = shape.name;
-            let ours = fragment::refine(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let ours = assemble::refine(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
             let reference = cpu::refine_surface(&shape.surface, level).unwrap();
             let c = Comparison::new(&ours.mesh, &reference.mesh, 1e-12);
             assert!(c.is_match(), "{name} level {level} ({}):\n{c}", shape.covers);
@@ -200,7 +201,8 @@ fn limits_give_clear_errors() {
     let err = Packing::new(&fragments, 3, 64, None).unwrap_err();
     assert!(err.to_string().contains("do not fit"), "{err}");
     // A row width that is not a power of two.
-    assert!(Packing::new(&fragments, 1, 16384, Some(100)).is_err());
+    let err = Packing::new(&fragments, 1, 16384, Some(100)).unwrap_err();
+    assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("power of two"), "{err}");
     // More distinct valences than the run table holds: bipyramids over 3…260-gons.
     let mut positions = Vec::new();
     let mut faces = Vec::new();
@@ -247,8 +249,7 @@ fn isolated_vertices_stay() {
 #[test]
 fn subdivide_command() {
     let exe = env!("CARGO_BIN_EXE_texgeo");
-    let dir = std::env::temp_dir().join(format!("texgeo-subdivide-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::TempDir::new("subdivide");
     let out = dir.join("out.off");
     let texgeo = |args: &[&str]| std::process::Command::new(exe).args(args).output().unwrap();
     let run = texgeo(&["subdivide", "builtin:pyramid", "-l", "3", "--validate", "-o", out.to_str().unwrap()]);
@@ -296,7 +297,6 @@ fn subdivide_command() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("cube.obj:20") && stderr.contains("not joined by an edge"), "{stderr}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Issue 12, item 7: meshes with coincident but distinct vertices. Two grids side by side
@@ -316,8 +316,7 @@ fn coincident_vertices_match_by_the_refinement() {
         assert_eq!(c.matching, Matching::Faces, "seam level {level}:\n{c}");
     }
     // And through the command line.
-    let dir = std::env::temp_dir().join(format!("texgeo-seam-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::TempDir::new("seam");
     let file = dir.join("seam.off");
     texgeo::mesh::formats::write(&file, &seam).unwrap();
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
@@ -326,7 +325,6 @@ fn coincident_vertices_match_by_the_refinement() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success() && stdout.contains("corresponding by faces"), "{stdout}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Every shape of the sharp set on the GPU equals OpenSubdiv (1e-5 × diagonal), faces in

@@ -28,9 +28,10 @@ use glam::DVec3;
 
 use crate::mesh::Mesh;
 
-use super::fragment::{Class, FragmentMesh};
+use super::cpu;
+use super::fragment::{Built, Class, FragmentMesh, sharp_edges};
 use super::topology::Topology;
-use super::{Result, SubdivError};
+use super::{Result, SubdivError, Surface};
 
 /// Builds the refined mesh from `stream`, the last fragment stream after `levels`
 /// fragment levels, in which every fragment holds its owned region (`2^levels` rings).
@@ -236,4 +237,21 @@ fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, 
             scope.spawn(move || work(b * per_block, block));
         }
     });
+}
+
+/// The whole fragment-mesh algorithm on the CPU in f64 (base level, [`FragmentMesh::refine_stream`] per level, assembly): the GPU path's arithmetic without a GPU, to
+/// test the layout, rules and welding exactly. Levels the fragments cannot reach are
+/// refined by [`cpu::refine_surface`].
+pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
+    let fragments = match FragmentMesh::build(surface, level)? {
+        Built::Fragments(f) => f,
+        Built::Cpu(_) => return cpu::refine_surface(surface, level),
+    };
+    let levels = level - fragments.cpu_levels();
+    let mut stream = fragments.base_stream(levels, 1, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
+    for j in 0..levels {
+        stream = fragments.refine_stream(&stream, j, levels);
+    }
+    let mesh = assemble(&fragments, &stream, levels, |p| DVec3::new(p[0], p[1], p[2]))?;
+    Ok(cpu::Refined { mesh, sharp_edges: sharp_edges(&fragments, levels) })
 }

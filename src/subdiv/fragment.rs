@@ -64,7 +64,6 @@ use glam::DVec3;
 
 use crate::mesh::Mesh;
 
-use super::assemble::assemble;
 use super::cpu::{self, Refiner, SharpEdge};
 use super::crease::{self, INFINITE, Method, Rule, SemiSharpSum};
 use super::topology::{NONE, Topology};
@@ -752,24 +751,6 @@ pub fn radii(levels: u32) -> Vec<u32> {
             j => (1 << j) + 1,
         })
         .collect()
-}
-
-/// The whole fragment-mesh algorithm on the CPU in f64 (base level, [`FragmentMesh::
-/// refine_stream`] per level, assembly): the GPU path's arithmetic without a GPU, to
-/// test the layout, rules and welding exactly. Levels the fragments cannot reach are
-/// refined by [`cpu::refine_surface`].
-pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
-    let fragments = match FragmentMesh::build(surface, level)? {
-        Built::Fragments(f) => f,
-        Built::Cpu(_) => return cpu::refine_surface(surface, level),
-    };
-    let levels = level - fragments.cpu_levels();
-    let mut stream = fragments.base_stream(levels, 1, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
-    for j in 0..levels {
-        stream = fragments.refine_stream(&stream, j, levels);
-    }
-    let mesh = assemble(&fragments, &stream, levels, |p| DVec3::new(p[0], p[1], p[2]))?;
-    Ok(cpu::Refined { mesh, sharp_edges: sharp_edges(&fragments, levels) })
 }
 
 /// A fragment of the input stream: positions and (when `data`) its spokes' sharpness.
