@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         resolutions: DEFAULT_RESOLUTIONS.to_vec(),
         methods: Method::ALL.to_vec(),
         runs: 3,
-        zone: None,
+        zone: texgeo::voxel::Zone::Auto,
     };
     let report = run(&ctx, &models, &cfg)?;
     println!("{}", report.to_markdown());

@@ -2,16 +2,20 @@
 //!
 //! `gpu` owns every Vulkan object; `mesh` is the polygon mesh and its formats;
 //! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top; `sweep`
-//! runs one of them over a whole mesh collection.
+//! runs one of them over a whole mesh collection; `output` writes every file atomically.
 
+pub mod boolean;
+pub mod exact;
 pub mod gpu;
 pub mod host;
 pub mod inclusion;
 pub mod mesh;
+pub mod output;
 pub mod random;
 pub mod render;
 pub mod report;
 pub mod subdiv;
 pub mod sweep;
+pub mod tetragrid;
 pub mod view;
 pub mod voxel;

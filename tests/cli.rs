@@ -1,25 +1,8 @@
 //! The `texgeo` command line: output, exit status 2 with one clear message on errors.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn texgeo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("texgeo-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use common::{TempDir, assert_refused, stderr, stdout, texgeo};
 
 #[test]
 fn info_names_the_device_and_logic_op() {
@@ -38,7 +21,8 @@ fn mesh_stats_and_convert() {
     assert!(out.contains("closed: yes, oriented: yes, manifold: yes"), "{out}");
     assert!(out.contains("Euler characteristic   2"), "{out}");
     assert!(out.contains("area                   24"), "{out}");
-    let obj = temp("knot.obj");
+    let dir = TempDir::new("cli-stats");
+    let obj = dir.join("knot.obj");
     let o = texgeo(&["mesh", "convert", "builtin:knot", obj.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = texgeo(&["mesh", "stats", obj.to_str().unwrap()]);
@@ -47,7 +31,8 @@ fn mesh_stats_and_convert() {
 
 #[test]
 fn errors_exit_2_with_one_message() {
-    let bad = temp("bad.off");
+    let dir = TempDir::new("cli-errors");
+    let bad = dir.join("bad.off");
     std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").unwrap();
     for (args, needle) in [
         (vec!["mesh", "stats", "no/such/file.off"], "no/such/file.off"),
@@ -56,24 +41,21 @@ fn errors_exit_2_with_one_message() {
         (vec!["mesh", "stats", "model.xyz"], "unknown mesh format"),
         (
             vec!["inclusion", "builtin:cube", "--random", "10", "--method", "magic"],
-            "unknown inclusion method 'magic'",
+            "invalid value 'magic' for '--method <METHOD>' [possible values: cpu, bvh",
         ),
     ] {
-        let o = texgeo(&args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}");
-        let err = stderr(&o);
-        assert!(err.starts_with("texgeo: error: ") && err.contains(needle), "{args:?}: {err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "one message: {err}");
+        assert_refused(&texgeo(&args), &[needle]);
     }
-    // clap's own usage errors also exit with 2.
-    assert_eq!(texgeo(&["inclusion"]).status.code(), Some(2));
+    // clap's own usage errors: status 2, one line too.
+    assert_refused(&texgeo(&["inclusion"]), &["--points <FILE>"]);
 }
 
 #[test]
 fn inclusion_writes_one_class_per_point() {
-    let pts = temp("points.txt");
+    let dir = TempDir::new("cli-inclusion");
+    let pts = dir.join("points.txt");
     std::fs::write(&pts, "# x y z\n0 0 0\n2 0 0\n1 0 0\n0.5 0.5 -0.5\n").unwrap();
-    let out = temp("classes.txt");
+    let out = dir.join("classes.txt");
     for method in ["cpu", "tetragrid", "gpu", "cpu+gpu", "gpu+tetragrid", "jordan", "winding"] {
         let o = texgeo(&[
             "inclusion",
@@ -95,22 +77,30 @@ fn inclusion_writes_one_class_per_point() {
 
 #[test]
 fn open_meshes_are_refused_unless_allowed() {
-    let open = temp("open.off");
+    let dir = TempDir::new("cli-open");
+    let open = dir.join("open.off");
     std::fs::write(&open, "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n").unwrap();
     let o = texgeo(&["inclusion", open.to_str().unwrap(), "--random", "10", "--method", "cpu"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("not closed"), "{}", stderr(&o));
-    let o =
-        texgeo(&["inclusion", open.to_str().unwrap(), "--random", "10", "--method", "cpu", "--allow-open"]);
+    assert_refused(&o, &["not closed", "--allow-open"]);
+    let o = texgeo(&[
+        "inclusion",
+        open.to_str().unwrap(),
+        "--random",
+        "10",
+        "--method",
+        "winding",
+        "--allow-open",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("warning"), "{}", stderr(&o));
 }
 
 #[test]
 fn voxelize_writes_binvox_slices_and_aspect() {
-    let out = temp("knot.binvox");
-    let slices = temp("knot-slices");
-    let aspect = temp("knot-aspect");
+    let dir = TempDir::new("cli-voxelize");
+    let out = dir.join("knot.binvox");
+    let slices = dir.join("knot-slices");
+    let aspect = dir.join("knot-aspect");
     let o = texgeo(&[
         "voxelize",
         "builtin:knot",
@@ -142,15 +132,129 @@ fn voxelize_writes_binvox_slices_and_aspect() {
     assert_eq!(std::fs::read_dir(&slices).unwrap().count(), 24);
     assert!(aspect.join("front.png").exists());
     // Too large a grid, an open mesh, an unknown method: one message, status 2.
+    let x = dir.arg("x.binvox");
     for (args, expect) in [
-        (vec!["voxelize", "builtin:cube", "--res", "5000", "-o", "x.binvox"], "1024"),
+        (vec!["voxelize", "builtin:cube", "--res", "5000", "-o", &x], "1024"),
         (
-            vec!["voxelize", "builtin:cube", "--res", "8", "--method", "magic", "-o", "x.binvox"],
-            "unknown method",
+            vec!["voxelize", "builtin:cube", "--res", "8", "--method", "magic", "-o", &x],
+            "[possible values: cpu, fgpu",
         ),
     ] {
-        let o = texgeo(&args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}");
-        assert!(stderr(&o).contains(expect), "{args:?}: {}", stderr(&o));
+        assert_refused(&texgeo(&args), &[expect]);
     }
+}
+
+#[test]
+fn numeric_options_must_be_finite_and_positive() {
+    let dir = TempDir::new("cli-numbers");
+    let out = dir.arg("x.binvox");
+    for (args, needle) in [
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "nan"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "inf"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--frequency", "0"], "--frequency"),
+        (vec!["voxelize", "builtin:cube", "--res", "0", "-o", &out], "resolution 0"),
+        (vec!["voxelize", "builtin:cube", "--res", "8", "-o", &out, "--zone", "0"], "--zone"),
+        (vec!["inclusion", "builtin:cube", "--random", "0"], "--random"),
+        (vec!["inclusion", "builtin:cube", "--random", "10", "--batch", "0"], "--batch"),
+        (vec!["bench", "xor", "--runs", "0"], "--runs"),
+        (vec!["bench", "inclusion", "--sets", "0"], "--sets"),
+    ] {
+        assert_refused(&texgeo(&args), &[needle]);
+    }
+    assert!(!dir.join("x.binvox").exists());
+    // `--zone auto` and a number are both fine.
+    for zone in ["auto", "5"] {
+        let o = texgeo(&[
+            "voxelize",
+            "builtin:cube",
+            "--res",
+            "8",
+            "--method",
+            "zoned",
+            "--zone",
+            zone,
+            "-o",
+            &out,
+        ]);
+        assert!(o.status.success(), "{zone}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn file_errors_say_the_os_error_once() {
+    let o = texgeo(&["voxelize", "builtin:cube", "--res", "8", "-o", "/nonexistent/texgeo/x.binvox"]);
+    assert_refused(&o, &["/nonexistent/texgeo/x.binvox"]);
+    let o = texgeo(&["mesh", "stats", "/nonexistent/texgeo/m.off"]);
+    assert_refused(&o, &["/nonexistent/texgeo/m.off: No such file or directory (os error 2)"]);
+    assert_eq!(stderr(&o).matches("os error").count(), 1, "{}", stderr(&o));
+}
+
+#[test]
+fn a_gpu_method_without_a_vulkan_driver_suggests_a_cpu_one() {
+    // No ICD: the loader finds no driver.
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(args)
+            .env("VK_DRIVER_FILES", "/nonexistent/texgeo-icd.json")
+            .env("VK_ICD_FILENAMES", "/nonexistent/texgeo-icd.json")
+            .env_remove("TEXGEO_VALIDATION")
+            .env_remove("TEXGEO_REQUIRE_VALIDATION")
+            .output()
+            .unwrap()
+    };
+    let dir = TempDir::new("cli-nodriver");
+    let out = dir.arg("x.binvox");
+    assert_refused(
+        &run(&["inclusion", "builtin:cube", "--random", "10", "--method", "gpu"]),
+        &["--method cpu"],
+    );
+    assert_refused(
+        &run(&["voxelize", "builtin:cube", "--res", "8", "--method", "pgpu", "-o", &out]),
+        &["--method cpu"],
+    );
+    assert_refused(&run(&["subdivide", "builtin:cube", "-l", "2", "--method", "gpu"]), &["--method cpu"]);
+    // The CPU methods do not need it.
+    let o = run(&["inclusion", "builtin:cube", "--random", "10", "--method", "cpu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn coordinates_that_overflow_area_or_volume_are_refused() {
+    let dir = TempDir::new("cli-huge");
+    let huge = dir.join("huge.off");
+    let m = texgeo::mesh::procedural::cube().map_positions(|p| p * 1e200).unwrap();
+    texgeo::mesh::formats::write(&huge, &m).unwrap();
+    let huge = huge.to_str().unwrap();
+    let out = dir.arg("x.binvox");
+    for args in [
+        vec!["mesh", "stats", huge],
+        vec!["inclusion", huge, "--random", "10", "--method", "cpu"],
+        vec!["voxelize", huge, "--res", "8", "--method", "cpu", "-o", &out],
+    ] {
+        assert_refused(&texgeo(&args), &["overflows f64", "1e200"]);
+    }
+}
+
+#[test]
+fn sizes_that_do_not_fit_are_refused_before_any_work() {
+    // Far more than any machine has: refused at once, with the estimate.
+    let o = texgeo(&[
+        "inclusion",
+        "builtin:cube",
+        "--random",
+        "100000000000000",
+        "--method",
+        "cpu",
+        "-o",
+        "/tmp/x.txt",
+    ]);
+    assert_refused(&o, &["100000000000000 points", "MiB", "of text"]);
+    let o = texgeo(&["subdivide", "builtin:knot", "-l", "10", "--method", "cpu", "-o", "/tmp/x.obj"]);
+    assert_refused(&o, &["level 10", "MiB", "/tmp/x.obj would be about"]);
+    assert!(!stdout(&o).contains("CPU reference"), "{}", stdout(&o));
+    let o = texgeo(&["subdivide", "builtin:cube", "-l", "40", "--method", "gpu"]);
+    assert_refused(&o, &["level 40", "32-bit"]);
+    assert!(!stdout(&o).contains("device"), "{}", stdout(&o));
+    let o = texgeo(&["voxelize", "builtin:cube", "--res", "100000", "-o", "/tmp/x.binvox"]);
+    assert_refused(&o, &["resolution 100000", "1024"]);
 }

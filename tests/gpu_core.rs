@@ -1,7 +1,7 @@
 //! The GPU core: context, reduction and XOR rasterization on the default device
 //! (lavapipe in `tools/test`), with validation on when `TEXGEO_VALIDATION=1`.
 
-use texgeo::gpu::{Context, TexFormat, Texture, XorRaster, reduce_sum};
+use texgeo::gpu::{Context, GpuError, TexFormat, Texture, XorRaster, reduce_sum};
 use texgeo::random::Rng;
 
 fn ctx() -> Context {
@@ -48,7 +48,10 @@ fn reduce_sum_pads_other_sizes() {
 #[test]
 fn reduce_sum_rejects_wrong_sizes() {
     let ctx = ctx();
-    assert!(reduce_sum(&ctx, &[[1.0; 4]; 3], 2, 2).is_err());
+    match reduce_sum(&ctx, &[[1.0; 4]; 3], 2, 2) {
+        Err(GpuError::Usage(m)) => assert!(m.contains("3 texels given for a 2×2 texture"), "{m}"),
+        other => panic!("expected a usage error, got {other:?}"),
+    }
 }
 
 #[test]
@@ -208,7 +211,7 @@ fn check_tiles(ctx: &Context, rng: &mut Rng, (w, h, tw, th, layers): (u32, u32, 
     // Tiles that are not powers of two are refused.
     if tw > 2 {
         let refused = ctx.submit(|rec| reducer.record_tiles(rec, &tex, [w, h], [tw - 1, th]).map(|_| ()));
-        assert!(refused.is_err());
+        assert!(matches!(&refused, Err(GpuError::Usage(m)) if m.contains("power of two")), "{refused:?}");
     }
 }
 
@@ -277,10 +280,14 @@ fn point_pass_puts_each_datum_on_its_own_texel() {
         assert_eq!(texel[1], expect, "texel {t}");
     }
     assert_eq!(out[7], [0.0; 4]);
+    let outside = Scatter::new(&ctx, Blend::Replace).unwrap().scatter(
+        &ctx,
+        4,
+        2,
+        &[Datum { texel: 8, value: [0.0; 4] }],
+    );
     assert!(
-        Scatter::new(&ctx, Blend::Replace)
-            .unwrap()
-            .scatter(&ctx, 4, 2, &[Datum { texel: 8, value: [0.0; 4] }])
-            .is_err()
+        matches!(&outside, Err(GpuError::Usage(m)) if m == "texel 8 outside a 4×2 target"),
+        "{outside:?}"
     );
 }

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 use texgeo::inclusion::cpu::{APEX_BALL, EdgeRule, FeitoTorres};
-use texgeo::inclusion::tetragrid::TetraGrid;
+use texgeo::inclusion::tetragrid::GridClassifier;
 use texgeo::inclusion::winding::WindingNumber;
 use texgeo::inclusion::{Class, Classifier, InclusionError, Method, Options, build};
 use texgeo::mesh::Mesh;
@@ -503,7 +503,7 @@ fn tetragrid_resolutions_and_cells() {
     let want = cpu.classify_all(&points);
     let mut bytes = 0;
     for n in [2, 5, 32, 64] {
-        let grid = TetraGrid::new(FeitoTorres::new(&knot).unwrap(), n).unwrap();
+        let grid = GridClassifier::new(FeitoTorres::new(&knot).unwrap(), n).unwrap();
         assert_eq!(grid.classify_all(&points), want, "n = {n}");
         // Every tetra that does not answer Outside for p is listed in p's cell.
         let eps = cpu.surface().eps();

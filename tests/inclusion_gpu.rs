@@ -6,7 +6,7 @@ use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::inclusion::gpu::{GpuInclusion, GpuOptions, Phase2};
 use texgeo::inclusion::gpu_grid::GpuGridInclusion;
-use texgeo::inclusion::tetragrid::TetraGrid;
+use texgeo::inclusion::tetragrid::GridClassifier;
 use texgeo::inclusion::winding::WindingNumber;
 use texgeo::inclusion::{Class, Classifier, FeitoTorres};
 use texgeo::mesh::{Mesh, procedural};
@@ -16,8 +16,8 @@ fn ctx() -> Context {
     Context::from_env().expect("a Vulkan device (run tools/setup)")
 }
 
-fn grid(mesh: &Mesh) -> TetraGrid {
-    TetraGrid::new(FeitoTorres::new(mesh).unwrap(), 16).unwrap()
+fn grid(mesh: &Mesh) -> GridClassifier {
+    GridClassifier::new(FeitoTorres::new(mesh).unwrap(), 16).unwrap()
 }
 
 /// Random points in the grown bounding box plus points on the surface and at the apex.
@@ -123,7 +123,7 @@ fn flat_tetras_fall_back_to_the_cpu() {
     let apex = DVec3::new(1.0, 0.3, -0.2);
     let grid = || {
         let ft = FeitoTorres::with_options(&mesh, Some(apex), texgeo::inclusion::EdgeRule::Rerun).unwrap();
-        TetraGrid::new(ft, 8).unwrap()
+        GridClassifier::new(ft, 8).unwrap()
     };
     let mut pts = query_points(&mesh, 2000, 9);
     // Points in the flat tetrahedra's plane, inside and outside the face.

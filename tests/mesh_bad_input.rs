@@ -1,21 +1,25 @@
 //! Bad files: every reader must fail with an error naming the file, the line (or byte
-//! offset) and the problem, never panic and never return part of a mesh.
+//! offset) and the problem, never panic and never return part of a mesh. The files are
+//! bytes in memory named like files (the readers behind `formats::read`), so parallel
+//! tests share nothing.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use texgeo::mesh::error::Location;
-use texgeo::mesh::formats::{self, ply, stl};
+use texgeo::mesh::formats::{self, Format, ply, stl};
 use texgeo::mesh::{MeshError, procedural};
 
-/// Writes `bytes` to a fresh file `name` and checks that reading it fails at `location`
-/// with a message containing `message`.
+/// Reads `bytes` as the file `name` (format from its extension), as `formats::read` does.
+fn read_named(name: &str, bytes: &[u8]) -> texgeo::mesh::Result<texgeo::mesh::Mesh> {
+    let path = Path::new(name);
+    formats::read_bytes(bytes, Format::from_path(path)?, path)
+}
+
+/// Checks that reading `bytes` as the file `name` fails at `location` with a message
+/// containing `message`.
 fn expect(name: &str, bytes: &[u8], location: Location, message: &str) {
-    let dir = std::env::temp_dir().join(format!("texgeo-bad-input-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file: PathBuf = dir.join(name);
-    std::fs::write(&file, bytes).unwrap();
-    let result = formats::read(&file);
-    std::fs::remove_file(&file).unwrap();
+    let file = PathBuf::from(name);
+    let result = read_named(name, bytes);
     let err = match result {
         Ok(m) => panic!("{name}: read a mesh with {} faces instead of failing", m.num_faces()),
         Err(e) => e,
@@ -58,8 +62,15 @@ fn unknown_or_missing_extension() {
 #[test]
 fn missing_file_is_an_io_error_naming_it() {
     let err = formats::read("/nonexistent/texgeo/x.obj").unwrap_err();
-    assert!(matches!(err, MeshError::Io { .. }));
-    assert!(err.to_string().starts_with("/nonexistent/texgeo/x.obj: "), "{err}");
+    match &err {
+        MeshError::Io { path, error } => {
+            assert_eq!(path, Path::new("/nonexistent/texgeo/x.obj"));
+            assert_eq!(error.kind(), std::io::ErrorKind::NotFound);
+        }
+        other => panic!("not an I/O error: {other}"),
+    }
+    // The OS error once, after the path.
+    assert_eq!(err.to_string(), "/nonexistent/texgeo/x.obj: No such file or directory (os error 2)");
 }
 
 // ---------------------------------------------------------------- OBJ
@@ -430,12 +441,7 @@ fn stl_binary_non_finite_coordinates() {
     // The facet normal is not used, so a NaN there is fine.
     let mut b = binary_cube_stl();
     b[84..88].copy_from_slice(&f32::NAN.to_le_bytes());
-    let dir = std::env::temp_dir().join(format!("texgeo-bad-input-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("normal.stl");
-    std::fs::write(&file, &b).unwrap();
-    assert_eq!(formats::read(&file).unwrap().num_faces(), 12);
-    std::fs::remove_file(&file).unwrap();
+    assert_eq!(read_named("normal.stl", &b).unwrap().num_faces(), 12);
 }
 
 const ASCII_FACET: &str =
@@ -483,9 +489,40 @@ fn replace_bytes(bytes: Vec<u8>, marker: &str, with: &[u8]) -> Vec<u8> {
 
 // ---------------------------------------------------------------- mutations
 
+/// `mesh convert` of a mesh to every format and back: exact for the polygon formats; for
+/// binary STL, the triangulated mesh rounded to f32 (same area and volume), or a clear
+/// error when a coordinate does not fit f32.
+fn converts_back(m: &texgeo::mesh::Mesh) {
+    use texgeo::mesh::covering::Covering;
+    use texgeo::mesh::formats::Format;
+    for format in [Format::Obj, Format::Off, Format::Ply] {
+        let mut bytes = Vec::new();
+        formats::write_to(&mut bytes, m, format).unwrap();
+        assert_eq!(&formats::read_bytes(&bytes, format, Path::new("back")).unwrap(), m, "{format:?}");
+    }
+    let mut bytes = Vec::new();
+    match formats::write_to(&mut bytes, m, Format::Stl) {
+        Ok(()) => {
+            let back = formats::read_bytes(&bytes, Format::Stl, Path::new("back.stl")).unwrap();
+            let want =
+                texgeo::mesh::triangulate::triangulated(m).map_positions(|p| p.as_vec3().as_dvec3()).unwrap();
+            let (a, b) = (Covering::new(&back), Covering::new(&want));
+            let same = |x: f64, y: f64| x == y || (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+            assert!(same(a.area(), b.area()), "{} vs {}", a.area(), b.area());
+            assert!(
+                same(a.volume(), b.volume()) || !b.volume().is_finite(),
+                "{} vs {}",
+                a.volume(),
+                b.volume()
+            );
+        }
+        Err(e) => assert!(e.to_string().contains("does not fit binary STL"), "{e}"),
+    }
+}
+
 /// Random byte flips, cuts and insertions in valid files of every format: a reader may
-/// accept the result (then it is a valid mesh by construction) or reject it with a
-/// parse error, but never panic.
+/// accept the result (then it is a valid mesh by construction, which converts to every
+/// format and back) or reject it with a parse error, but never panic.
 #[test]
 fn mutated_files_never_panic() {
     use texgeo::mesh::formats::Format;
@@ -523,6 +560,7 @@ fn mutated_files_never_panic() {
                 Ok(m) => {
                     accepted += 1;
                     assert!(m.num_faces() > 0);
+                    converts_back(&m);
                 }
                 Err(MeshError::Parse { .. }) => rejected += 1,
                 Err(e) => panic!("{format:?}: not a parse error: {e}"),

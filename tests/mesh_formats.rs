@@ -1,11 +1,15 @@
 //! Round trips of every built-in model through every format, and readers on hand-made
 //! files that use the formats' less common features.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
+use texgeo::mesh::covering::Covering;
 use texgeo::mesh::formats::{self, Format, obj, off, ply, stl};
 use texgeo::mesh::procedural::{self, BUILTIN_NAMES};
+use texgeo::mesh::triangulate;
 use texgeo::mesh::{Mesh, Result};
 
 fn models() -> Vec<(&'static str, Mesh)> {
@@ -51,11 +55,11 @@ fn obj_off_ply_round_trips_are_exact() {
     }
 }
 
-/// The fan triangles of `mesh` as f32-rounded coordinates.
+/// The triangles of `mesh` (as STL gets them) as f32-rounded coordinates.
 fn f32_triangles(mesh: &Mesh) -> Vec<[[f32; 3]; 3]> {
     let p = mesh.positions();
     let r = |i: u32| p[i as usize].to_array().map(|c| c as f32);
-    mesh.faces().flat_map(|f| f.windows(2).skip(1).map(move |w| [r(f[0]), r(w[0]), r(w[1])])).collect()
+    triangulate::triangles(mesh).map(|[a, b, c]| [r(a), r(b), r(c)]).collect()
 }
 
 #[test]
@@ -66,7 +70,7 @@ fn stl_round_trips_are_f32_exact_and_welded() {
         assert_eq!(f32_triangles(&back), f32_triangles(&mesh), "{name}");
         // Welding restores the shared vertices, so the topology survives.
         assert_eq!(back.num_vertices(), mesh.num_vertices(), "{name}");
-        // Fan triangulation adds as many edges as faces: χ and the flags stay.
+        // Triangulation adds as many edges as triangles beyond the faces: χ and the flags stay.
         let summary = |m: &Mesh| {
             let r = m.report();
             (r.is_closed(), r.is_oriented(), r.is_manifold(), r.euler_characteristic, r.components)
@@ -84,24 +88,78 @@ fn ascii_stl_round_trip_is_exact_in_f64() {
         let p = |m: &Mesh| -> Vec<DVec3> {
             m.faces().flat_map(|f| f.iter().map(|&i| m.positions()[i as usize]).collect::<Vec<_>>()).collect()
         };
-        let fan: Vec<DVec3> = mesh
-            .faces()
-            .flat_map(|f| f.windows(2).skip(1).flat_map(move |w| [f[0], w[0], w[1]]))
-            .map(|i| mesh.positions()[i as usize])
-            .collect();
+        let fan: Vec<DVec3> =
+            triangulate::triangles(&mesh).flatten().map(|i| mesh.positions()[i as usize]).collect();
         assert_eq!(p(&back), fan, "{name}");
         assert_eq!(back.num_vertices(), mesh.num_vertices(), "{name}");
         assert!(back.report().is_closed(), "{name}");
     }
 }
 
+/// A writer of one format.
+type Writer = fn(&mut Vec<u8>, &Mesh) -> std::io::Result<()>;
+
+/// (area, volume) from the simplicial covering.
+fn measures(mesh: &Mesh) -> (f64, f64) {
+    let c = Covering::new(mesh);
+    (c.area(), c.volume())
+}
+
+#[test]
+fn convert_keeps_area_and_volume_in_every_format() {
+    // Every built-in (the star's 10-gon caps are not covered by any vertex fan), and a
+    // comb-shaped prism whose teeth a fan from the first vertex folds over.
+    let comb = [
+        (0.0, 0.0),
+        (5.0, 0.0),
+        (5.0, 2.0),
+        (4.0, 2.0),
+        (4.0, 1.0),
+        (3.0, 1.0),
+        (3.0, 2.0),
+        (2.0, 2.0),
+        (2.0, 1.0),
+        (1.0, 1.0),
+        (1.0, 2.0),
+        (0.0, 2.0),
+    ];
+    let mut all = models();
+    all.push(("comb", procedural::prism(&comb, 0.75).unwrap()));
+    for (name, mesh) in all {
+        let (area, volume) = measures(&mesh);
+        let writers: [(&str, Format, Writer); 6] = [
+            ("obj", Format::Obj, |w, m| obj::write(w, m)),
+            ("off", Format::Off, |w, m| off::write(w, m)),
+            ("ply", Format::Ply, |w, m| ply::write(w, m)),
+            ("ascii ply", Format::Ply, |w, m| ply::write_ascii(w, m)),
+            ("stl", Format::Stl, |w, m| stl::write(w, m)),
+            ("ascii stl", Format::Stl, |w, m| stl::write_ascii(w, m)),
+        ];
+        for (label, format, write) in writers {
+            let mut bytes = Vec::new();
+            write(&mut bytes, &mesh).unwrap();
+            let back = formats::read_bytes(&bytes, format, &path(name)).unwrap();
+            let (a, v) = measures(&back);
+            // Binary STL rounds coordinates to f32: compare with the rounded mesh's measures
+            // (the triangulation itself must keep them, checked below).
+            let (area, volume) = if label == "stl" {
+                measures(&mesh.map_positions(|p| p.as_vec3().as_dvec3()).unwrap())
+            } else {
+                (area, volume)
+            };
+            let ok = |x: f64, want: f64| (x - want).abs() <= 1e-11 * want.abs().max(1e-300);
+            assert!(ok(a, area), "{name} as {label}: area {a} instead of {area}");
+            assert!(ok(v, volume), "{name} as {label}: volume {v} instead of {volume}");
+        }
+    }
+}
+
 #[test]
 fn files_on_disk_by_extension() {
-    let dir = std::env::temp_dir().join(format!("texgeo-mesh-formats-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::TempDir::new("mesh-formats");
     let knot = procedural::torus_knot();
     for ext in ["obj", "off", "ply", "stl", "OBJ"] {
-        let file = dir.join(format!("knot.{ext}"));
+        let file = dir.join(&format!("knot.{ext}"));
         formats::write(&file, &knot).unwrap();
         let back = formats::read(&file).unwrap();
         assert_eq!(back.num_faces(), 1200);
@@ -111,7 +169,6 @@ fn files_on_disk_by_extension() {
         }
     }
     assert_eq!(Format::from_path(Path::new("a/b.Ply")).unwrap(), Format::Ply);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 const OBJ_CUBE_IN_GROUPS: &str = "\
@@ -337,4 +394,36 @@ fn off_reads_what_the_thesis_files_use() {
     let m = off::read(text.as_bytes(), &path("t.off")).unwrap();
     assert_eq!((m.num_vertices(), m.num_faces()), (4, 4));
     assert!(m.report().is_closed());
+}
+
+#[test]
+fn text_formats_accept_a_byte_order_mark() {
+    let mesh = procedural::pyramid();
+    let bom = b"\xef\xbb\xbf";
+    let writers: [(Format, Writer); 4] = [
+        (Format::Obj, |w, m| obj::write(w, m)),
+        (Format::Off, |w, m| off::write(w, m)),
+        (Format::Ply, |w, m| ply::write_ascii(w, m)),
+        (Format::Stl, |w, m| stl::write_ascii(w, m)),
+    ];
+    for (format, write) in writers {
+        let mut bytes = bom.to_vec();
+        write(&mut bytes, &mesh).unwrap();
+        let back =
+            formats::read_bytes(&bytes, format, &path("bom")).unwrap_or_else(|e| panic!("{format:?}: {e}"));
+        let want = if format == Format::Stl { triangulate::triangulated(&mesh) } else { mesh.clone() };
+        assert_eq!(back.num_faces(), want.num_faces(), "{format:?}");
+        assert_eq!(measures(&back), measures(&want), "{format:?}");
+    }
+    // A binary PLY's header may carry one too.
+    let mut bytes = bom.to_vec();
+    ply::write(&mut bytes, &mesh).unwrap();
+    assert_eq!(ply::read(&bytes, &path("bom.ply")).unwrap(), mesh);
+    // And a point file.
+    let pts =
+        texgeo::inclusion::points::parse(b"\xef\xbb\xbf# points\n0 0 0\n1 2 3\n", &path("p.txt")).unwrap();
+    assert_eq!(pts, vec![DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0)]);
+    // Errors still name the right line and byte.
+    let e = formats::read_bytes(b"\xef\xbb\xbfOFF\n1 0 0\n0 y 0\n", Format::Off, &path("b.off")).unwrap_err();
+    assert!(e.to_string().ends_with("b.off:3: 'y' is not a number"), "{e}");
 }

@@ -1,6 +1,8 @@
 //! Every shader source under glsl/ also passes the reference compiler, glslangValidator
 //! (build.rs compiles them with shaderc; two front ends catch more mistakes).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -21,7 +23,8 @@ fn glslang_validator_accepts_every_shader() {
     let mut files = Vec::new();
     sources(&root.join("glsl"), &mut files);
     assert!(files.len() >= 4, "expected shaders under glsl/, found {files:?}");
-    let out = std::env::temp_dir().join(format!("texgeo-glslang-{}.spv", std::process::id()));
+    let dir = common::TempDir::new("glslang");
+    let out = dir.join("shader.spv");
     for f in &files {
         let result = Command::new("glslangValidator")
             .args(["-V", "--target-env", "vulkan1.3"])

@@ -1,4 +1,4 @@
-//! Voxelization (issue 4): every method gives the identical bit volume, equal to the
+//! Voxelization: every method gives the identical bit volume, equal to the
 //! exact inclusion test at every voxel centre, on built-in solids (holed, non-manifold,
 //! polygon faces, a cavity) and on solids built so voxel centres fall exactly on faces,
 //! edges and vertices (the tie rule) or a hair off them (the GPU fallback bound). Runs on

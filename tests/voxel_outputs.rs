@@ -8,16 +8,13 @@ use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::procedural;
 use texgeo::random::Rng;
+use texgeo::tetragrid::{Cells, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::tetragrid::{self, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::{Grid, Method, binvox, pictures, voxelize};
 
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("texgeo-voxel-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+
+use common::TempDir;
 
 #[test]
 fn binvox_round_trips_exactly() {
@@ -31,11 +28,10 @@ fn binvox_round_trips_exactly() {
         assert_eq!(grid, r.grid);
         assert_eq!(volume, r.volume);
         // Through a file as well.
-        let dir = temp_dir("binvox");
+        let dir = TempDir::new("voxel-binvox");
         let path = dir.join("v.binvox");
         binvox::write(&path, &r.grid, &r.volume).unwrap();
         assert_eq!(binvox::read(&path).unwrap(), (r.grid, r.volume.clone()));
-        std::fs::remove_dir_all(dir).unwrap();
     }
 }
 
@@ -75,8 +71,8 @@ fn bad_binvox_files_are_rejected_with_a_reason() {
 #[test]
 fn slice_pngs_show_the_slices() {
     let r = voxelize(None, &procedural::torus(1.0, 0.4, 24, 12), 24, Method::Cpu).unwrap();
-    let dir = temp_dir("slices");
-    let files = pictures::write_slices(&r.volume, &dir).unwrap();
+    let dir = TempDir::new("voxel-slices");
+    let files = pictures::write_slices(&r.volume, dir.path()).unwrap();
     assert_eq!(files.len(), 24);
     for (j, f) in files.iter().enumerate() {
         let img = image::open(f).unwrap().to_luma8();
@@ -85,7 +81,6 @@ fn slice_pngs_show_the_slices() {
             assert_eq!(p.0[0] == 255, r.volume.get(i as usize, j, k as usize));
         }
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -135,6 +130,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
     let mut rng = Rng::new(45);
     for n in [7usize, 16, 32] {
         let grid = Grid::new(n, DVec3::ZERO, 1.0).unwrap();
+        let cells_of = Cells::new(grid.min, grid.h(), n);
         let h = grid.h();
         for _ in 0..60 {
             let t = random_tetra(&mut rng);
@@ -144,7 +140,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                 Growth::CellBox { extra: 0.0 },
             ] {
                 let mut cells = Vec::new();
-                tetragrid::cells(&grid, &t, growth, &mut cells);
+                cells_of.rasterize(&t, growth, |c| cells.push(c as u32));
                 let listed: std::collections::HashSet<u32> = cells.iter().copied().collect();
                 assert_eq!(listed.len(), cells.len(), "no duplicates");
                 let mut touched = 0;
@@ -154,7 +150,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                             let lo = grid.min + DVec3::new(i as f64, j as f64, k as f64) * h;
                             if tetra_box_overlap(&t, lo, lo + DVec3::splat(h)) {
                                 touched += 1;
-                                let c = tetragrid::cell_index(n, i, j, k) as u32;
+                                let c = cells_of.index([i, j, k]) as u32;
                                 assert!(listed.contains(&c), "n {n} {growth:?}: cell ({i},{j},{k}) of {t:?}");
                             }
                         }
@@ -174,7 +170,7 @@ fn conservative_rasterization_never_misses_a_touched_cell() {
                 let reach = (offset + 1.0) * h * 3f64.sqrt();
                 for &c in &cells {
                     let c = c as usize;
-                    let (i, k, j) = (c % n, c / n % n, c / (n * n));
+                    let (i, j, k) = (c % n, c / n % n, c / (n * n));
                     let centre = grid.centre(i, j, k);
                     assert!(
                         centre.cmpge(tlo - DVec3::splat(reach)).all()
@@ -202,13 +198,15 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
     let mesh = procedural::torus_knot();
     let solid = texgeo::voxel::Solid::new(&mesh).unwrap();
     let grid = Grid::for_mesh(&mesh, 16).unwrap();
+    let cells = Cells::new(grid.min, grid.h(), 16);
     let tetras = solid.tetras();
     for growth in
         [Growth::CellBox { extra: 0.0 }, Growth::Diagonals(MIN_OFFSET), Growth::Diagonals(SPEC_OFFSET)]
     {
-        let tg = TetraGrid::build(&grid, &tetras, growth).unwrap();
-        assert_eq!(tg.offsets.len(), 16 * 16 * 16 + 1);
-        assert_eq!(*tg.offsets.last().unwrap() as usize, tg.tetras.len());
+        let tg = TetraGrid::of_tetras(cells, &tetras, growth).unwrap();
+        let (start, ids) = tg.lists();
+        assert_eq!(start.len(), 16 * 16 * 16 + 1);
+        assert_eq!(*start.last().unwrap() as usize, ids.len());
         let mut rng = Rng::new(3);
         // A point inside a tetra is found in its cell's list.
         for _ in 0..2000 {
@@ -220,7 +218,7 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
             assert!(tg.tetras_at(p).binary_search(&(id as u32)).is_ok(), "tetra {id} at {p}");
         }
     }
-    let size = |g| TetraGrid::build(&grid, &tetras, g).unwrap().tetras.len();
+    let size = |g| TetraGrid::of_tetras(cells, &tetras, g).unwrap().lists().1.len();
     let (tight, small, spec) = (
         size(Growth::CellBox { extra: 0.0 }),
         size(Growth::Diagonals(MIN_OFFSET)),
@@ -231,7 +229,7 @@ fn tetragrid_lists_every_tetra_of_a_solid_in_its_cells() {
 
 #[test]
 fn the_inclusion_tetragrid_uses_the_conservative_rasterizer() {
-    use texgeo::inclusion::tetragrid::TetraGrid as InclusionGrid;
+    use texgeo::inclusion::tetragrid::GridClassifier as InclusionGrid;
     use texgeo::inclusion::{Classifier, FeitoTorres};
     for mesh in
         [procedural::torus_knot(), procedural::cube_with_cavity(), procedural::two_cubes_sharing_edge()]

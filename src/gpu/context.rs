@@ -141,6 +141,9 @@ pub(crate) struct Device {
     pub queue: Mutex<vk::Queue>,
     pub command_pool: Mutex<vk::CommandPool>,
     pub allocator: ManuallyDrop<Mutex<Allocator>>,
+    /// Failures seen where they cannot be returned (freeing memory in `Drop`): reported by
+    /// the next [`Device::check_validation`] and at teardown.
+    problems: Mutex<Vec<String>>,
     /// NEAREST, clamp-to-edge: the texture era reads texels with `texelFetch` only.
     pub sampler: vk::Sampler,
     pub info: DeviceInfo,
@@ -150,6 +153,7 @@ impl Drop for Device {
     fn drop(&mut self) {
         // SAFETY: every resource holds an Arc<Device>, so none is alive here; wait for
         // the queue, then destroy in reverse creation order (allocator before device).
+        let leaks = self.leaks();
         unsafe {
             let _ = self.raw.device_wait_idle();
             self.raw.destroy_sampler(self.sampler, None);
@@ -185,19 +189,61 @@ impl Drop for Device {
                 }
             }
         }
+        // Leaks and failed frees are bugs: loud under validation (tests), a warning otherwise.
+        if !leaks.is_empty() {
+            eprintln!("texgeo: GPU memory problems at teardown:\n{}", leaks.join("\n"));
+            if self.log.is_some() && !std::thread::panicking() {
+                panic!("{} GPU memory problem(s) at teardown: {}", leaks.len(), leaks.join("; "));
+            }
+        }
     }
 }
 
 impl Device {
-    /// Validation errors since the last check, as an error.
+    /// Validation errors and memory problems since the last check, as an error.
     pub fn check_validation(&self) -> Result<()> {
-        match &self.log {
-            Some(log) => {
-                let errors = log.take();
-                if errors.is_empty() { Ok(()) } else { Err(GpuError::Validation(errors)) }
-            }
-            None => Ok(()),
+        let errors = self.log.as_ref().map(|log| log.take()).unwrap_or_default();
+        if !errors.is_empty() {
+            return Err(GpuError::Validation(errors));
         }
+        let problems = self.problems.lock().map(|mut p| std::mem::take(&mut *p)).unwrap_or_default();
+        if problems.is_empty() { Ok(()) } else { Err(GpuError::Release(problems)) }
+    }
+
+    /// Records a failure that happened where it could not be returned (in a `Drop`).
+    pub fn report_problem(&self, problem: String) {
+        match self.problems.lock() {
+            Ok(mut p) => p.push(problem),
+            Err(_) => eprintln!("texgeo: GPU problem: {problem}"),
+        }
+    }
+
+    /// Frees `allocation` (of the resource `what`), recording a failure instead of ignoring it.
+    pub fn free(&self, allocation: gpu_allocator::vulkan::Allocation, what: &str) {
+        let freed = match self.allocator.lock() {
+            Ok(mut a) => a.free(allocation).map_err(|e| e.to_string()),
+            Err(_) => Err("the allocator lock is poisoned".into()),
+        };
+        if let Err(e) = freed {
+            self.report_problem(format!("freeing the memory of {what}: {e}"));
+        }
+    }
+
+    /// Allocations still alive and failures not yet reported: at teardown, each is a leak
+    /// or a lost error.
+    fn leaks(&self) -> Vec<String> {
+        let mut out: Vec<String> =
+            self.problems.lock().map(|mut p| std::mem::take(&mut *p)).unwrap_or_default();
+        if let Ok(a) = self.allocator.lock() {
+            let report = a.generate_report();
+            out.extend(
+                report
+                    .allocations
+                    .iter()
+                    .map(|r| format!("leaked GPU allocation '{}' ({} bytes)", r.name, r.size)),
+            );
+        }
+        out
     }
 }
 
@@ -538,11 +584,14 @@ impl Context {
             .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        // Leaks are reported by `Device::drop` itself, loudly (gpu-allocator would only log).
+        let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
+        debug_settings.log_leaks_on_shutdown = false;
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: inst.instance.clone(),
             device: raw.clone(),
             physical_device: physical,
-            debug_settings: Default::default(),
+            debug_settings,
             buffer_device_address: false,
             allocation_sizes: Default::default(),
         });
@@ -593,6 +642,7 @@ impl Context {
             queue: Mutex::new(queue),
             command_pool: Mutex::new(command_pool),
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            problems: Mutex::new(Vec::new()),
             sampler,
             info,
         };
@@ -641,8 +691,7 @@ impl Context {
         record: impl FnOnce(&mut Recorder) -> Result<T>,
     ) -> Result<T> {
         let dev = &self.dev;
-        let pool =
-            dev.command_pool.lock().map_err(|_| GpuError::Usage("command pool lock poisoned".into()))?;
+        let pool = dev.command_pool.lock().map_err(|_| GpuError::Internal("command pool lock poisoned"))?;
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(*pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -683,7 +732,7 @@ impl Context {
                 .wait_semaphore_infos(&waits)
                 .signal_semaphore_infos(&signals)];
             let waited = (|| {
-                let queue = dev.queue.lock().map_err(|_| GpuError::Usage("queue lock poisoned".into()))?;
+                let queue = dev.queue.lock().map_err(|_| GpuError::Internal("queue lock poisoned"))?;
                 // SAFETY: the command buffer is complete; the fence is unsignalled.
                 unsafe { dev.raw.queue_submit2(*queue, &submit, fence) }.vk("vkQueueSubmit2")?;
                 drop(queue);
@@ -705,5 +754,38 @@ impl Context {
     /// Returns `GpuError::Validation` if the layer logged errors since the last check.
     pub fn check_validation(&self) -> Result<()> {
         self.dev.check_validation()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_leaked_allocation_fails_at_teardown() {
+        let options = ContextOptions { validation: Some(true), ..ContextOptions::default() };
+        let ctx = Context::new(&options).expect("a Vulkan device with the validation layer (tools/setup)");
+        let requirements = vk::MemoryRequirements { size: 256, alignment: 16, memory_type_bits: !0 };
+        let leaked = ctx
+            .dev
+            .allocator
+            .lock()
+            .unwrap()
+            .allocate(&gpu_allocator::vulkan::AllocationCreateDesc {
+                name: "leaky test allocation",
+                requirements,
+                location: gpu_allocator::MemoryLocation::CpuToGpu,
+                linear: true,
+                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+            })
+            .unwrap();
+        std::mem::forget(leaked);
+        let teardown = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| drop(ctx)));
+        let message = teardown.expect_err("a leak must fail loudly").downcast::<String>().unwrap();
+        assert!(
+            message.contains("leaky test allocation (256 bytes)")
+                || message.contains("'leaky test allocation'"),
+            "{message}"
+        );
     }
 }

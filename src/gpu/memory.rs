@@ -38,7 +38,7 @@ impl Buffer {
         // SAFETY: `raw` was just created.
         let requirements = unsafe { dev.raw.get_buffer_memory_requirements(raw) };
         let allocated =
-            dev.allocator.lock().map_err(|_| GpuError::Usage("allocator lock poisoned".into())).and_then(
+            dev.allocator.lock().map_err(|_| GpuError::Internal("allocator lock poisoned")).and_then(
                 |mut a| {
                     Ok(a.allocate(&AllocationCreateDesc {
                         name,
@@ -58,7 +58,7 @@ impl Buffer {
             }
         };
         let buffer = Buffer { dev, raw, allocation: Some(allocation), size };
-        let a = buffer.allocation.as_ref().ok_or_else(|| GpuError::Usage("buffer without memory".into()))?;
+        let a = buffer.allocation.as_ref().ok_or(GpuError::Internal("buffer without memory"))?;
         // SAFETY: memory and offset come from the allocator for this buffer's requirements.
         unsafe { buffer.dev.raw.bind_buffer_memory(raw, a.memory(), a.offset()) }.vk("vkBindBufferMemory")?;
         Ok(buffer)
@@ -107,7 +107,7 @@ impl Buffer {
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
-            .ok_or_else(|| GpuError::Usage("buffer memory is not host-visible".into()))?;
+            .ok_or(GpuError::Internal("buffer memory is not host-visible"))?;
         let start = offset as usize;
         let end = start.checked_add(bytes.len()).filter(|&e| e as u64 <= size).ok_or_else(|| {
             GpuError::Usage(format!(
@@ -134,7 +134,7 @@ impl Buffer {
     pub fn view<T: Pod>(&self) -> Result<&[T]> {
         let bytes = self.bytes()?;
         if bytes.as_ptr().align_offset(std::mem::align_of::<T>()) != 0 {
-            return Err(GpuError::Usage("mapped buffer memory is not aligned for this type".into()));
+            return Err(GpuError::Internal("mapped buffer memory is not aligned for this type"));
         }
         let n = bytes.len() / std::mem::size_of::<T>();
         // SAFETY: aligned (checked), `n` values lie inside the mapped bytes, Pod accepts any
@@ -149,16 +149,14 @@ impl Buffer {
             .as_ref()
             .and_then(|a| a.mapped_slice())
             .map(|s| &s[..size.min(s.len())])
-            .ok_or_else(|| GpuError::Usage("buffer memory is not host-visible".into()))
+            .ok_or(GpuError::Internal("buffer memory is not host-visible"))
     }
 }
 
 impl Drop for Buffer {
     fn drop(&mut self) {
         if let Some(a) = self.allocation.take() {
-            if let Ok(mut allocator) = self.dev.allocator.lock() {
-                let _ = allocator.free(a);
-            }
+            self.dev.free(a, "a buffer");
         }
         // SAFETY: submissions wait for completion, so the buffer is idle.
         unsafe { self.dev.raw.destroy_buffer(self.raw, None) };

@@ -354,8 +354,7 @@ impl<'d> Recorder<'d> {
         reads: &'p [&'p Texture],
         draw: impl FnOnce(&mut RenderScope<'_, 'p>) -> Result<T>,
     ) -> Result<T> {
-        let first =
-            targets.colour.first().ok_or_else(|| GpuError::Usage("a render pass needs a target".into()))?;
+        let first = targets.colour.first().ok_or(GpuError::Internal("a render pass without a target"))?;
         let area = area.unwrap_or([0, 0, first.texture.width(), first.texture.height()]);
         let samples = first.texture.samples();
         let fits = |t: &Texture| {
@@ -561,7 +560,7 @@ impl<'p> RenderScope<'_, 'p> {
     }
 
     fn bound(&self) -> Result<&'p Pipeline> {
-        self.pipeline.ok_or_else(|| GpuError::Usage("bind a pipeline before drawing".into()))
+        self.pipeline.ok_or(GpuError::Internal("draw without a bound pipeline"))
     }
 
     /// Binds textures (sampled with `texelFetch`) to set-0 bindings. Each must have been
@@ -638,7 +637,7 @@ impl<'p> RenderScope<'_, 'p> {
         let p = self.bound()?;
         let bytes = as_bytes(data);
         let Some((stages, offset, size)) = p.push else {
-            return Err(GpuError::Usage("the bound pipeline has no push constants".into()));
+            return Err(GpuError::Internal("push constants for a pipeline without any"));
         };
         if offset != 0 || bytes.len() as u32 != size {
             return Err(GpuError::Usage(format!(

@@ -155,5 +155,5 @@ pub fn reduce_sum(ctx: &Context, data: &[[f32; 4]], width: u32, height: u32) -> 
     let mut reducer = Reducer::new(ctx, width, height, 1)?;
     ctx.submit(|rec| rec.upload(&tex, 0, data))?;
     let sums = reducer.sum(ctx, &tex, width, height)?;
-    sums.first().copied().ok_or_else(|| GpuError::Usage("empty readback".into()))
+    sums.first().copied().ok_or(GpuError::Internal("empty readback"))
 }

@@ -254,18 +254,16 @@ impl Texture {
         // From here on `tex`'s Drop cleans up whatever was created if a step fails.
         // SAFETY: the image was just created.
         let requirements = unsafe { tex.dev.raw.get_image_memory_requirements(image) };
-        let allocation = tex
-            .dev
-            .allocator
-            .lock()
-            .map_err(|_| GpuError::Usage("allocator lock poisoned".into()))?
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })?;
+        let allocation =
+            tex.dev.allocator.lock().map_err(|_| GpuError::Internal("allocator lock poisoned"))?.allocate(
+                &AllocationCreateDesc {
+                    name,
+                    requirements,
+                    location: MemoryLocation::GpuOnly,
+                    linear: false,
+                    allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                },
+            )?;
         // SAFETY: memory allocated for this image's requirements.
         unsafe { tex.dev.raw.bind_image_memory(image, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
@@ -359,9 +357,7 @@ impl Drop for Texture {
             self.dev.raw.destroy_image(self.image, None);
         }
         if let Some(a) = self.allocation.take() {
-            if let Ok(mut allocator) = self.dev.allocator.lock() {
-                let _ = allocator.free(a);
-            }
+            self.dev.free(a, "a texture");
         }
     }
 }

@@ -8,9 +8,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::cpu::FeitoTorres;
 use super::tetra::CompactPlanes;
-use super::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Tetras per leaf.
 const LEAF: usize = 4;

@@ -58,9 +58,11 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::Result;
 use super::surface::Surface;
 use super::tetra::{CompactPlanes, CompactPoint, Contact, TetraPlanes, Verdict, octant_bit};
-use super::{BuildStats, Class, Classifier, Result, vec_bytes, winding};
+use super::winding;
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 use crate::random::Rng;
@@ -337,7 +339,7 @@ impl FeitoTorres {
     #[cold]
     fn fallback(&self, p: DVec3, tally: &mut Tally) -> Class {
         tally.trace.fallback = true;
-        winding::classify(&self.surface, p)
+        winding::classify_nonzero(&self.surface, p)
     }
 
     /// Alg. 4-1's loop: sums the tetras' contributions, stopping early on the boundary.

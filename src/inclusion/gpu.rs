@@ -34,8 +34,10 @@ use crate::gpu::{
     shaders,
 };
 
-use super::tetragrid::TetraGrid;
-use super::{Class, Classifier, FeitoTorres, InclusionError, Result};
+use super::classifier::{Class, Classifier};
+use super::cpu::FeitoTorres;
+use super::error::{InclusionError, Result};
+use super::tetragrid::GridClassifier;
 
 /// Plane-distance margin in normalized coordinates (bounding cube = [-1, 1]³). f32
 /// evaluation errors stay below 2·10⁻⁶ there; CPU ties are decided at 10⁻⁹ of the
@@ -59,6 +61,10 @@ pub enum Phase2 {
     Host,
 }
 
+/// Tetrahedra per point-vertex by default, measured on lavapipe (`texgeo bench inclusion`
+/// reports the thesis' batch of 1 beside it).
+pub const DEFAULT_BATCH: u32 = 64;
+
 #[derive(Clone, Copy, Debug)]
 pub struct GpuOptions {
     /// Tetrahedra summed per point-vertex (1 = the thesis' layout).
@@ -70,7 +76,7 @@ pub struct GpuOptions {
 
 impl Default for GpuOptions {
     fn default() -> GpuOptions {
-        GpuOptions { batch: super::solver::GPU_BATCH, groups_per_draw: 32, phase2: Phase2::Gpu }
+        GpuOptions { batch: DEFAULT_BATCH, groups_per_draw: 32, phase2: Phase2::Gpu }
     }
 }
 
@@ -313,7 +319,7 @@ pub(crate) fn triage(ft: &FeitoTorres, set: &TetraSet, points: &[DVec3]) -> (Vec
 
 /// Answers the flagged points exactly; records the time.
 pub(crate) fn fall_back(
-    exact: &TetraGrid,
+    exact: &GridClassifier,
     points: &[DVec3],
     flagged: &[usize],
     out: &mut [Class],
@@ -341,13 +347,13 @@ pub struct GpuInclusion {
     /// Phase-2 sums (or, for `cpu+gpu`, the whole phase-1 target) copied to the host.
     readback: Buffer,
     /// Exact answers for flagged points (same apex and tolerance as the CPU methods).
-    exact: TetraGrid,
+    exact: GridClassifier,
     stats: GpuStats,
 }
 
 impl GpuInclusion {
     /// `exact` answers the flagged points; its tetrahedra are the ones drawn.
-    pub fn new(ctx: &Context, exact: TetraGrid, options: GpuOptions) -> Result<GpuInclusion> {
+    pub fn new(ctx: &Context, exact: GridClassifier, options: GpuOptions) -> Result<GpuInclusion> {
         if options.batch == 0 || options.groups_per_draw == 0 {
             return Err(InclusionError::Options("batch and groups per draw must be at least 1".into()));
         }
@@ -404,7 +410,7 @@ impl GpuInclusion {
     }
 
     /// The exact CPU classifier answering flagged points.
-    pub fn exact(&self) -> &TetraGrid {
+    pub fn exact(&self) -> &GridClassifier {
         &self.exact
     }
 

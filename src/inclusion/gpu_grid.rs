@@ -11,11 +11,12 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::Class;
+use super::error::{InclusionError, Result};
 use super::gpu::{
     GROUP_POINTS, GpuStats, LAYERS, MAX_POINTS, TetraSet, classify_pipeline, decode, fall_back, triage,
 };
-use super::tetragrid::TetraGrid;
-use super::{Class, InclusionError, Result};
+use super::tetragrid::GridClassifier;
 use crate::gpu::{Attachment, Buffer, Context, Load, Pipeline, Reducer, TexFormat, Texture};
 
 /// Side of the square tiles a job's point-vertices fill (a power of two).
@@ -24,9 +25,12 @@ const TILE: u32 = 4;
 const TILES_WIDE: u32 = 64;
 const TILES_HIGH: u32 = 256;
 
+/// Tetrahedra of a cell's list per point-vertex by default (measured on lavapipe).
+pub const DEFAULT_BATCH: u32 = 64;
+
 pub struct GpuGridInclusion {
     ctx: Context,
-    grid: TetraGrid,
+    grid: GridClassifier,
     set: TetraSet,
     /// The grid's CSR tetrahedron lists, as an R32UI texture `lists_width` wide.
     lists: Texture,
@@ -46,7 +50,7 @@ pub struct GpuGridInclusion {
 
 impl GpuGridInclusion {
     /// `grid` gives the cell lists and answers flagged points exactly.
-    pub fn new(ctx: &Context, grid: TetraGrid, batch: u32) -> Result<GpuGridInclusion> {
+    pub fn new(ctx: &Context, grid: GridClassifier, batch: u32) -> Result<GpuGridInclusion> {
         if batch == 0 {
             return Err(InclusionError::Options("batch must be at least 1".into()));
         }
@@ -94,7 +98,7 @@ impl GpuGridInclusion {
         &self.stats
     }
 
-    pub fn grid(&self) -> &TetraGrid {
+    pub fn grid(&self) -> &GridClassifier {
         &self.grid
     }
 

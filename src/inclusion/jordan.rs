@@ -17,8 +17,10 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier};
+use super::error::Result;
 use super::surface::Surface;
-use super::{BuildStats, Class, Classifier, Result, winding};
+use super::winding;
 use crate::mesh::Mesh;
 use crate::random::Rng;
 
@@ -142,7 +144,7 @@ pub(crate) fn cast(
             return if w != 0 { Class::Inside } else { Class::Outside };
         }
     }
-    winding::classify(surface, p)
+    winding::classify_nonzero(surface, p)
 }
 
 /// Ray crossings over every covering triangle.

@@ -12,9 +12,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::cpu::FeitoTorres;
 use super::tetra::{CompactPlanes, octant_bit};
-use super::{BuildStats, Class, Classifier, vec_bytes};
 
 /// Feito-Torres over the tetras of the point's octant.
 #[derive(Clone, Debug)]

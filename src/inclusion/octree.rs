@@ -11,9 +11,10 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::{InclusionError, Result};
 use super::jordan::{Hit, cast, ray_hit, segment_meets_box};
 use super::surface::Surface;
-use super::{BuildStats, Class, Classifier, InclusionError, Result, vec_bytes};
 use crate::mesh::Mesh;
 
 /// Triangles a leaf may hold before it is split (when the depth allows).
@@ -49,6 +50,10 @@ pub struct JordanOctree {
     nodes: Vec<Node>,
     items: Vec<u32>,
     depth: u32,
+    /// How far triangle and node boxes are grown: ε, plus the rounding of hit points far
+    /// from the origin (a crossing belongs to the leaf that owns its computed point, which
+    /// must list the triangle).
+    slack: f64,
     stats: BuildStats,
 }
 
@@ -67,17 +72,18 @@ impl JordanOctree {
         let surface = Surface::with_policy(mesh, allow_open)?;
         let eps = surface.eps();
         let covering = surface.covering();
+        let (lo, hi) = surface.bounds();
+        let slack = eps + 16.0 * f64::EPSILON * lo.abs().max(hi.abs()).max_element();
         let boxes: Vec<(DVec3, DVec3)> = (0..covering.triangles.len())
             .map(|t| {
                 let [a, b, c] = covering.triangle(t);
-                (a.min(b).min(c) - eps, a.max(b).max(c) + eps)
+                (a.min(b).min(c) - slack, a.max(b).max(c) + slack)
             })
             .collect();
-        // The root strictly contains the bounding box grown by ε, so every point that can be
-        // on the boundary, and every hit point, is owned by some leaf.
-        let (lo, hi) = surface.bounds();
+        // The root strictly contains the bounding box grown by the slack, so every point that
+        // can be on the boundary, and every hit point, is owned by some leaf.
         let (root_lo, root_hi) =
-            (lo - 2.0 * eps - DVec3::splat(f64::MIN_POSITIVE), hi + 2.0 * eps + (hi - lo) * 1e-9);
+            (lo - 2.0 * slack - DVec3::splat(f64::MIN_POSITIVE), hi + 2.0 * slack + (hi - lo) * 1e-9);
         let mut nodes = vec![Node { lo: root_lo, hi: root_hi, children: 0, start: 0, count: 0 }];
         let mut items = Vec::new();
         let mut stack = vec![(0usize, 0u32, (0..boxes.len() as u32).collect::<Vec<u32>>())];
@@ -126,6 +132,7 @@ impl JordanOctree {
             nodes,
             items,
             depth,
+            slack,
             stats: BuildStats { build_time: start.elapsed(), bytes },
         })
     }
@@ -163,14 +170,14 @@ impl JordanOctree {
     /// Signed crossings along `d`, or `None` when the ray must be cast again.
     fn crossings(&self, p: DVec3, d: DVec3, reach: f64) -> Option<i32> {
         let covering = self.surface.covering();
-        let eps = self.surface.eps();
+        let slack = self.slack;
         let mut w = 0;
         let mut stack = [0u32; 96];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if !segment_meets_box(p, d, reach, node.lo - eps, node.hi + eps) {
+            if !segment_meets_box(p, d, reach, node.lo - slack, node.hi + slack) {
                 continue;
             }
             if node.children != 0 {

@@ -39,7 +39,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
 }
 
 /// Writes one class per line (`1` inside, `0` outside, `2` on the boundary).
-pub fn write_classes(out: &mut impl Write, classes: &[super::Class]) -> std::io::Result<()> {
+pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     for c in classes {
         writeln!(w, "{}", *c as u8)?;
@@ -62,7 +62,9 @@ mod tests {
         assert!(e.contains("pts.txt:1") && e.contains("not finite"), "{e}");
         let e = parse(b"1 2 x\n", p).unwrap_err().to_string();
         assert!(e.contains("'x' is not a number"), "{e}");
-        assert!(parse(b"# nothing\n", p).is_err());
-        assert!(parse(&[0xff, 0xfe], p).is_err());
+        let e = parse(b"# nothing\n", p).unwrap_err().to_string();
+        assert_eq!(e, "pts.txt: no points in the file");
+        let e = parse(&[0xff, 0xfe], p).unwrap_err().to_string();
+        assert_eq!(e, "pts.txt:1: not a text file (invalid UTF-8 at byte 0)");
     }
 }

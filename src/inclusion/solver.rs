@@ -1,24 +1,68 @@
-//! Any inclusion method behind one interface: the CPU classifiers and the GPU paths,
-//! for the command line and the benchmarks.
+//! The one factory of inclusion methods, CPU and GPU: [`Solver::new`] builds any
+//! [`Method`] behind one interface, for the command line and the benchmarks; [`build`]
+//! gives the CPU classifiers as [`Classifier`] objects.
+//!
+//! It also applies the one rule every method follows ([`crate::mesh::solidity`]): a
+//! surface that is not closed is only classified under `allow_open`, and then only by
+//! the winding number (inside iff w ≥ ½).
 
 use glam::DVec3;
 
+use super::bvh::Bvh;
+use super::classifier::{BuildStats, Class, Classifier};
+use super::cpu::{EdgeRule, FeitoTorres};
+use super::error::{InclusionError, Result};
 use super::gpu::{GpuInclusion, GpuOptions, GpuStats, Phase2};
 use super::gpu_grid::GpuGridInclusion;
-use super::tetragrid::TetraGrid;
-use super::{BuildStats, Class, Classifier, FeitoTorres, Method, Options, Result, build};
+use super::jordan::Jordan;
+use super::method::{Method, Options};
+use super::octants::Octants;
+use super::octree::JordanOctree;
+use super::tetragrid::GridClassifier;
+use super::winding::WindingNumber;
 use crate::gpu::Context;
 use crate::mesh::Mesh;
+use crate::mesh::covering::Covering;
 
-/// Defaults for the GPU methods: tetrahedra per point-vertex, measured on lavapipe
-/// (`texgeo bench inclusion` reports the thesis' batch of 1 beside them).
-pub const GPU_BATCH: u32 = 64;
-pub const GPU_GRID_BATCH: u32 = 64;
+/// Defaults for the GPU methods: tetrahedra per point-vertex.
+pub const GPU_BATCH: u32 = super::gpu::DEFAULT_BATCH;
+pub const GPU_GRID_BATCH: u32 = super::gpu_grid::DEFAULT_BATCH;
 
+/// Any inclusion method, ready to classify points.
 pub enum Solver {
     Cpu(Box<dyn Classifier>),
     Gpu(Box<GpuInclusion>),
     GpuGrid(Box<GpuGridInclusion>),
+}
+
+/// Under `allow_open`, a surface that is really open may only be classified by `winding`.
+fn check_open(method: Method, mesh: &Mesh, options: &Options) -> Result<()> {
+    if options.allow_open && method != Method::Winding {
+        if let Some(edge) = Covering::new(mesh).unbalanced_edge() {
+            return Err(InclusionError::OpenNeedsWinding { method: method.name(), edge });
+        }
+    }
+    Ok(())
+}
+
+/// Builds the CPU classifier `method` for `mesh` (GPU methods: [`Solver::new`]).
+pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
+    check_open(method, mesh, options)?;
+    let ft = || FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open);
+    Ok(match method {
+        Method::Cpu => Box::new(ft()?),
+        Method::Bvh => Box::new(Bvh::new(ft()?)),
+        Method::Octants => Box::new(Octants::new(ft()?)),
+        Method::TetraGrid => Box::new(GridClassifier::new(ft()?, options.tetragrid_resolution)?),
+        Method::Jordan => Box::new(Jordan::with_policy(mesh, options.allow_open)?),
+        Method::JordanOctree => {
+            Box::new(JordanOctree::with_policy(mesh, options.octree_depth, options.allow_open)?)
+        }
+        Method::Winding => Box::new(WindingNumber::with_policy(mesh, options.allow_open)?),
+        Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => {
+            return Err(InclusionError::NeedsGpu(method.name()));
+        }
+    })
 }
 
 impl Solver {
@@ -31,27 +75,29 @@ impl Solver {
         ctx: Option<&Context>,
         batch: Option<u32>,
     ) -> Result<Solver> {
+        if method.is_cpu() {
+            return Ok(Solver::Cpu(build(method, mesh, options)?));
+        }
+        check_open(method, mesh, options)?;
         let grid = || {
-            TetraGrid::new(
-                FeitoTorres::with_policy(mesh, options.apex, super::EdgeRule::Rerun, options.allow_open)?,
+            GridClassifier::new(
+                FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open)?,
                 options.tetragrid_resolution,
             )
         };
-        let need_ctx = || ctx.ok_or(super::InclusionError::NeedsGpu(method));
-        let solver = match method {
-            Method::Gpu | Method::CpuGpu => {
-                let phase2 = if method == Method::Gpu { Phase2::Gpu } else { Phase2::Host };
-                let opts = GpuOptions { batch: batch.unwrap_or(GPU_BATCH), phase2, ..GpuOptions::default() };
-                Solver::Gpu(Box::new(GpuInclusion::new(need_ctx()?, grid()?, opts)?))
-            }
+        let ctx = ctx.ok_or(InclusionError::NeedsGpu(method.name()))?;
+        Ok(match method {
             Method::GpuTetraGrid => Solver::GpuGrid(Box::new(GpuGridInclusion::new(
-                need_ctx()?,
+                ctx,
                 grid()?,
                 batch.unwrap_or(GPU_GRID_BATCH),
             )?)),
-            cpu => Solver::Cpu(build(cpu, mesh, options)?),
-        };
-        Ok(solver)
+            _ => {
+                let phase2 = if method == Method::Gpu { Phase2::Gpu } else { Phase2::Host };
+                let opts = GpuOptions { batch: batch.unwrap_or(GPU_BATCH), phase2, ..GpuOptions::default() };
+                Solver::Gpu(Box::new(GpuInclusion::new(ctx, grid()?, opts)?))
+            }
+        })
     }
 
     pub fn name(&self) -> &str {

@@ -3,7 +3,9 @@
 
 use glam::DVec3;
 
-use super::{InclusionError, vec_bytes};
+use super::classifier::vec_bytes;
+use super::error::InclusionError;
+use crate::exact;
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 
@@ -18,9 +20,14 @@ pub struct Surface {
     eps: f64,
     lo: DVec3,
     hi: DVec3,
-    /// Unit normal and offset of every polygon face (degree > 3) that is planar within ε;
-    /// `None` for triangles and non-planar faces.
-    face_planes: Vec<Option<(DVec3, f64)>>,
+    /// Unit normal and a point (the centroid) of every polygon face (degree > 3) that is
+    /// planar within ε; `None` for triangles and non-planar faces. Distances are measured
+    /// from the point, so they do not lose precision far from the origin.
+    face_planes: Vec<Option<(DVec3, DVec3)>>,
+    /// Axis along which each polygon face (degree > 3) is projected for its winding test
+    /// (the dominant axis of its vector area, decided exactly); `None` for triangles and
+    /// faces without area.
+    face_axes: Vec<Option<usize>>,
 }
 
 impl Surface {
@@ -58,15 +65,21 @@ impl Surface {
                 });
                 let n = n.try_normalize()?;
                 // The centroid is the first corner of every covering triangle of an n-gon.
-                let off = n.dot(covering.points[covering.triangles[tris.start][0] as usize]);
+                let c = covering.points[covering.triangles[tris.start][0] as usize];
                 let planar = covering
                     .polygon(f)
                     .iter()
-                    .all(|&i| (n.dot(covering.points[i as usize]) - off).abs() <= 0.5 * eps);
-                planar.then_some((n, off))
+                    .all(|&i| n.dot(covering.points[i as usize] - c).abs() <= 0.5 * eps);
+                planar.then_some((n, c))
             })
             .collect();
-        Surface { covering, eps, lo, hi, face_planes }
+        let face_axes = (0..covering.num_faces())
+            .map(|f| {
+                let poly = covering.polygon(f);
+                if poly.len() > 3 { dominant_axis(poly, &covering.points) } else { None }
+            })
+            .collect();
+        Surface { covering, eps, lo, hi, face_planes, face_axes }
     }
 
     pub fn covering(&self) -> &Covering {
@@ -95,15 +108,15 @@ impl Surface {
         p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z
     }
 
-    /// Unit normal and offset (n·x = offset) of face `f` when it is a polygon of degree > 3
+    /// Unit normal and a point of the plane of face `f` when it is a polygon of degree > 3
     /// that is planar within ε/2; `None` for triangles and non-planar faces.
-    pub fn face_plane(&self, f: usize) -> Option<(DVec3, f64)> {
+    pub fn face_plane(&self, f: usize) -> Option<(DVec3, DVec3)> {
         self.face_planes[f]
     }
 
     /// Signed distance from `p` to the plane of face `f` (0 when it has none, see [`Self::face_plane`]).
     pub fn face_distance(&self, f: usize, p: DVec3) -> f64 {
-        self.face_planes[f].map_or(0.0, |(n, off)| n.dot(p) - off)
+        self.face_planes[f].map_or(0.0, |(n, c)| n.dot(p - c))
     }
 
     /// Cheap filter: `p` is inside the bounding box of covering triangle `t` grown by ε.
@@ -119,44 +132,35 @@ impl Surface {
         self.near_triangle(t, p) && self.on_face(self.covering.face_of[t] as usize, p)
     }
 
-    /// True iff `p` is within ε of face `f`.
+    /// True iff `p` is within ε of face `f`, decided exactly ([`crate::exact`]): the
+    /// answer depends on nothing but the covering points, so every method, and the same
+    /// solid translated by any amount that keeps its coordinates exact, agree.
     ///
     /// A triangle: Euclidean distance ≤ ε. An n-gon: `p` is within ε of one of its edges,
-    /// or within ε of a covering triangle at a point X around which the polygon (projected
-    /// on that triangle's plane) winds — so the parts of the fan that a non-convex face's
+    /// or within ε of one of its covering triangles at a place the polygon covers —
+    /// projected along the dominant axis of the polygon's vector area, `p` lies where the
+    /// polygon winds (non-zero rule) — so the parts of the fan that a non-convex face's
     /// negative triangles cancel are *not* boundary.
     pub fn on_face(&self, f: usize, p: DVec3) -> bool {
         let eps = self.eps;
         let tris = self.covering.face_triangles(f);
+        let near = |t: usize| {
+            let [a, b, c] = self.covering.triangle(t);
+            self.near_triangle(t, p) && exact::triangle_within(p, a, b, c, eps)
+        };
         if tris.len() == 1 {
-            let [a, b, c] = self.covering.triangle(tris.start);
-            return closest_point_on_triangle(p, a, b, c).distance(p) <= eps;
+            return near(tris.start);
+        }
+        if !tris.clone().any(near) {
+            return false;
         }
         let poly = self.covering.polygon(f);
         let pts = &self.covering.points;
-        let mut edges_checked = false;
-        for t in tris {
-            let [a, b, c] = self.covering.triangle(t);
-            let x = closest_point_on_triangle(p, a, b, c);
-            if x.distance(p) > eps {
-                continue;
-            }
-            if !edges_checked {
-                edges_checked = true;
-                let near_edge = poly.iter().enumerate().any(|(i, &v)| {
-                    let (s, e) = (pts[v as usize], pts[poly[(i + 1) % poly.len()] as usize]);
-                    closest_point_on_segment(p, s, e).distance(p) <= eps
-                });
-                if near_edge {
-                    return true;
-                }
-            }
-            let n = (b - a).cross(c - a);
-            if n != DVec3::ZERO && polygon_winds_around(poly, pts, n, x) {
-                return true;
-            }
-        }
-        false
+        let on_edge = poly.iter().enumerate().any(|(i, &v)| {
+            let (s, e) = (pts[v as usize], pts[poly[(i + 1) % poly.len()] as usize]);
+            exact::segment_within(p, s, e, eps)
+        });
+        on_edge || self.face_axes[f].is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
     }
 
     /// `p`, or `p` moved ε/2 away from the plane of the first covering triangle of an n-gon
@@ -194,111 +198,75 @@ impl Surface {
             + c.num_faces() * std::mem::size_of::<usize>()
             + (0..c.num_faces()).map(|f| c.polygon(f).len() * 4).sum::<usize>()
             + vec_bytes(&self.face_planes)
+            + vec_bytes(&self.face_axes)
     }
 }
 
-/// Whether the polygon `poly` (indices into `pts`), projected along the dominant axis of
-/// `n`, has a non-zero winding number around the projection of `x` (Sunday's crossing rule).
-fn polygon_winds_around(poly: &[u32], pts: &[DVec3], n: DVec3, x: DVec3) -> bool {
-    let a = n.abs();
-    let (u, v) = if a.x >= a.y && a.x >= a.z {
-        (1, 2)
-    } else if a.y >= a.z {
-        (2, 0)
-    } else {
-        (0, 1)
-    };
-    let (xu, xv) = (x[u], x[v]);
+/// Whether the polygon `poly` (indices into `pts`), projected along coordinate axis `axis`,
+/// winds around the projection of `x` (Sunday's crossing rule with exact orientation tests;
+/// a point on an edge is left to the edge test).
+fn polygon_winds_around(poly: &[u32], pts: &[DVec3], axis: usize, x: DVec3) -> bool {
+    let (u, v) = [(1, 2), (2, 0), (0, 1)][axis];
+    let q = [x[u], x[v]];
     let mut wn = 0i32;
     for (i, &s) in poly.iter().enumerate() {
         let (s, e) = (pts[s as usize], pts[poly[(i + 1) % poly.len()] as usize]);
-        let left = (e[u] - s[u]) * (xv - s[v]) - (xu - s[u]) * (e[v] - s[v]);
-        if s[v] <= xv {
-            if e[v] > xv && left > 0.0 {
+        let (s, e) = ([s[u], s[v]], [e[u], e[v]]);
+        if s[1] <= q[1] {
+            if e[1] > q[1] && exact::orient2d(s, e, q) > 0 {
                 wn += 1;
             }
-        } else if e[v] <= xv && left < 0.0 {
+        } else if e[1] <= q[1] && exact::orient2d(s, e, q) < 0 {
             wn -= 1;
         }
     }
     wn != 0
 }
 
-/// The point of segment [a, b] closest to `p` (a when the segment is a point).
-pub fn closest_point_on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    if len2 == 0.0 {
-        return a;
+/// The coordinate axis along which the polygon's vector area Σ (Pᵢ − P₀) × (Pᵢ₊₁ − P₀) is
+/// largest in absolute value (ties: the lower axis), decided exactly; `None` when the
+/// vector area is zero.
+fn dominant_axis(poly: &[u32], pts: &[DVec3]) -> Option<usize> {
+    let p0 = pts[poly[0] as usize];
+    let (mut n, mut bound) = (DVec3::ZERO, DVec3::ZERO);
+    for w in poly.windows(2).skip(1) {
+        let (a, b) = (pts[w[0] as usize] - p0, pts[w[1] as usize] - p0);
+        n += a.cross(b);
+        bound += DVec3::new(
+            (a.y * b.z).abs() + (a.z * b.y).abs(),
+            (a.z * b.x).abs() + (a.x * b.z).abs(),
+            (a.x * b.y).abs() + (a.y * b.x).abs(),
+        );
     }
-    a + ab * ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-}
-
-/// The point of triangle (a, b, c) closest to `p`, by Voronoi regions; degenerate
-/// (zero-area) triangles fall back to their edges.
-pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+    // Rounding of the differences, products and sums: far below this bound.
+    let bound = bound * (8.0 * (poly.len() as f64 + 2.0) * f64::EPSILON);
+    let m = n.abs();
+    let best = if m.x >= m.y && m.x >= m.z {
+        0
+    } else if m.y >= m.z {
+        1
+    } else {
+        2
+    };
+    let clear = (0..3).all(|k| k == best || m[best] - m[k] > bound[best] + bound[k]);
+    if clear && m[best] > bound[best] {
+        return Some(best);
     }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
+    // In doubt: the vector area in exact arithmetic.
+    let mut e = exact::Exact3::default();
+    for w in poly.windows(2).skip(1) {
+        let a = exact::Exact3::diff(pts[w[0] as usize], p0);
+        let b = exact::Exact3::diff(pts[w[1] as usize], p0);
+        let c = a.cross(&b);
+        e = exact::Exact3(std::array::from_fn(|k| &e.0[k] + &c.0[k]));
     }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
+    let abs = |x: &exact::Exact| if x.sign() < 0 { -x } else { x.clone() };
+    let a: [exact::Exact; 3] = std::array::from_fn(|k| abs(&e.0[k]));
+    let mut best = 0;
+    for k in 1..3 {
+        if (&a[k] - &a[best]).sign() > 0 {
+            best = k;
+        }
     }
-    let vc = d1 * d4 - d3 * d2;
-    let vb = d5 * d2 - d1 * d6;
-    let va = d3 * d6 - d5 * d4;
-    let sum = va + vb + vc;
-    if sum <= 0.0 || ab.cross(ac) == DVec3::ZERO {
-        return [
-            closest_point_on_segment(p, a, b),
-            closest_point_on_segment(p, b, c),
-            closest_point_on_segment(p, c, a),
-        ]
-        .into_iter()
-        .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
-        .unwrap_or(a);
-    }
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    a + ab * (vb / sum) + ac * (vc / sum)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn closest_points() {
-        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
-        let at = |p: DVec3, want: DVec3| {
-            let q = closest_point_on_triangle(p, a, b, c);
-            assert!(q.distance(want) < 1e-15, "{p} -> {q}, want {want}");
-        };
-        at(DVec3::new(0.2, 0.3, 5.0), DVec3::new(0.2, 0.3, 0.0));
-        at(DVec3::new(-1.0, -1.0, 0.0), a);
-        at(DVec3::new(2.0, -0.5, 1.0), b);
-        at(DVec3::new(-0.5, 3.0, 1.0), c);
-        at(DVec3::new(0.5, -3.0, 0.0), DVec3::new(0.5, 0.0, 0.0));
-        at(DVec3::new(-3.0, 0.25, 2.0), DVec3::new(0.0, 0.25, 0.0));
-        at(DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.5, 0.5, 0.0));
-        // Collinear corners: the closest point of the segment they span.
-        let q = closest_point_on_triangle(DVec3::new(0.5, 1.0, 0.0), a, DVec3::X, DVec3::X * 2.0);
-        assert_eq!(q, DVec3::new(0.5, 0.0, 0.0));
-        assert_eq!(closest_point_on_segment(DVec3::ONE, DVec3::X, DVec3::X), DVec3::X);
-    }
+    (a[best].sign() != 0).then_some(best)
 }

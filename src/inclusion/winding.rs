@@ -3,40 +3,40 @@
 //! w(P) = Σ Ω(t) / 4π over the covering triangles, Ω the signed solid angle of a triangle
 //! seen from P (Van Oosterom & Strackee 1983). Negative triangles of non-convex faces
 //! subtract what their positive partners add, so the covering works as is. Inside iff
-//! |w| ≥ 0.5; within ε of a face, OnBoundary (the shared rule of [`crate::inclusion`]).
+//! w ≥ ½ (the rule of [`crate::mesh::solidity`]: on a valid solid w is 0 or 1; on an open
+//! surface, accepted with `--allow-open`, it is the generalized winding number); within ε
+//! of a face, OnBoundary (the shared rule of [`crate::inclusion`]).
 
-use std::f64::consts::PI;
 use std::time::Instant;
 
 use glam::DVec3;
 
+use super::classifier::{BuildStats, Class, Classifier};
+use super::error::Result;
 use super::surface::Surface;
-use super::{BuildStats, Class, Classifier, Result};
 use crate::mesh::Mesh;
 
-/// Signed solid angle of triangle (a, b, c) seen from the origin (corners relative to the
-/// viewer): positive when the origin is behind the triangle, i.e. on the side opposite to
-/// its normal (b−a)×(c−a) — so w = +1 inside an outward-oriented closed surface.
-pub fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (la, lb, lc) = (a.length(), b.length(), c.length());
-    let num = a.dot(b.cross(c));
-    let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    2.0 * num.atan2(den)
-}
+pub use crate::mesh::covering::solid_angle;
 
 /// Winding number of the covering around `p` (≈ integer away from the boundary).
 pub fn winding_number(surface: &Surface, p: DVec3) -> f64 {
     let covering = surface.covering();
-    let sum: f64 = (0..covering.triangles.len())
-        .map(|t| {
-            let [a, b, c] = covering.triangle(t);
-            solid_angle(a - p, b - p, c - p)
-        })
-        .sum();
-    sum / (4.0 * PI)
+    covering.winding_number(0..covering.triangles.len(), p)
 }
 
-/// OnBoundary within ε of a face, else Inside iff |w| ≥ 0.5 (measured from a point moved
+/// The last word of the Feito-Torres and Jordan methods when their own passes stay
+/// ambiguous: OnBoundary within ε of a face, else their rule, Inside iff w is non-zero
+/// (|w| ≥ ½). On a valid solid this is [`classify`]'s answer.
+pub fn classify_nonzero(surface: &Surface, p: DVec3) -> Class {
+    let n = surface.covering().triangles.len();
+    if (0..n).any(|t| surface.on_boundary_near(t, p)) {
+        return Class::OnBoundary;
+    }
+    let p = surface.off_polygon_planes(p, 0..n);
+    if winding_number(surface, p).abs() >= 0.5 { Class::Inside } else { Class::Outside }
+}
+
+/// OnBoundary within ε of a face, else Inside iff w ≥ ½ (measured from a point moved
 /// off the plane of a non-convex face if `p` lies in one, see [`Surface::off_polygon_planes`]).
 pub fn classify(surface: &Surface, p: DVec3) -> Class {
     let n = surface.covering().triangles.len();
@@ -44,7 +44,7 @@ pub fn classify(surface: &Surface, p: DVec3) -> Class {
         return Class::OnBoundary;
     }
     let p = surface.off_polygon_planes(p, 0..n);
-    if winding_number(surface, p).abs() >= 0.5 { Class::Inside } else { Class::Outside }
+    if winding_number(surface, p) >= 0.5 { Class::Inside } else { Class::Outside }
 }
 
 /// The winding-number oracle as a [`Classifier`].
@@ -92,6 +92,8 @@ impl Classifier for WindingNumber {
 
 #[cfg(test)]
 mod tests {
+    use std::f64::consts::PI;
+
     use super::*;
 
     #[test]

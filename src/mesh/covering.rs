@@ -46,9 +46,31 @@ pub struct UnbalancedEdge {
     pub backward: u32,
 }
 
+impl std::fmt::Display for UnbalancedEdge {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (a, b) = (self.a, self.b);
+        write!(
+            f,
+            "edge {a}–{b} is used {} time(s) as {a}→{b} but {} time(s) as {b}→{a}",
+            self.forward, self.backward
+        )
+    }
+}
+
 /// Signed volume of the tetrahedron (O, A, B, C): det(A−O, B−O, C−O) / 6 (Def. 3.21).
 pub fn signed_tetra_volume(o: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     (a - o).dot((b - o).cross(c - o)) / 6.0
+}
+
+/// Signed solid angle of triangle (a, b, c) seen from the origin (corners relative to the
+/// viewer): positive when the origin is behind the triangle, i.e. on the side opposite to
+/// its normal (b−a)×(c−a) — so the winding number is +1 inside an outward-oriented closed
+/// surface (Van Oosterom & Strackee 1983).
+pub fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let num = a.dot(b.cross(c));
+    let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    2.0 * num.atan2(den)
 }
 
 impl Covering {
@@ -113,6 +135,21 @@ impl Covering {
             return (DVec3::ZERO, DVec3::ZERO);
         }
         self.points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
+    /// Generalized winding number about `p` of the covering triangles `triangles`:
+    /// Σ Ω(t) / 4π ([`solid_angle`]). Negative triangles of non-convex faces subtract what
+    /// their positive partners add. For a closed, consistently oriented set of faces it is
+    /// an integer (up to rounding) away from their surface: 1 inside an outward solid.
+    pub fn winding_number(&self, triangles: impl IntoIterator<Item = usize>, p: DVec3) -> f64 {
+        let sum: f64 = triangles
+            .into_iter()
+            .map(|t| {
+                let [a, b, c] = self.triangle(t);
+                solid_angle(a - p, b - p, c - p)
+            })
+            .sum();
+        sum / (4.0 * std::f64::consts::PI)
     }
 
     /// Sum of the signed covering-tetra volumes with apex `o` (Alg. 3-1, §3.6.3).
@@ -227,18 +264,7 @@ mod tests {
     use super::*;
 
     fn quad_box(lo: DVec3, hi: DVec3) -> Mesh {
-        let p: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2]))
-            .collect();
-        let f = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![2, 6, 7, 3],
-            vec![0, 4, 6, 2],
-            vec![1, 3, 7, 5],
-        ];
-        Mesh::new(p, f).unwrap()
+        crate::mesh::procedural::box_between(lo, hi)
     }
 
     fn prism(xy: &[(f64, f64)], h: f64) -> Mesh {

@@ -41,6 +41,12 @@ pub enum MeshError {
     Unsuitable(String),
 }
 
+impl From<crate::output::Error> for MeshError {
+    fn from(e: crate::output::Error) -> MeshError {
+        MeshError::Io { path: e.path, error: e.error }
+    }
+}
+
 impl MeshError {
     pub fn invalid(message: impl Into<String>) -> MeshError {
         MeshError::Invalid(message.into())

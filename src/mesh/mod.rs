@@ -3,10 +3,14 @@
 
 use glam::DVec3;
 
+pub mod boxgrid;
 pub mod covering;
 pub mod error;
 pub mod formats;
+pub mod intersect;
 pub mod procedural;
+pub mod solidity;
+pub mod triangulate;
 pub mod validate;
 
 pub use error::{MeshError, Result};

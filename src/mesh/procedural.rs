@@ -11,7 +11,7 @@ use super::Mesh;
 
 /// The names [`by_name`] knows.
 pub const BUILTIN_NAMES: &[&str] =
-    &["cube", "tetrahedron", "pyramid", "sphere", "torus", "knot", "two-cubes", "cavity", "l-prism"];
+    &["cube", "tetrahedron", "pyramid", "sphere", "torus", "knot", "two-cubes", "cavity", "l-prism", "star"];
 
 /// A built-in model by name (see [`BUILTIN_NAMES`]), with default parameters:
 /// `sphere` = `sphere(16, 32)`, `torus` = `torus(1.0, 0.4, 32, 16)`.
@@ -26,6 +26,7 @@ pub fn by_name(name: &str) -> Option<Mesh> {
         "two-cubes" => two_cubes_sharing_edge(),
         "cavity" => cube_with_cavity(),
         "l-prism" => l_prism(),
+        "star" => star_prism(),
         _ => return None,
     })
 }
@@ -51,6 +52,20 @@ pub fn prism(outline: &[(f64, f64)], height: f64) -> Option<Mesh> {
 pub fn l_prism() -> Mesh {
     let outline = [(0.0, 0.0), (4.0, 0.0), (4.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)];
     prism(&outline, 1.0).unwrap_or_else(|| unreachable!("the L outline is a valid polygon"))
+}
+
+/// A five-pointed star prism, height 1: outer radius 2, inner radius 0.8, its caps kept as
+/// whole non-convex 10-gons that no fan from one of their vertices covers (a tip sees
+/// past the neighbouring notches), for triangulation tests.
+pub fn star_prism() -> Mesh {
+    let outline: Vec<(f64, f64)> = (0..10)
+        .map(|i| {
+            let r = if i % 2 == 0 { 2.0 } else { 0.8 };
+            let t = TAU * f64::from(i) / 10.0 + TAU / 4.0;
+            (r * t.cos(), r * t.sin())
+        })
+        .collect();
+    prism(&outline, 1.0).unwrap_or_else(|| unreachable!("the star outline is a valid polygon"))
 }
 
 /// Builds a mesh from data this module made (always valid).

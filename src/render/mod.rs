@@ -23,6 +23,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod boolean;
 mod camera;
 pub mod colour;
 mod error;
@@ -31,7 +32,6 @@ mod model;
 mod picture;
 mod renderer;
 mod scene;
-mod triangulate;
 pub mod voxels;
 
 pub use camera::Camera;
@@ -42,4 +42,3 @@ pub use model::{Content, Model};
 pub use picture::Picture;
 pub use renderer::{Prepared, Renderer, View};
 pub use scene::{Colours, Points, Polyline, Scene, SceneMesh, Shading};
-pub use triangulate::triangulate_face;

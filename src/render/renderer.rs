@@ -12,11 +12,11 @@ use super::colour::{Rgba, pack};
 use super::error::{RenderError, Result};
 use super::picture::Picture;
 use super::scene::{Colours, Scene, SceneMesh, Shading};
-use super::triangulate::{newell, triangulate_face};
 use crate::gpu::{
     Attachment, Blend, Buffer, Context, DepthTest, Load, Pipeline, PipelineDesc, Pod, Raster, Recorder,
     Targets, TexFormat, Texture, Topology, shaders,
 };
+use crate::mesh::triangulate::{newell_normal, polygon_or_fan};
 
 /// A vertex of `glsl/render/mesh.vert`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -383,12 +383,12 @@ fn mesh_geometry(item: &SceneMesh, origin: DVec3) -> (Vec<Vertex>, Vec<u32>) {
     for face in mesh.faces() {
         corners.clear();
         corners.extend(face.iter().map(|&v| p[v as usize]));
-        let n = newell(&corners);
+        let n = newell_normal(corners.iter().copied());
         for &v in face {
             normals[v as usize] += n;
         }
         let start = triangles.len();
-        triangles.extend(triangulate_face(&corners));
+        triangles.extend(polygon_or_fan(&corners).into_iter().map(|t| t.map(|i| i as usize)));
         face_triangles.push((start, triangles.len()));
     }
     let vertex = |v: usize, colour: Rgba| Vertex {

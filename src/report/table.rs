@@ -90,11 +90,12 @@ impl Report {
 
     /// Writes `NAME.md` and one `NAME-<k>.csv` per table (or `NAME.csv` for one table)
     /// into `dir`; returns the files written.
-    pub fn write(&self, dir: &Path) -> std::io::Result<Vec<PathBuf>> {
-        std::fs::create_dir_all(dir)?;
+    /// Every file is written atomically ([`crate::output`]).
+    pub fn write(&self, dir: &Path) -> crate::output::Result<Vec<PathBuf>> {
+        crate::output::check_dir(dir)?;
         let mut written = Vec::new();
         let md = dir.join(format!("{}.md", self.name));
-        std::fs::write(&md, self.to_markdown())?;
+        crate::output::write_bytes(&md, self.to_markdown().as_bytes())?;
         written.push(md);
         for (k, t) in self.tables.iter().enumerate() {
             let name = if !t.stem.is_empty() {
@@ -111,7 +112,7 @@ impl Report {
                 format!("{}-{}-{slug}.csv", self.name, k + 1)
             };
             let path = dir.join(name);
-            std::fs::write(&path, t.to_csv())?;
+            crate::output::write_bytes(&path, t.to_csv().as_bytes())?;
             written.push(path);
         }
         Ok(written)

@@ -18,6 +18,7 @@ use serde_json::{Map, Value};
 use super::record::{Outcome, Record};
 use super::tasks;
 use crate::gpu::Context;
+use crate::mesh::solidity::NotSolid;
 use crate::mesh::{Mesh, Report};
 
 /// A refusal or a failure of one mesh.
@@ -33,6 +34,11 @@ impl Failure {
     /// The task declines the mesh with a clear error (the answer it would give a user).
     pub fn refused(reason: &str, error: impl std::fmt::Display) -> Failure {
         Failure { outcome: Outcome::Refused, reason: reason.into(), error: error.to_string() }
+    }
+
+    /// The mesh is not a solid the command would accept (`mesh::solidity`).
+    pub fn not_solid(e: NotSolid) -> Failure {
+        Failure::refused(e.defect.slug(), e)
     }
 
     /// A check failed or an unexpected error happened.
@@ -87,16 +93,19 @@ pub enum TaskKind {
     Inclusion,
     Voxelize,
     Subdivide,
+    Boolean,
 }
 
 impl TaskKind {
-    pub const ALL: [TaskKind; 3] = [TaskKind::Inclusion, TaskKind::Voxelize, TaskKind::Subdivide];
+    pub const ALL: [TaskKind; 4] =
+        [TaskKind::Inclusion, TaskKind::Voxelize, TaskKind::Subdivide, TaskKind::Boolean];
 
     pub fn name(self) -> &'static str {
         match self {
             TaskKind::Inclusion => tasks::inclusion::Inclusion::NAME,
             TaskKind::Voxelize => tasks::voxelize::Voxelize::NAME,
             TaskKind::Subdivide => tasks::subdivide::Subdivide::NAME,
+            TaskKind::Boolean => tasks::boolean::BooleanTask::NAME,
         }
     }
 
@@ -111,6 +120,7 @@ impl TaskKind {
             TaskKind::Inclusion => v.visit::<tasks::inclusion::Inclusion>(),
             TaskKind::Voxelize => v.visit::<tasks::voxelize::Voxelize>(),
             TaskKind::Subdivide => v.visit::<tasks::subdivide::Subdivide>(),
+            TaskKind::Boolean => v.visit::<tasks::boolean::BooleanTask>(),
         }
     }
 

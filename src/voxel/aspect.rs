@@ -10,8 +10,8 @@ use super::volume::Volume;
 use crate::gpu::{Attachment, Blend, Context, Load, Pipeline, TexFormat, Texture, shaders};
 use crate::random::Rng;
 
-/// The materials of the noise palette.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The materials of the noise palette (`--material`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Material {
     Marble,
     Wood,

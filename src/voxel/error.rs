@@ -25,16 +25,23 @@ pub enum VoxelError {
     /// A binvox file that cannot be read.
     #[error("{}: {message}", path.display())]
     Binvox { path: PathBuf, message: String },
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    /// (The OS error is part of the message, not a `source`, so chains print it once.)
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
     #[error(transparent)]
     Gpu(#[from] GpuError),
     #[error(transparent)]
     MeshFile(#[from] MeshError),
 }
 
+impl From<crate::output::Error> for VoxelError {
+    fn from(e: crate::output::Error) -> VoxelError {
+        VoxelError::Io { path: e.path, error: e.error }
+    }
+}
+
 impl VoxelError {
-    pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> VoxelError {
-        VoxelError::Io { path: path.into(), source }
+    pub(crate) fn io(path: impl Into<PathBuf>, error: std::io::Error) -> VoxelError {
+        VoxelError::Io { path: path.into(), error }
     }
 }

@@ -1,9 +1,7 @@
 //! Exact geometric predicates on f64 inputs, and the tie rule they decide.
 //!
-//! `orient2d` / `orient3d` first evaluate the determinant in floating point with a
-//! forward error bound (the filter); only when the sign is in doubt do they recompute it
-//! exactly with floating-point expansions (error-free two-sum / two-product, Shewchuk's
-//! grow, scale and sum), so the answer is the sign of the exact real determinant.
+//! `orient2d` / `orient3d` come from [`crate::exact`] (a filtered floating-point
+//! determinant, recomputed exactly with expansions when its sign is in doubt).
 //!
 //! **The tie rule.** A voxel centre p on the surface is decided as the point
 //! p + (ε, ε³, ε²) for an infinitesimal ε > 0: pushed first along +x, then +z, then +y.
@@ -14,52 +12,10 @@
 
 use glam::DVec3;
 
-/// Sign of a real number: −1, 0 or 1.
-pub type Sign = i8;
+pub use crate::exact::{Sign, orient2d, orient3d};
 
 fn sign_of(x: f64) -> Sign {
-    if x > 0.0 {
-        1
-    } else if x < 0.0 {
-        -1
-    } else {
-        0
-    }
-}
-
-const EPS: f64 = f64::EPSILON * 0.5; // 2^-53, the unit roundoff
-
-/// Sign of (b − a) × (c − a) for 2D points: positive when a, b, c turn counter-clockwise.
-pub fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Sign {
-    let (bax, bay, cax, cay) = (b[0] - a[0], b[1] - a[1], c[0] - a[0], c[1] - a[1]);
-    let (l, r) = (bax * cay, bay * cax);
-    let det = l - r;
-    // Shewchuk's ccwerrboundA is (3 + 16ε)ε; 8ε keeps a margin.
-    if det.abs() > 8.0 * EPS * (l.abs() + r.abs()) {
-        return sign_of(det);
-    }
-    let (bax, bay, cax, cay) = (diff(b[0], a[0]), diff(b[1], a[1]), diff(c[0], a[0]), diff(c[1], a[1]));
-    expansion_sign(&sum(&mul(&bax, &cay), &negate(&mul(&bay, &cax))))
-}
-
-/// Sign of ((b − a) × (c − a)) · (d − a): positive when d lies on the side the normal of
-/// the counter-clockwise triangle abc points to.
-pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
-    let (u, v, w) = (b - a, c - a, d - a);
-    let (m1, m2, m3) = (v.y * w.z - v.z * w.y, v.z * w.x - v.x * w.z, v.x * w.y - v.y * w.x);
-    let det = u.x * m1 + u.y * m2 + u.z * m3;
-    let permanent = u.x.abs() * ((v.y * w.z).abs() + (v.z * w.y).abs())
-        + u.y.abs() * ((v.z * w.x).abs() + (v.x * w.z).abs())
-        + u.z.abs() * ((v.x * w.y).abs() + (v.y * w.x).abs());
-    // Shewchuk's o3derrboundA is (7 + 56ε)ε; 16ε keeps a margin.
-    if det.abs() > 16.0 * EPS * permanent {
-        return sign_of(det);
-    }
-    let d3 = |p: DVec3, q: DVec3| [diff(p.x, q.x), diff(p.y, q.y), diff(p.z, q.z)];
-    let (u, v, w) = (d3(b, a), d3(c, a), d3(d, a));
-    let minor = |i: usize, j: usize| sum(&mul(&v[i], &w[j]), &negate(&mul(&v[j], &w[i])));
-    let det = sum(&sum(&mul(&u[0], &minor(1, 2)), &mul(&u[1], &minor(2, 0))), &mul(&u[2], &minor(0, 1)));
-    expansion_sign(&det)
+    crate::exact::sign_of(x)
 }
 
 /// The normal (b − a) × (c − a) of a triangle, as exact signs of its components.
@@ -171,126 +127,10 @@ pub fn inside_by_tetras(triangles: &[[DVec3; 3]], apex: DVec3, p: DVec3) -> bool
     parity
 }
 
-// ---- Expansion arithmetic (components non-overlapping, increasing magnitude). ----
-
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    let err = (a - (s - bb)) + (b - bb);
-    (s, err)
-}
-
-fn two_prod(a: f64, b: f64) -> (f64, f64) {
-    let p = a * b;
-    (p, a.mul_add(b, -p))
-}
-
-/// a − b exactly, as a two-component expansion.
-fn diff(a: f64, b: f64) -> Vec<f64> {
-    let (s, e) = two_sum(a, -b);
-    compress(vec![e, s])
-}
-
-fn compress(mut e: Vec<f64>) -> Vec<f64> {
-    e.retain(|&x| x != 0.0);
-    e
-}
-
-/// e + b (Shewchuk's Grow-Expansion).
-fn grow(e: &[f64], b: f64) -> Vec<f64> {
-    let mut out = Vec::with_capacity(e.len() + 1);
-    let mut q = b;
-    for &x in e {
-        let (s, err) = two_sum(q, x);
-        out.push(err);
-        q = s;
-    }
-    out.push(q);
-    compress(out)
-}
-
-/// e + f (Expansion-Sum: grow by each component of f).
-fn sum(e: &[f64], f: &[f64]) -> Vec<f64> {
-    f.iter().fold(e.to_vec(), |acc, &x| grow(&acc, x))
-}
-
-fn negate(e: &[f64]) -> Vec<f64> {
-    e.iter().map(|x| -x).collect()
-}
-
-/// e · b (Shewchuk's Scale-Expansion).
-fn scale(e: &[f64], b: f64) -> Vec<f64> {
-    let Some((&first, rest)) = e.split_first() else { return Vec::new() };
-    let mut out = Vec::with_capacity(2 * e.len());
-    let (mut q, h) = two_prod(first, b);
-    out.push(h);
-    for &x in rest {
-        let (hi, lo) = two_prod(x, b);
-        let (s, err) = two_sum(q, lo);
-        out.push(err);
-        let (s2, err2) = two_sum(hi, s);
-        out.push(err2);
-        q = s2;
-    }
-    out.push(q);
-    compress(out)
-}
-
-fn mul(e: &[f64], f: &[f64]) -> Vec<f64> {
-    f.iter().fold(Vec::new(), |acc, &x| sum(&acc, &scale(e, x)))
-}
-
-/// The sign of a non-overlapping expansion is the sign of its largest component.
-fn expansion_sign(e: &[f64]) -> Sign {
-    e.iter().copied().fold(0.0f64, |m, x| if x.abs() > m.abs() { x } else { m }).partial_cmp(&0.0).map_or(
-        0,
-        |o| match o {
-            std::cmp::Ordering::Greater => 1,
-            std::cmp::Ordering::Less => -1,
-            std::cmp::Ordering::Equal => 0,
-        },
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::random::Rng;
-
-    /// Exact determinant of small integer points in i128.
-    fn orient3d_i128(a: [i64; 3], b: [i64; 3], c: [i64; 3], d: [i64; 3]) -> Sign {
-        let s =
-            |p: [i64; 3], q: [i64; 3]| [(p[0] - q[0]) as i128, (p[1] - q[1]) as i128, (p[2] - q[2]) as i128];
-        let (u, v, w) = (s(b, a), s(c, a), s(d, a));
-        let det = u[0] * (v[1] * w[2] - v[2] * w[1])
-            + u[1] * (v[2] * w[0] - v[0] * w[2])
-            + u[2] * (v[0] * w[1] - v[1] * w[0]);
-        det.signum() as Sign
-    }
-
-    #[test]
-    fn orient3d_matches_integer_arithmetic() {
-        let mut rng = Rng::new(11);
-        let big = 1i64 << 26; // products reach 2^80: beyond f64's 53 bits, fine for i128
-        for _ in 0..20_000 {
-            let p = |rng: &mut Rng| -> [i64; 3] {
-                std::array::from_fn(|_| rng.below(2 * big as u64) as i64 - big)
-            };
-            let (a, b, c) = (p(&mut rng), p(&mut rng), p(&mut rng));
-            // A third of the time d is coplanar (a + b − c), a third one unit off the plane.
-            let d = match rng.below(3) {
-                0 => p(&mut rng),
-                1 => [a[0] + b[0] - c[0], a[1] + b[1] - c[1], a[2] + b[2] - c[2]],
-                _ => [a[0] + b[0] - c[0] + 1, a[1] + b[1] - c[1], a[2] + b[2] - c[2]],
-            };
-            let f = |q: [i64; 3]| DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64);
-            assert_eq!(
-                orient3d(f(a), f(b), f(c), f(d)),
-                orient3d_i128(a, b, c, d),
-                "{a:?} {b:?} {c:?} {d:?}"
-            );
-        }
-    }
 
     #[test]
     fn near_degenerate_floats_are_exact() {

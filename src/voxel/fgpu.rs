@@ -82,7 +82,7 @@ impl<'a> SliceTriangles<'a> {
             let local = j - self.first_slice;
             let range = self.ranges[local].clone();
             if !range.is_empty() {
-                pass.push(&params(self.n, j as f32 + 0.5, self.bits[local]))?;
+                pass.push(&[params(self.n, j as f32 + 0.5, self.bits[local])])?;
                 pass.draw(range, 0..1)?;
             }
         }

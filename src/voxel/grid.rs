@@ -1,4 +1,4 @@
-//! The voxel grid (SPEC §4.1, issue 4): N×N×N voxels over the bounding cube of the
+//! The voxel grid (SPEC §4.1): N×N×N voxels over the bounding cube of the
 //! solid. The cube's side s is the largest extent of the mesh's bounding box, centred on
 //! the box's centre; h = s/N; voxel (i, j, k) has its centre at
 //! `min + ((i+½)h, (j+½)h, (k+½)h)`, i along x, j along y (the slicing axis), k along z.

@@ -66,12 +66,29 @@ pub(crate) fn side(n: usize) -> usize {
     n + 2 * MARGIN
 }
 
-/// The push constants of `slice_params.glsl`: grid units → clip, slice, bits.
-pub(crate) fn params(n: usize, slice: f32, bits: u32) -> [u32; 6] {
+/// The push constants of `glsl/voxel/slice_params.glsl`, field for field (std430 push
+/// constant layout: two vec2, a float and a uint, 24 bytes, no padding).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct SliceParams {
+    /// clip = p · clip_scale + clip_offset, p in grid units (x, z).
+    pub clip_scale: [f32; 2],
+    pub clip_offset: [f32; 2],
+    /// y of the slice plane in grid units (j + ½).
+    pub slice: f32,
+    /// 1 << (j mod 32) for a slice; a mask for a Fang slab.
+    pub bits: u32,
+}
+
+// SAFETY: four-byte fields only, `repr(C)`, no padding; any bit pattern is valid.
+unsafe impl crate::gpu::Pod for SliceParams {}
+
+/// The slicing push constants for slice `slice` of an N³ grid.
+pub(crate) fn params(n: usize, slice: f32, bits: u32) -> SliceParams {
     // clip = (u + MARGIN)·2/side − 1
     let scale = 2.0 / side(n) as f32;
     let offset = MARGIN as f32 * scale - 1.0;
-    [scale.to_bits(), scale.to_bits(), offset.to_bits(), offset.to_bits(), slice.to_bits(), bits]
+    SliceParams { clip_scale: [scale; 2], clip_offset: [offset; 2], slice, bits }
 }
 
 /// Checks that the device can draw an (N + 2)² presence buffer (N voxels and the margin)
@@ -166,4 +183,31 @@ pub(crate) fn render(
         timings.readback += t.elapsed();
     }
     Ok(volume)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slice_params_mirror_the_shader_block() {
+        // slice_params.glsl: vec2 clip_scale, vec2 clip_offset, float slice, uint bits.
+        assert_eq!(std::mem::offset_of!(SliceParams, clip_offset), 8);
+        assert_eq!(std::mem::offset_of!(SliceParams, slice), 16);
+        assert_eq!(std::mem::offset_of!(SliceParams, bits), 20);
+        let ctx = Context::from_env().expect("a Vulkan device (tools/setup installs lavapipe)");
+        let size = std::mem::size_of::<SliceParams>() as u32;
+        for pipeline in
+            [super::super::pgpu::pipeline(&ctx).unwrap(), super::super::fgpu::pipeline(&ctx).unwrap()]
+        {
+            assert_eq!(
+                pipeline.push.map(|(_, offset, bytes)| (offset, bytes)),
+                Some((0, size)),
+                "{}",
+                pipeline.name
+            );
+        }
+        let p = params(30, 4.5, 1 << 4);
+        assert_eq!((p.clip_scale, p.slice, p.bits), ([2.0 / 32.0; 2], 4.5, 16));
+    }
 }

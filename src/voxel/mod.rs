@@ -1,5 +1,5 @@
 //! Solid voxelization by slicing the tetras of a simplicial covering with XOR (2006
-//! thesis, Ch. 5; SPEC §4; issue 4).
+//! thesis, Ch. 5; SPEC §4).
 //!
 //! Every method returns the same bit volume: voxel (i, j, k) is occupied iff its centre
 //! ([`Grid::centre`]) is inside the solid, with centres on the surface decided by the
@@ -9,10 +9,11 @@
 //! silently wrong (SPEC §0).
 //!
 //! "Inside" is the parity of the XOR accumulation (§5.3.1): an odd number of covering
-//! tetras, i.e. an odd winding number. For a valid solid that is the same as `inclusion`'s
-//! non-zero rule; they differ only for self-overlapping shells (winding 2: `inclusion`
-//! says Inside, a voxelization Outside). Where `inclusion` answers OnBoundary, the tie
-//! rule gives the voxel's value.
+//! tetras, i.e. an odd winding number. On a valid solid ([`crate::mesh::solidity`]: the
+//! winding number is 0 or 1) that is `inclusion`'s answer too; `texgeo voxelize` refuses
+//! meshes that are not valid solids (nested or overlapping shells would give winding 2,
+//! which parity calls outside), or flips inverted ones with `--flip-inverted`. Where
+//! `inclusion` answers OnBoundary, the tie rule gives the voxel's value.
 //!
 //! | method | what it is |
 //! |---|---|
@@ -39,7 +40,6 @@ pub mod raster;
 pub mod scanline;
 pub mod slicing;
 pub mod solid;
-pub mod tetragrid;
 pub mod volume;
 
 use std::time::{Duration, Instant};
@@ -53,14 +53,21 @@ pub use volume::Volume;
 use crate::gpu::Context;
 use crate::mesh::Mesh;
 
-/// A voxelization method (see the module table).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// A voxelization method (see the module table; `--method`). A new method is one variant
+/// here and one arm in [`Voxelizer::run`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Method {
+    /// Tetra slicing (Table 5-1) + scanline XOR rasterizer on the CPU.
     Cpu,
+    /// The CPU slices, the GPU rasterizes with logic-op XOR.
     Fgpu,
+    /// Alg. 5-2: the vertex shader slices a static buffer of tetras, one draw per slice.
     Pgpu,
+    /// PGPU-MP: one display list per zone of slices (`--zone`).
     Zoned,
+    /// Fang & Chen: surface triangles cut into slabs, XOR along y.
     Fang,
+    /// Exact ray parity along x rows.
     Scanline,
 }
 
@@ -86,6 +93,50 @@ impl Method {
     /// Whether the method needs a Vulkan device.
     pub fn uses_gpu(self) -> bool {
         matches!(self, Method::Fgpu | Method::Pgpu | Method::Zoned | Method::Fang)
+    }
+}
+
+/// The zone height of `zoned` (PGPU-MP, §5.4.2; `--zone`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Zone {
+    /// [`pgpu::default_zone`]: N/8 slices, between 4 and 32.
+    #[default]
+    Auto,
+    /// This many slices per zone (at least 1).
+    Slices(std::num::NonZeroUsize),
+}
+
+impl Zone {
+    /// The height in slices at resolution `n`.
+    pub fn slices(self, n: usize) -> usize {
+        match self {
+            Zone::Auto => pgpu::default_zone(n),
+            Zone::Slices(z) => z.get(),
+        }
+    }
+}
+
+impl std::str::FromStr for Zone {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Zone, String> {
+        if s == "auto" {
+            return Ok(Zone::Auto);
+        }
+        match s.parse::<usize>() {
+            Ok(z) => std::num::NonZeroUsize::new(z).map(Zone::Slices).ok_or_else(|| {
+                "a zone holds at least 1 slice (or 'auto': N/8, between 4 and 32)".to_string()
+            }),
+            Err(_) => Err(format!("'{s}' is not a number of slices or 'auto'")),
+        }
+    }
+}
+
+impl std::fmt::Display for Zone {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Zone::Auto => f.write_str("auto"),
+            Zone::Slices(z) => write!(f, "{z}"),
+        }
     }
 }
 
@@ -129,8 +180,8 @@ pub struct Voxelizer {
     slice: Option<crate::gpu::Pipeline>,
     /// Pass-through pipeline (fgpu, fang), made on first use.
     section: Option<crate::gpu::Pipeline>,
-    /// Zone height for `zoned` in slices (None: [`pgpu::default_zone`]).
-    pub zone: Option<usize>,
+    /// Zone height for `zoned`.
+    pub zone: Zone,
     /// Apply the exact fallback near the surface (on by default; off only to study a
     /// method's raw output — it can then be wrong there).
     pub fallback: bool,
@@ -139,7 +190,7 @@ pub struct Voxelizer {
 impl Voxelizer {
     /// A voxelizer; GPU methods need `ctx`.
     pub fn new(ctx: Option<Context>) -> Voxelizer {
-        Voxelizer { ctx, slice: None, section: None, zone: None, fallback: true }
+        Voxelizer { ctx, slice: None, section: None, zone: Zone::Auto, fallback: true }
     }
 
     fn context(&self, method: Method) -> Result<&Context> {
@@ -210,7 +261,7 @@ impl Voxelizer {
                     self.slice = Some(pgpu::pipeline(ctx)?);
                 }
                 let pipeline = self.slice.as_ref().ok_or_else(|| VoxelError::Usage("no pipeline".into()))?;
-                let zone = (method == Method::Zoned).then(|| self.zone.unwrap_or(0));
+                let zone = (method == Method::Zoned).then(|| self.zone.slices(grid.n));
                 let t = Instant::now();
                 let mut painter = pgpu::Tetras::new(ctx, pipeline, solid, grid, zone)?;
                 timings.prepare += t.elapsed();

@@ -90,11 +90,7 @@ impl<'a> Tetras<'a> {
     ) -> Result<Tetras<'a>> {
         let n = grid.n;
         let tetras = solid.sorted_tetras(grid);
-        let zone = match zone {
-            Some(0) => default_zone(n),
-            Some(z) => z,
-            None => n,
-        };
+        let zone = zone.unwrap_or(n).max(1);
         let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n.div_ceil(zone)];
         for (i, t) in tetras.iter().enumerate() {
             let r = f32_slices(t, n);
@@ -135,7 +131,7 @@ impl LayerPainter for Tetras<'_> {
         pass.vertex_buffers(&self.vertices, None)?;
         let first = layer * SLICES_PER_LAYER;
         for j in first..(first + SLICES_PER_LAYER).min(self.n) {
-            pass.push(&params(self.n, j as f32 + 0.5, 1 << (j - first)))?;
+            pass.push(&[params(self.n, j as f32 + 0.5, 1 << (j - first))])?;
             pass.draw(self.ranges[j / self.zone].clone(), 0..1)?;
         }
         Ok(())

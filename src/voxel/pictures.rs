@@ -14,14 +14,14 @@ pub fn slice_name(j: usize, n: usize) -> String {
 
 /// Writes one grey PNG per slice (white = occupied) into `dir`.
 pub fn write_slices(volume: &Volume, dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| VoxelError::io(dir, e))?;
+    crate::output::check_dir(dir)?;
     let n = volume.n();
     (0..n)
         .map(|j| {
             let path = dir.join(slice_name(j, n));
             let image = image::GrayImage::from_raw(n as u32, n as u32, volume.slice_pixels(j))
                 .ok_or_else(|| VoxelError::Usage("slice image size".into()))?;
-            image.save(&path).map_err(|e| VoxelError::io(&path, std::io::Error::other(e)))?;
+            crate::output::write_png(&path, &image)?;
             Ok(path)
         })
         .collect()
@@ -32,13 +32,13 @@ pub fn write_rgba_slice(n: usize, j: usize, pixels: &[u8], dir: &Path) -> Result
     let path = dir.join(slice_name(j, n));
     let image = image::RgbaImage::from_raw(n as u32, n as u32, pixels.to_vec())
         .ok_or_else(|| VoxelError::Usage("slice image size".into()))?;
-    image.save(&path).map_err(|e| VoxelError::io(&path, std::io::Error::other(e)))?;
+    crate::output::write_png(&path, &image)?;
     Ok(path)
 }
 
 /// Writes RGBA slices (`slices[j]` is slice j, n×n RGBA8) into `dir`.
 pub fn write_rgba_slices(n: usize, slices: &[Vec<u8>], dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| VoxelError::io(dir, e))?;
+    crate::output::check_dir(dir)?;
     slices.iter().enumerate().map(|(j, pixels)| write_rgba_slice(n, j, pixels, dir)).collect()
 }
 

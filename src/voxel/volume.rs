@@ -47,6 +47,15 @@ impl Volume {
         (j * self.n + k) * self.words_per_row
     }
 
+    /// Every word, rows in (j, k) order ([`Self::words_per_row`] words each).
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
+    pub fn words_per_row(&self) -> usize {
+        self.words_per_row
+    }
+
     /// The words of row (j, k): bit i of the row is voxel (i, j, k).
     pub fn row(&self, j: usize, k: usize) -> &[u64] {
         let s = self.row_start(j, k);
@@ -280,6 +289,12 @@ mod tests {
         v.xor_packed_slices(32, &texels).unwrap();
         assert!(v.get(5, 32, 3) && v.get(5, 36, 3) && v.get(36, 34, 36));
         assert_eq!(v.count(), 3);
-        assert!(Volume::new(0).is_err() && Volume::new(100_000).is_err());
+        for (n, why) in
+            [(0, "resolution 0 is outside 1..=1024"), (100_000, "resolution 100000 is outside 1..=1024 (a")]
+        {
+            let e = Volume::new(n).unwrap_err();
+            assert!(matches!(e, VoxelError::Resolution { res, .. } if res == n), "{e}");
+            assert!(e.to_string().starts_with(why), "{e}");
+        }
     }
 }

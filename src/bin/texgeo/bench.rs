@@ -12,12 +12,12 @@ pub enum Command {
         #[command(flatten)]
         models: Models,
         /// Point sets per model (the thesis: 10).
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = crate::args::positive_usize)]
         sets: usize,
         /// Points per set (the thesis: 1000).
-        #[arg(long, default_value_t = 1000)]
+        #[arg(long, default_value_t = 1000, value_parser = crate::args::positive_usize)]
         points: usize,
-        /// TetraGrid resolutions for Tables 4-4 and 4-5.
+        /// TetraGrid resolutions for Tables 4-4 and 4-5 (2..=64).
         #[arg(long, value_delimiter = ',', default_values_t = vec![2, 4, 8, 16, 32, 64])]
         resolutions: Vec<usize>,
         /// Folder for the Markdown and CSV files.
@@ -28,21 +28,41 @@ pub enum Command {
     Voxelize {
         #[command(flatten)]
         models: Models,
-        /// Resolutions N (N³ voxels).
+        /// Resolutions N (N³ voxels, 1..=1024).
         #[arg(long, value_delimiter = ',', default_values_t = bench::voxelize::DEFAULT_RESOLUTIONS.to_vec())]
         sizes: Vec<usize>,
         /// Methods to measure (default: all).
-        #[arg(long, value_delimiter = ',')]
-        methods: Vec<String>,
-        /// Zone height in slices for `zoned` (default: automatic).
-        #[arg(long)]
-        zone: Option<usize>,
+        #[arg(long, value_delimiter = ',', value_enum)]
+        methods: Vec<texgeo::voxel::Method>,
+        /// Zone height in slices for `zoned`: a number ≥ 1, or `auto` (N/8, between 4 and 32).
+        #[arg(long, default_value_t = texgeo::voxel::Zone::Auto)]
+        zone: texgeo::voxel::Zone,
         /// Timed runs per measurement (the median is reported).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = crate::args::positive_usize)]
         runs: usize,
         /// Folder for the Markdown and CSV files.
         #[arg(long, short, default_value = "out/bench")]
         out: PathBuf,
+    },
+    /// Booleans: the thesis' Table 6-1 (phases, plain vs grouped, CPU vs GPU point tests,
+    /// CGAL) on stand-in pairs, and the growth from 1 k to 100 k triangles.
+    Boolean {
+        #[command(flatten)]
+        models: Models,
+        /// CPU inclusion method for the point tests.
+        #[arg(long, default_value = "octants")]
+        method: String,
+        /// Skip the plain classification (one point test per triangle; slow on big models).
+        #[arg(long)]
+        no_plain: bool,
+        /// Skip CGAL.
+        #[arg(long)]
+        no_cgal: bool,
+        /// Triangle counts of the scaling series (sphere − turned copy); 0 = none.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1_000, 4_000, 16_000, 64_000, 100_000])]
+        scaling: Vec<usize>,
+        #[command(flatten)]
+        common: Common,
     },
     /// XOR rasterization (logic op) of random triangles against the CPU scanline rasterizer.
     Xor {
@@ -50,7 +70,7 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = bench::xor::DEFAULT_SIDES.to_vec())]
         sizes: Vec<u32>,
         /// Triangles per target.
-        #[arg(long, default_value_t = 20_000)]
+        #[arg(long, default_value_t = 20_000, value_parser = crate::args::positive_usize)]
         triangles: usize,
         #[command(flatten)]
         common: Common,
@@ -66,8 +86,8 @@ pub enum Command {
     /// The 2010 thesis' Table 5: Catmull-Clark to level 5 with fragment meshes on the GPU
     /// vs the CPU reference and OpenSubdiv, on built-in models and fetched ones.
     Subdivide {
-        /// Subdivision level.
-        #[arg(long, short, default_value_t = 5)]
+        /// Subdivision level (≥ 1).
+        #[arg(long, short, default_value_t = 5, value_parser = crate::args::positive_u32)]
         level: u32,
         /// Extra mesh files (or `builtin:NAME`) to measure after the default models.
         #[arg(long = "mesh", value_name = "MESH")]
@@ -82,6 +102,14 @@ pub enum Command {
         /// Also compare every GPU result with OpenSubdiv (slow on millions of faces).
         #[arg(long)]
         validate: bool,
+        /// Instead of Table 5: sharp features — each model with its feature edges creased
+        /// against itself without creases (default models: fandisk.off and
+        /// couplingdown.off when fetched, builtin:knot).
+        #[arg(long)]
+        creases: bool,
+        /// With --creases: edges whose faces meet at more than this many degrees are creased.
+        #[arg(long, default_value_t = 30.0)]
+        crease_angle: f64,
         #[command(flatten)]
         common: Common,
     },
@@ -129,7 +157,7 @@ impl Models {
 #[derive(clap::Args)]
 pub struct Common {
     /// Timed runs per measurement (the median is reported).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = crate::args::positive_usize)]
     runs: usize,
     /// Folder for the Markdown and CSV files.
     #[arg(long, short, default_value = "out/bench")]
@@ -137,7 +165,7 @@ pub struct Common {
 }
 
 fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
-    println!("{}", report.to_markdown());
+    say!("{}", report.to_markdown());
     for f in report.write(&common.out)? {
         eprintln!("wrote {}", f.display());
     }
@@ -145,10 +173,18 @@ fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
 }
 
 pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
+    // The report folder must take files before hours of measuring start.
+    let out = match &cmd {
+        Command::Inclusion { out, .. } | Command::Voxelize { out, .. } => out,
+        Command::Xor { common, .. }
+        | Command::Reduce { common, .. }
+        | Command::Subdivide { common, .. }
+        | Command::Boolean { common, .. } => &common.out,
+    };
+    texgeo::output::check_dir(out)?;
     let ctx = crate::open_context(device)?;
     match cmd {
         Command::Inclusion { models, sets, points, resolutions, out } => {
-            anyhow::ensure!(sets > 0 && points > 0, "--sets and --points must be positive");
             let models = models
                 .load(bench::inclusion::STAND_INS)?
                 .into_iter()
@@ -158,15 +194,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             finish(bench::inclusion::run(&ctx, &models, &cfg)?, &Common { runs: 0, out })
         }
         Command::Voxelize { models, sizes, methods, zone, runs, out } => {
-            use texgeo::voxel::Method;
-            let methods = if methods.is_empty() {
-                Method::ALL.to_vec()
-            } else {
-                methods
-                    .iter()
-                    .map(|m| Method::parse(m).ok_or_else(|| anyhow::anyhow!("unknown method '{m}'")))
-                    .collect::<anyhow::Result<_>>()?
-            };
+            let methods = if methods.is_empty() { texgeo::voxel::Method::ALL.to_vec() } else { methods };
             for &n in &sizes {
                 texgeo::voxel::grid::check_resolution(n)?;
             }
@@ -179,11 +207,31 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
             finish(bench::voxelize::run(&ctx, &models, &cfg)?, &Common { runs, out })
         }
+        Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {
+            use bench::boolean::{Config, Pair, STAND_INS};
+            let cpu_method: texgeo::inclusion::Method = method.parse()?;
+            anyhow::ensure!(
+                cpu_method.is_cpu(),
+                "--method takes a CPU inclusion method (the GPU one always runs)"
+            );
+            let pairs = models
+                .load(STAND_INS)?
+                .into_iter()
+                .map(|(thesis, name, mesh)| Ok(Pair::with_turned_copy(thesis, name, mesh)?))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let cfg = Config {
+                runs: common.runs,
+                cpu_method,
+                plain: !no_plain,
+                cgal: !no_cgal,
+                scaling: scaling.into_iter().filter(|&n| n > 0).collect(),
+            };
+            finish(bench::boolean::run(&ctx, &pairs, &cfg)?, &common)
+        }
         Command::Xor { sizes, triangles, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
-            anyhow::ensure!(triangles > 0, "--triangles must be positive");
             finish(bench::xor::run(&ctx, &sizes, triangles, common.runs)?, &common)
         }
         Command::Reduce { sizes, common } => {
@@ -192,8 +240,23 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             }
             finish(bench::reduce::run(&ctx, &sizes, common.runs)?, &common)
         }
-        Command::Subdivide { level, meshes, models, only, validate, common } => {
-            use bench::subdiv::{Model, Settings, default_models};
+        Command::Subdivide { level, meshes, models, only, validate, creases, crease_angle, common } => {
+            use bench::subdiv::{CreaseSettings, Model, Settings, crease_models, default_models};
+            if creases {
+                anyhow::ensure!((0.0..=180.0).contains(&crease_angle), "--crease-angle must be in 0..=180");
+                let mut list = if only { Vec::new() } else { crease_models(&models)? };
+                for m in &meshes {
+                    list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+                }
+                anyhow::ensure!(!list.is_empty(), "no models to measure");
+                let settings = CreaseSettings {
+                    level,
+                    runs: common.runs,
+                    angle_degrees: crease_angle,
+                    sharpness: &[10.0, 2.5],
+                };
+                return finish(bench::subdiv::run_creases(&ctx, &list, settings)?, &common);
+            }
             let mut list = if only { Vec::new() } else { default_models(&models)? };
             for m in &meshes {
                 list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });

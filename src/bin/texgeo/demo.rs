@@ -16,9 +16,9 @@ pub struct Args {
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    texgeo::output::check_dir(&args.out)?;
     let ctx = crate::open_context(device)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    println!("device: {}", ctx.info().label());
+    say!("device: {}", ctx.info().label());
 
     // 1. Reduction: sum a 512×512 texture of random integers on the GPU and on the CPU.
     let n = 512u32;
@@ -29,7 +29,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let gpu = reduce_sum(&ctx, &data, n, n)?;
     let gpu_ms = t.elapsed().as_secs_f64() * 1e3;
     let cpu = texgeo::report::bench::reduce::cpu_sum(&data);
-    println!(
+    say!(
         "reduce_sum {n}x{n} RGBA32F: GPU {gpu:?} ({gpu_ms:.1} ms incl. upload), CPU {cpu:?}: {}",
         if gpu == cpu { "equal" } else { "DIFFERENT" }
     );
@@ -52,27 +52,27 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let bits = xor.rasterize(&ctx, size, size, &tris, 1)?;
     let pixels: Vec<u8> = bits.iter().map(|&b| if b & 1 == 1 { 255 } else { 0 }).collect();
     let png = args.out.join("xor-star.png");
-    image::GrayImage::from_raw(size, size, pixels)
-        .context("image size")?
-        .save(&png)
-        .with_context(|| format!("writing {}", png.display()))?;
+    texgeo::output::write_png(&png, &image::GrayImage::from_raw(size, size, pixels).context("image size")?)?;
     let set = bits.iter().filter(|&&b| b & 1 == 1).count();
-    println!(
-        "XOR raster: {k} overlapping triangles -> {set} texels of odd parity, picture {}",
-        png.display()
-    );
+    say!("XOR raster: {k} overlapping triangles -> {set} texels of odd parity, picture {}", png.display());
 
     // 3. The built-in models and what the mesh checks say about them.
-    println!("\nbuilt-in models:");
-    println!(
+    say!("\nbuilt-in models:");
+    say!(
         "{:<12} {:>6} {:>6} {:>7} {:>9} {:>9} {:>4}",
-        "name", "V", "F", "closed", "oriented", "manifold", "chi"
+        "name",
+        "V",
+        "F",
+        "closed",
+        "oriented",
+        "manifold",
+        "chi"
     );
     for name in procedural::BUILTIN_NAMES {
         let Some(m) = procedural::by_name(name) else { continue };
         let r = m.report();
         let yn = |b: bool| if b { "yes" } else { "no" };
-        println!(
+        say!(
             "{name:<12} {:>6} {:>6} {:>7} {:>9} {:>9} {:>4}",
             m.num_vertices(),
             m.num_faces(),
@@ -107,7 +107,7 @@ fn inclusion(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Resul
             glam::DVec3::new(lo.x + (hi.x - lo.x) * i / n as f64, hi.y - (hi.y - lo.y) * j / n as f64, 0.0)
         })
         .collect();
-    println!(
+    say!(
         "
 point in solid, {} points on the plane z = 0 through builtin:knot:",
         points.len()
@@ -118,11 +118,11 @@ point in solid, {} points on the plane z = 0 through builtin:knot:",
         let t = std::time::Instant::now();
         let classes = solver.classify_all(&points)?;
         let inside = classes.iter().filter(|&&c| c == Class::Inside).count();
-        println!("  {:<14} {inside:>6} inside in {:>7.1} ms", method.name(), t.elapsed().as_secs_f64() * 1e3);
+        say!("  {:<14} {inside:>6} inside in {:>7.1} ms", method.name(), t.elapsed().as_secs_f64() * 1e3);
         answers.push(classes);
     }
     let agree = answers.windows(2).all(|w| w[0] == w[1]);
-    println!("  all methods agree point for point: {}", if agree { "yes" } else { "NO" });
+    say!("  all methods agree point for point: {}", if agree { "yes" } else { "NO" });
     anyhow::ensure!(agree, "inclusion methods disagree");
     let pixels: Vec<u8> = answers[0]
         .iter()
@@ -133,11 +133,11 @@ point in solid, {} points on the plane z = 0 through builtin:knot:",
         })
         .collect();
     let png = out.join("inclusion-knot-slice.png");
-    image::GrayImage::from_raw(n as u32, n as u32, pixels)
-        .context("image size")?
-        .save(&png)
-        .with_context(|| format!("writing {}", png.display()))?;
-    println!("  picture {}", png.display());
+    texgeo::output::write_png(
+        &png,
+        &image::GrayImage::from_raw(n as u32, n as u32, pixels).context("image size")?,
+    )?;
+    say!("  picture {}", png.display());
     Ok(())
 }
 
@@ -145,7 +145,7 @@ point in solid, {} points on the plane z = 0 through builtin:knot:",
 /// GPU, compared with the CPU reference and OpenSubdiv, written as OBJ.
 fn subdivision(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Result<()> {
     use texgeo::subdiv::{compare::Comparison, cpu, gpu, osd};
-    println!("\nCatmull-Clark, level 3 (fragment passes on the GPU vs references):");
+    say!("\nCatmull-Clark, level 3 (fragment passes on the GPU vs references):");
     let mut subdivider = gpu::Subdivider::new(ctx)?;
     for name in ["cube", "knot"] {
         let Some(mesh) = procedural::by_name(name) else { continue };
@@ -162,9 +162,8 @@ fn subdivision(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Res
             Err(e) => format!("not run ({e})"),
         };
         let file = out.join(format!("subdiv-{name}-level3.obj"));
-        texgeo::mesh::formats::write(&file, refined)
-            .with_context(|| format!("writing {}", file.display()))?;
-        println!(
+        texgeo::mesh::formats::write(&file, refined)?;
+        say!(
             "{name}: {} fragments, {} CPU + {} GPU levels -> {} vertices, {} quads in {:.1} ms, {}",
             run.fragments,
             run.cpu_levels,
@@ -174,7 +173,7 @@ fn subdivision(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Res
             run.times.total.as_secs_f64() * 1e3,
             file.display()
         );
-        println!("  vs CPU reference: {vs_cpu}; vs OpenSubdiv: {vs_osd}");
+        say!("  vs CPU reference: {vs_cpu}; vs OpenSubdiv: {vs_osd}");
     }
     Ok(())
 }
@@ -197,10 +196,8 @@ fn voxelization(ctx: &texgeo::gpu::Context, out: &std::path::Path) -> anyhow::Re
     let colours = voxel::aspect::render(ctx, &zoned.volume, &voxel::aspect::Aspect::default())?;
     voxel::pictures::write_rgba_slices(n, &colours, &out.join("knot-aspect"))?;
     let picture = out.join("knot-voxels.png");
-    voxel::pictures::render_front(&zoned.volume, Some(&colours))
-        .save(&picture)
-        .with_context(|| format!("writing {}", picture.display()))?;
-    println!(
+    texgeo::output::write_png(&picture, &voxel::pictures::render_front(&zoned.volume, Some(&colours)))?;
+    say!(
         "\nvoxelized the torus knot at {n}³ (zoned, {:.0} ms): {} voxels occupied, equal to the exact scanline; \
          {} centres near the surface decided exactly; wrote {}, {} slice PNGs, marble slices and {}",
         zoned.timings.total.as_secs_f64() * 1e3,

@@ -1,4 +1,4 @@
-//! `texgeo inclusion`: classify query points against a closed solid.
+//! `texgeo inclusion`: classify query points against a solid.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -6,77 +6,97 @@ use std::time::Instant;
 use anyhow::Context as _;
 use texgeo::inclusion::solver::Solver;
 use texgeo::inclusion::{Class, Method, Options, points};
+use texgeo::mesh::solidity::Policy;
 use texgeo::random::Rng;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The solid: a closed mesh file or `builtin:NAME`.
+    /// The solid: a mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
     mesh: String,
     /// Query points: one `x y z` per line, `#` comments allowed.
     #[arg(long, value_name = "FILE", conflicts_with = "random", required_unless_present = "random")]
     points: Option<PathBuf>,
-    /// N uniform random points in the mesh's bounding box.
-    #[arg(long, value_name = "N")]
+    /// N uniform random points in the mesh's bounding box (N ≥ 1).
+    #[arg(long, value_name = "N", value_parser = crate::args::positive_usize)]
     random: Option<usize>,
     /// Seed for `--random`.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// cpu, bvh, octants, tetragrid, gpu, cpu+gpu, gpu+tetragrid, jordan, jordan-octree, winding.
-    #[arg(long, default_value = "gpu")]
-    method: String,
+    #[arg(long, value_enum, default_value_t = Method::Gpu)]
+    method: Method,
     /// TetraGrid resolution n (n³ cells, 2..=64), for tetragrid and gpu+tetragrid.
     #[arg(long, default_value_t = 32)]
     grid: usize,
     /// GPU methods: tetrahedra per point-vertex (1 = the thesis' one point per tetrahedron).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::args::positive_u32)]
     batch: Option<u32>,
-    /// Accept a mesh that is not closed and consistently oriented (with a warning).
+    /// Accept a mesh that is not closed: a point is then inside iff the generalized winding
+    /// number of the open surface is at least ½, which only `--method winding` computes.
     #[arg(long)]
     allow_open: bool,
+    /// Reverse every face of an inverted solid (faces pointing inwards) instead of refusing it.
+    #[arg(long)]
+    flip_inverted: bool,
     /// Write one line per point: 1 inside, 0 outside, 2 on the boundary.
     #[arg(short, long)]
     output: Option<PathBuf>,
 }
 
+/// Bytes per query point while classifying: the point (24), its class, the GPU paths'
+/// per-point bookkeeping (flags, cell keys, sorted order), with margin.
+const BYTES_PER_POINT: u64 = 64;
+
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
-    let method: Method = args.method.parse()?;
-    let mesh = crate::mesh::load(&args.mesh)?;
+    if let Some(out) = &args.output {
+        texgeo::output::check_file(out)?;
+    }
+    // The size of the request, before anything is read or allocated.
+    let count = match (&args.points, args.random) {
+        (Some(file), _) => {
+            // A point takes at least 6 bytes of text ("0 0 0\n").
+            let bytes = std::fs::metadata(file).map_err(|e| texgeo::output::Error::new(file, e))?.len();
+            bytes / 6 + 1
+        }
+        (None, Some(n)) => n as u64,
+        (None, None) => anyhow::bail!("give --points FILE or --random N"),
+    };
+    check_size(count, args.points.is_some(), args.output.is_some())?;
+    let policy =
+        Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted, ..Policy::default() };
+    let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
+    let mesh = solid.mesh;
+    if solid.flipped {
+        eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
+    }
     let pts = match (&args.points, args.random) {
         (Some(file), _) => points::read(file)?,
-        (None, Some(n)) => {
+        (_, Some(n)) => {
             let (lo, hi) = mesh.bounds();
             Rng::new(args.seed).points_in_box(n, lo, hi)
         }
-        (None, None) => anyhow::bail!("give --points FILE or --random N"),
+        (None, None) => unreachable!("checked above"),
     };
-    let ctx = if method.is_cpu() { None } else { Some(crate::open_context(device)?) };
+    let ctx = if args.method.is_cpu() { None } else { Some(crate::open_context_for(device, "cpu")?) };
     let options =
         Options { tetragrid_resolution: args.grid, allow_open: args.allow_open, ..Options::default() };
-    if args.allow_open {
-        if let Some(e) = texgeo::mesh::covering::Covering::new(&mesh).unbalanced_edge() {
-            eprintln!(
-                "texgeo: warning: {} is not closed and consistently oriented (edge {}-{} used {}x one way, {}x the other); \
-                 answers follow the covering's winding number and may not describe a solid",
-                args.mesh, e.a, e.b, e.forward, e.backward
-            );
-        }
-    }
     let t = Instant::now();
-    let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
-        .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
+    let mut solver = Solver::new(args.method, &mesh, &options, ctx.as_ref(), args.batch)
+        .with_context(|| format!("preparing {} for {}", args.method, args.mesh))?;
     let build = t.elapsed();
+    if solid.open {
+        eprintln!(
+            "texgeo: warning: {} is not closed; points are classified by the generalized winding number",
+            args.mesh
+        );
+    }
     let t = Instant::now();
     let classes = solver.classify_all(&pts)?;
     let run = t.elapsed();
     match &args.output {
-        Some(path) => {
-            let mut f =
-                std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-            points::write_classes(&mut f, &classes).with_context(|| format!("writing {}", path.display()))?;
-        }
+        Some(path) => texgeo::output::write_with(path, |w| points::write_classes(w, &classes))?,
         None => {
             let count = |c: Class| classes.iter().filter(|&&x| x == c).count();
-            println!(
+            say!(
                 "{}: {} points, {} inside, {} outside, {} on the boundary",
                 args.mesh,
                 pts.len(),
@@ -85,7 +105,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                 count(Class::OnBoundary)
             );
             let stats = solver.build_stats();
-            println!(
+            say!(
                 "method {}: build {:.3} ms ({:.1} KiB of structures), classify {:.3} ms",
                 solver.name(),
                 build.as_secs_f64() * 1e3,
@@ -93,7 +113,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                 run.as_secs_f64() * 1e3
             );
             if let Some(g) = solver.gpu_stats() {
-                println!(
+                say!(
                     "GPU: {} points drawn in {} draw(s), {:.3} ms; {} flagged and answered exactly on the CPU in {:.3} ms",
                     g.gpu_points,
                     g.draws,
@@ -102,10 +122,25 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                     g.fallback.as_secs_f64() * 1e3
                 );
                 if let Some(ctx) = &ctx {
-                    println!("device: {}", ctx.info().label());
+                    say!("device: {}", ctx.info().label());
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// Refuses, before any work, a point count whose memory exceeds what is available; the
+/// message gives the estimate and the size of the output text.
+fn check_size(count: u64, from_file: bool, to_file: bool) -> anyhow::Result<()> {
+    let bytes = count.saturating_mul(BYTES_PER_POINT);
+    if let Err((need, have)) = texgeo::host::check_available(bytes) {
+        let what = if from_file { "the points of that file (at most)" } else { "that many points" };
+        let text =
+            if to_file { format!("; -o would be {} MiB of text", (count * 2) >> 20) } else { String::new() };
+        anyhow::bail!(
+            "{count} points: {what} need about {need} MiB of memory, but only {have} MiB are available{text}"
+        );
     }
     Ok(())
 }

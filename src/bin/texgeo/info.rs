@@ -14,22 +14,21 @@ fn yes(b: bool) -> &'static str {
 }
 
 fn print(d: &DeviceInfo) {
-    println!("device: {} (index {}, {})", d.name, d.index, d.kind);
-    println!("driver: {} {}", d.driver, d.driver_info);
-    println!("Vulkan API: {}", d.api_version);
-    println!("logicOp: {}", yes(d.logic_op));
-    println!(
+    say!("device: {} (index {}, {})", d.name, d.index, d.kind);
+    say!("driver: {} {}", d.driver, d.driver_info);
+    say!("Vulkan API: {}", d.api_version);
+    say!("logicOp: {}", yes(d.logic_op));
+    say!(
         "max texture size: {0}x{0} (2D), {1} layers, {2}^3 (3D)",
-        d.max_image_2d, d.max_array_layers, d.max_image_3d
+        d.max_image_2d,
+        d.max_array_layers,
+        d.max_image_3d
     );
-    println!("color attachments: {}", d.max_color_attachments);
-    println!(
-        "push constants: {} bytes; vertex attributes: {}",
-        d.max_push_constants, d.max_vertex_attributes
-    );
-    println!("shaderFloat64: {}", yes(d.float64));
-    println!("timestamps: {} ({} ns per tick)", yes(d.timestamps), d.timestamp_period_ns);
-    println!(
+    say!("color attachments: {}", d.max_color_attachments);
+    say!("push constants: {} bytes; vertex attributes: {}", d.max_push_constants, d.max_vertex_attributes);
+    say!("shaderFloat64: {}", yes(d.float64));
+    say!("timestamps: {} ({} ns per tick)", yes(d.timestamps), d.timestamp_period_ns);
+    say!(
         "dynamic rendering + synchronization2: {}; push descriptors: {}",
         yes(d.vulkan13),
         yes(d.push_descriptor)
@@ -43,7 +42,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if args.all {
         for (i, d) in list_devices()?.iter().enumerate() {
             if i > 0 {
-                println!();
+                say!();
             }
             print(d);
         }
@@ -51,7 +50,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     }
     let ctx = crate::open_context(device)?;
     print(ctx.info());
-    println!(
+    say!(
         "validation layer: {}",
         if ctx.validating() { "on" } else { "off (TEXGEO_VALIDATION=1 turns it on)" }
     );

@@ -1,7 +1,20 @@
 //! The `texgeo` command line. Errors print one message and exit with status 2 (a failed
-//! `--validate` comparison exits with status 1).
+//! `--validate` comparison exits with status 1). Every output file is written atomically
+//! ([`texgeo::output`]) after its path was checked, before any work; a closed stdout
+//! (`texgeo … | head`) only loses the printed lines.
 
+/// `println!` that tolerates a closed stdout: printing is a courtesy, the work and the
+/// output files still get done.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+mod args;
 mod bench;
+mod boolean;
 mod demo;
 mod inclusion;
 mod info;
@@ -58,6 +71,8 @@ enum Command {
     /// Every experiment of both theses in one report: tables beside the thesis', plots,
     /// pictures and a verdict on every claim (`--compare OLD NEW` compares two runs).
     Reproduce(reproduce::Args),
+    /// Boolean operations on two closed solids: union, intersection, difference, symmetric difference.
+    Boolean(boolean::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -66,8 +81,41 @@ pub fn open_context(device: Option<&str>) -> anyhow::Result<Context> {
     Ok(Context::new(&options)?)
 }
 
+/// Opens the device for a GPU method of a command that also has CPU methods: without a
+/// Vulkan driver, the message says which CPU method to use instead.
+pub fn open_context_for(device: Option<&str>, cpu_method: &str) -> anyhow::Result<Context> {
+    let options = ContextOptions { device: DeviceChoice::from_env_or(device), validation: None };
+    Context::new(&options).map_err(|e| {
+        if e.is_missing_driver() {
+            anyhow::anyhow!("{e}; without a Vulkan driver, use a CPU method (--method {cpu_method})")
+        } else {
+            e.into()
+        }
+    })
+}
+
 fn main() {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help, --version: not errors.
+            let _ = e.print();
+            return;
+        }
+        Err(e) => {
+            // clap's usage errors, on one line like every other error (without the usage
+            // block, which --help shows).
+            let text = e.to_string();
+            let parts: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+                .filter(|l| !l.is_empty())
+                .collect();
+            eprintln!("texgeo: error: {} (see --help)", parts.join(" ").trim_start_matches("error: "));
+            std::process::exit(2);
+        }
+    };
     let device = cli.device.as_deref();
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
@@ -81,9 +129,27 @@ fn main() {
         Command::Render(a) => render::run(device, a),
         Command::View(a) => view::run(device, a),
         Command::Reproduce(a) => reproduce::run(device, a),
+        Command::Boolean(a) => boolean::run(device, a),
     };
     if let Err(e) = result {
-        eprintln!("texgeo: error: {e:#}");
+        eprintln!("texgeo: error: {}", one_line(&e));
         std::process::exit(2);
     }
+}
+
+/// The error and its causes on one line, each cause once (a cause whose text its
+/// context already repeats is not printed again).
+fn one_line(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out.lines().map(str::trim).collect::<Vec<_>>().join(" ")
 }

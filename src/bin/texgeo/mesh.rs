@@ -1,22 +1,27 @@
-//! `texgeo mesh stats|convert|builtins`.
+//! `texgeo mesh stats|convert|builtins`, and how every command reads its mesh.
 
 use std::path::PathBuf;
 
 use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
+use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
 use texgeo::mesh::{Mesh, formats, procedural};
+use texgeo::subdiv::Features;
+use texgeo::subdiv::tags::{self, Tagged, TaggedOptions};
 
 #[derive(clap::Subcommand)]
 pub enum Command {
-    /// Vertices, faces, face degrees, closed/manifold/oriented, volume, area, centroid.
+    /// Vertices, faces, face degrees, edges, closed/oriented/manifold, Euler characteristic,
+    /// shells and whether it is a solid (and why not), area, volume, centroids.
     Stats {
         /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
         mesh: String,
     },
-    /// Convert between formats (chosen by extension).
+    /// Convert between formats (chosen by extension); polygons are triangulated for STL.
     Convert {
-        /// A mesh file or `builtin:NAME`.
+        /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
         input: String,
+        /// The output file (.obj .off .ply .stl), written atomically.
         output: PathBuf,
     },
     /// List the built-in procedural models (use them as `builtin:NAME`).
@@ -33,34 +38,63 @@ pub fn load(spec: &str) -> anyhow::Result<Mesh> {
     Ok(formats::read(spec)?)
 }
 
+/// Reads a mesh and lets it through only if it is a solid ([`solidity::require_solid`]),
+/// or what `policy` accepts; the error names the reason and, among `flags` (the command's
+/// own), the one that would accept it.
+/// Reads a mesh with its sharp-feature tags (OpenSubdiv's `t crease`, … in an OBJ file;
+/// other formats and built-in models have none).
+pub fn load_tagged(spec: &str) -> anyhow::Result<Tagged> {
+    if spec.starts_with("builtin:") {
+        return Ok(Tagged {
+            mesh: load(spec)?,
+            features: Features::default(),
+            options: TaggedOptions::default(),
+            ignored: Vec::new(),
+        });
+    }
+    Ok(tags::read(spec)?)
+}
+
+pub fn load_solid(spec: &str, policy: Policy, flags: &[&str]) -> anyhow::Result<Accepted> {
+    let mesh = load(spec)?;
+    solidity::require_solid(mesh, policy).map_err(|e| {
+        let hint = match e.defect.remedy().filter(|f| flags.contains(f)) {
+            Some(f @ "--flip-inverted") => format!(" ({f} reverses every face)"),
+            Some(f @ "--allow-open") => {
+                format!(" ({f} classifies it by the generalized winding number, with --method winding)")
+            }
+            _ => String::new(),
+        };
+        anyhow::anyhow!("{spec}: {e}{hint}")
+    })
+}
+
 pub fn run(cmd: Command) -> anyhow::Result<()> {
     match cmd {
         Command::Stats { mesh } => {
             let m = load(&mesh)?;
-            println!("{mesh}");
-            println!("{}", m.report());
-            print_measures(&m);
+            say!("{mesh}");
+            say!("{}", m.report());
+            let solidity = solidity::check(&m);
+            say!("{solidity}");
+            if let Some(Defect::Overflow { .. }) = solidity.defects.first() {
+                anyhow::bail!("{mesh}: cannot measure it: {}", solidity.defects[0]);
+            }
+            print_measures(&m, &solidity);
             Ok(())
         }
         Command::Convert { input, output } => {
+            formats::Format::from_path(&output)?;
+            texgeo::output::check_file(&output)?;
             let m = load(&input)?;
-            formats::write(&output, &m).with_context(|| format!("writing {}", output.display()))?;
-            println!(
-                "{input} -> {}: {} vertices, {} faces",
-                output.display(),
-                m.num_vertices(),
-                m.num_faces()
-            );
+            formats::write(&output, &m)?;
+            say!("{input} -> {}: {} vertices, {} faces", output.display(), m.num_vertices(), m.num_faces());
             Ok(())
         }
         Command::Builtins => {
             for name in procedural::BUILTIN_NAMES {
                 if let Some(m) = procedural::by_name(name) {
-                    println!(
-                        "builtin:{name:<12} {:>6} vertices {:>6} faces",
-                        m.num_vertices(),
-                        m.num_faces()
-                    );
+                    say!("builtin:{name:<12} {:>6} vertices {:>6} faces", m.num_vertices(), m.num_faces());
                 }
             }
             Ok(())
@@ -69,25 +103,26 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
 }
 
 /// Volume, area and centroids from the simplicial covering (SPEC §2).
-fn print_measures(m: &Mesh) {
+fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
     let c = Covering::new(m);
     let (lo, hi) = m.bounds();
-    println!("bounding box           {lo} .. {hi}");
-    println!("area                   {}", c.area());
-    match c.unbalanced_edge() {
-        None => {
-            println!("volume                 {} (signed tetrahedra, Alg. 3-1)", c.volume());
+    say!("bounding box           {lo} .. {hi}");
+    say!("area                   {}", solidity.area);
+    match solidity.volume {
+        Some(v) => {
+            say!("volume                 {v} (signed tetrahedra, Alg. 3-1)");
             if let Some(g) = c.centroid() {
-                println!("centroid               {g} (volume)");
+                say!("centroid               {g} (volume)");
             }
         }
-        Some(e) => println!(
-            "volume                 undefined: the surface is not closed and consistently oriented \
-             (edge {}-{} used {}x forward, {}x backward)",
-            e.a, e.b, e.forward, e.backward
-        ),
+        None => {
+            let why = c.unbalanced_edge().map(|e| e.to_string()).unwrap_or_default();
+            say!(
+                "volume                 undefined: the surface is not closed and consistently oriented ({why})"
+            )
+        }
     }
     if let Some(g) = c.face_weighted_centroid() {
-        println!("centroid               {g} (face vertices, thesis §3.6.1)");
+        say!("centroid               {g} (face vertices, thesis §3.6.1)");
     }
 }

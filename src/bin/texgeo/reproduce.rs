@@ -81,7 +81,7 @@ impl Monitor for Bars {
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(dirs) = &args.compare {
         let [old, new] = dirs.as_slice() else { anyhow::bail!("--compare needs two folders: OLD NEW") };
-        print!("{}", reproduce::compare(old, new)?);
+        say!("{}", reproduce::compare(old, new)?.trim_end());
         return Ok(());
     }
     let out = args.out.clone().ok_or_else(|| anyhow::anyhow!("-o DIR is required"))?;
@@ -102,7 +102,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mut bars = Bars { multi, overall };
     let outcome = reproduce::run(&ctx, &config, &mut bars)?;
     bars.overall.finish_and_clear();
-    println!(
+    say!(
         "wrote {} and {} in {:.1} s: claims {} hold, {} do not hold, {} not measurable",
         outcome.report.display(),
         outcome.html.display(),

@@ -8,7 +8,7 @@
 //! | OBJ | `v`/`f` via `tobj`, polygons kept, groups merged | `v`/`f`, exact decimals |
 //! | OFF | OFF/COFF/NOFF/CNOFF | OFF, exact decimals |
 //! | PLY | ascii, binary little/big endian | binary little endian, `double` (exact) |
-//! | STL | ascii, binary; vertices welded | binary (f32; faces fan-triangulated) |
+//! | STL | ascii, binary; vertices welded | binary (f32; polygons triangulated, ear clipping when non-convex) |
 
 use std::path::Path;
 
@@ -78,13 +78,12 @@ pub fn read_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
-/// Writes a mesh, choosing the format from the file extension.
+/// Writes a mesh, choosing the format from the file extension. The file is written
+/// atomically ([`crate::output`]): a failure leaves any previous file at `path` intact.
 pub fn write(path: impl AsRef<Path>, mesh: &Mesh) -> Result<()> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let mut out = Vec::new();
-    write_to(&mut out, mesh, format).map_err(|error| MeshError::Io { path: path.into(), error })?;
-    std::fs::write(path, out).map_err(|error| MeshError::Io { path: path.into(), error })
+    Ok(crate::output::write_with(path, |w| write_to(w, mesh, format))?)
 }
 
 /// Writes a mesh in `format` to any writer.

@@ -140,7 +140,8 @@ struct Header {
 
 fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let err = |line: usize, m: String| MeshError::parse(path, Location::Line(line), m);
-    let mut pos = 0usize;
+    // A byte-order mark before the magic line is skipped; offsets stay those of the file.
+    let mut pos = super::text::strip_bom(bytes).1;
     let mut line_no = 0usize;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();

@@ -15,6 +15,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::text::{parse_coord, utf8};
+use crate::mesh::triangulate::triangles;
 use crate::mesh::{Mesh, MeshError, Result, error::Location};
 
 const HEADER: usize = 80;
@@ -38,7 +39,11 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     {
         return read_binary(bytes, n as usize, path);
     }
-    let looks_ascii = bytes.trim_ascii_start().get(..5).is_some_and(|s| s.eq_ignore_ascii_case(b"solid"));
+    let looks_ascii = super::text::strip_bom(bytes)
+        .0
+        .trim_ascii_start()
+        .get(..5)
+        .is_some_and(|s| s.eq_ignore_ascii_case(b"solid"));
     let size_note = match claimed {
         Some((n, size)) => format!(
             "as binary STL its header claims {n} triangles, which take {size} bytes, but the file has {}",
@@ -214,12 +219,20 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Mesh> {
         .map_err(|e| MeshError::parse(path, Location::File, e.to_string()))
 }
 
-/// Writes binary STL. Polygon faces are fan-triangulated (v0, vi, vi+1); STL stores f32,
+/// Writes binary STL. Polygon faces are triangulated ([`crate::mesh::triangulate`]:
+/// convex ones as the fan (v0, vi, vi+1), non-convex ones by ear clipping); STL stores f32,
 /// so coordinates are rounded to f32 and a round trip is exact only to f32.
 pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
-    let triangles: usize = mesh.faces().map(|f| f.len() - 2).sum();
-    let count = u32::try_from(triangles)
-        .map_err(|_| std::io::Error::other(format!("{triangles} triangles are too many for binary STL")))?;
+    let count_triangles: usize = mesh.faces().map(|f| f.len() - 2).sum();
+    let count = u32::try_from(count_triangles).map_err(|_| {
+        std::io::Error::other(format!("{count_triangles} triangles are too many for binary STL"))
+    })?;
+    if let Some(p) = mesh.positions().iter().find(|p| p.abs().max_element() > f64::from(f32::MAX)) {
+        return Err(std::io::Error::other(format!(
+            "vertex {p} does not fit binary STL's 32-bit floats (up to {:e}); write OBJ, OFF or PLY",
+            f32::MAX
+        )));
+    }
     let mut w = std::io::BufWriter::new(out);
     let mut header = [b' '; HEADER];
     let note = b"binary STL written by texgeo";
@@ -227,7 +240,7 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     w.write_all(&header)?;
     w.write_all(&count.to_le_bytes())?;
     let pos = mesh.positions();
-    for (a, b, c) in fan(mesh) {
+    for [a, b, c] in triangles(mesh) {
         let (a, b, c) = (pos[a as usize], pos[b as usize], pos[c as usize]);
         let n = (b - a).cross(c - a).normalize_or_zero();
         for v in [n, a, b, c] {
@@ -246,7 +259,7 @@ pub fn write_ascii(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     let pos = mesh.positions();
     writeln!(w, "solid texgeo")?;
-    for (a, b, c) in fan(mesh) {
+    for [a, b, c] in triangles(mesh) {
         let (a, b, c) = (pos[a as usize], pos[b as usize], pos[c as usize]);
         let n = (b - a).cross(c - a).normalize_or_zero();
         writeln!(w, "facet normal {} {} {}", n.x as f32, n.y as f32, n.z as f32)?;
@@ -259,9 +272,4 @@ pub fn write_ascii(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     }
     writeln!(w, "endsolid texgeo")?;
     w.flush()
-}
-
-/// Fan triangles (v0, vi, vi+1) of every face.
-fn fan(mesh: &Mesh) -> impl Iterator<Item = (u32, u32, u32)> + '_ {
-    mesh.faces().flat_map(|f| f.windows(2).skip(1).map(move |w| (f[0], w[0], w[1])))
 }

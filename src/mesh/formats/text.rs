@@ -36,15 +36,32 @@ impl<'a> Lines<'a> {
     }
 }
 
+/// The UTF-8 byte-order mark some editors put at the start of text files.
+pub(crate) const BOM: &[u8] = b"\xef\xbb\xbf";
+
+/// `bytes` without a leading byte-order mark, and the length of what was removed.
+pub(crate) fn strip_bom(bytes: &[u8]) -> (&[u8], usize) {
+    match bytes.strip_prefix(BOM) {
+        Some(rest) => (rest, BOM.len()),
+        None => (bytes, 0),
+    }
+}
+
 /// `bytes` as text, or an error naming the line and byte offset of the first invalid
 /// UTF-8 sequence. `lines_before` and `bytes_before` say where `bytes` starts in the file
-/// (for text that follows a header).
+/// (for text that follows a header); at the start of a file a byte-order mark is skipped.
 pub(crate) fn utf8<'a>(
     bytes: &'a [u8],
     path: &Path,
     lines_before: usize,
     bytes_before: usize,
 ) -> Result<&'a str, MeshError> {
+    let (bytes, bytes_before) = if lines_before == 0 && bytes_before == 0 {
+        let (rest, skipped) = strip_bom(bytes);
+        (rest, skipped)
+    } else {
+        (bytes, bytes_before)
+    };
     std::str::from_utf8(bytes).map_err(|e| {
         let at = e.valid_up_to();
         let line = lines_before + 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();

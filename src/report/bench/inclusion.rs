@@ -14,7 +14,7 @@ use crate::inclusion::bvh::Bvh;
 use crate::inclusion::octants::Octants;
 use crate::inclusion::octree::JordanOctree;
 use crate::inclusion::solver::Solver;
-use crate::inclusion::tetragrid::{RESOLUTIONS, TetraGrid};
+use crate::inclusion::tetragrid::{GridClassifier, RESOLUTIONS};
 use crate::inclusion::{Class, Classifier, EdgeRule, FeitoTorres, InclusionError, Method, Options};
 use crate::mesh::Mesh;
 use crate::random::Rng;
@@ -221,14 +221,14 @@ fn measure_model(
     let cpu = crate::inclusion::build(Method::Cpu, mesh, &Options::default())?;
     let want: Vec<Vec<Class>> = sets.iter().map(|s| cpu.classify_all(s)).collect();
 
-    // Tables 4-4 and 4-5: TetraGrid at every resolution.
+    // Tables 4-4 and 4-5: GridClassifier at every resolution.
     for &n in &cfg.resolutions {
         if !RESOLUTIONS.contains(&n) {
             return Err(InclusionError::Resolution(n));
         }
         progress.step(&format!("{}: TetraGrid {n}³", model.name));
         let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
-        let grid = TetraGrid::new(ft, n)?;
+        let grid = GridClassifier::new(ft, n)?;
         let s = grid.index_stats();
         m.grid_builds.push((s.build_time, s.bytes));
         let (t, ok) = set_times(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
@@ -274,7 +274,7 @@ fn measure_model(
     let ft = || FeitoTorres::with_options(mesh, None, EdgeRule::Rerun);
     m.index = vec![
         ("octants", Octants::new(ft()?).index_stats()),
-        ("tetragrid", TetraGrid::new(ft()?, 32)?.index_stats()),
+        ("tetragrid", GridClassifier::new(ft()?, 32)?.index_stats()),
         ("bvh", Bvh::new(ft()?).index_stats()),
         ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
     ];
@@ -295,7 +295,7 @@ fn measure_model(
 
 /// The mean share of the `tetrahedra` a query point of `sets` is tested against: those
 /// listed in its TetraGrid cell (none outside the grid).
-fn tested_share(grid: &TetraGrid, sets: &[Vec<DVec3>], tetrahedra: usize) -> f64 {
+fn tested_share(grid: &GridClassifier, sets: &[Vec<DVec3>], tetrahedra: usize) -> f64 {
     let (mut listed, mut points) = (0usize, 0usize);
     for p in sets.iter().flatten() {
         listed += grid.cell_of(*p).map_or(0, |c| grid.cell_tetras(c).len());
@@ -332,7 +332,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         cols.push(format!("{n}³ KiB"));
     }
     let mut t44 = Table {
-        title: "Table 4-4: TetraGrid build time (s) and memory (KiB)".into(),
+        title: "Table 4-4: GridClassifier build time (s) and memory (KiB)".into(),
         columns: cols,
         ..Default::default()
     };

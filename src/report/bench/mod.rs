@@ -1,5 +1,6 @@
 //! Benchmark suites behind `texgeo bench …` and `cargo bench`.
 
+pub mod boolean;
 pub mod inclusion;
 pub mod reduce;
 pub mod subdiv;

@@ -31,8 +31,8 @@ pub struct Config {
     pub methods: Vec<Method>,
     /// Timed runs per measurement (after one warm-up).
     pub runs: usize,
-    /// Zone height for `zoned` (None: automatic).
-    pub zone: Option<usize>,
+    /// Zone height for `zoned`.
+    pub zone: crate::voxel::Zone,
 }
 
 /// The thesis' seconds for (resolution, model, method), if transcribed.

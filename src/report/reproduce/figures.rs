@@ -1,7 +1,7 @@
 //! The report's pictures, rendered headless by texgeo's own Vulkan pipeline
 //! (`render`): subdivision levels coloured by valence (2010 Figs. 27–30), voxelized
-//! models in Perlin aspect colours (2006 Fig. 5-9), an inclusion slice and the
-//! fragment-mesh layout. Each picture is described in `figures.json` (camera, model,
+//! models in Perlin aspect colours (2006 Fig. 5-9), an inclusion slice, the fragment-mesh
+//! layout and Boolean results (2006 Figs. 6-9 … 6-12). Each picture is described in `figures.json` (camera, model,
 //! level) so a test can check it against the geometry.
 
 use glam::DVec3;
@@ -319,17 +319,20 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
 /// colour per sector, the support ring grey; a line joins the entries in storage order.
 pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
     let cube = procedural::cube();
-    let fragments = fragment::FragmentMesh::new(&cube)?;
-    let mut stream = fragments.base_stream(|p| p);
-    for (r_in, r_out) in [(2, 3), (3, 5)] {
-        stream = fragments.refine_stream(&stream, r_in, r_out);
+    // Three fragment levels after the base level (ring radii 2, 3, 5, 8); the picture
+    // stops after two passes, where the stream still carries its support ring.
+    let fragments = fragment::FragmentMesh::new(&cube, 4)?;
+    let levels = 4 - fragments.cpu_levels();
+    let mut stream = fragments.base_stream(levels, 1, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
+    for j in 0..2 {
+        stream = fragments.refine_stream(&stream, j, levels);
     }
-    let radius = 5;
-    let layout = fragments.layout(radius);
+    let layout = fragments.layout(2, levels, 1);
+    let radius = layout.radius;
     let frag = fragments.fragments()[0];
     let start = fragments.fragment_start(&layout, 0) as usize;
     let len = frag.class.len(radius) as usize;
-    let entries = &stream[start..start + len];
+    let entries: Vec<DVec3> = stream[start..start + len].iter().map(|t| DVec3::new(t[0], t[1], t[2])).collect();
     let sectors = frag.class.valence as usize + usize::from(frag.class.boundary);
     const SECTOR: [colour::Rgba; 6] = [
         [230, 80, 60, 255],
@@ -351,7 +354,7 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
     let surface = cpu::refine(&cube, 1 + 2)?;
     let mut scene = Scene::new()
         .with_mesh(SceneMesh::new(&surface, colour::SURFACE).wireframe(colour::EDGE).shading(Shading::Flat));
-    scene = scene.with_line(Polyline::new(entries.to_vec(), [250, 220, 60, 255], 1.5));
+    scene = scene.with_line(Polyline::new(entries.clone(), [250, 220, 60, 255], 1.5));
     for (s, pts) in owned.into_iter().enumerate() {
         scene = scene.with_points(Points { positions: pts, colour: SECTOR[s % SECTOR.len()], size: 9.0 });
     }
@@ -382,4 +385,49 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
          the entries in storage order — the centre, then ring by ring, sector by sector (SPEC §5.2)"
     );
     Ok(vec![run.picture(&picture, "fragment-layout", &caption, record)?])
+}
+
+/// Union, intersection and difference of a torus and a sphere through its tube (2006
+/// Figs. 6-9 … 6-12, `render::boolean`): the refined operands in their two colours with
+/// the cut curve, and beside them the result, each face in its operand's colour.
+pub fn boolean_results(run: &mut Run) -> Result<Vec<Block>> {
+    use crate::boolean::{self, Names, Operation, Transform};
+    let a = procedural::torus(1.0, 0.4, 48, 24);
+    let b = Transform::parse("scale 0.55; translate 1 0 0.3")
+        .map_err(super::ReproduceError::Usage)?
+        .apply(&procedural::sphere(16, 32))?;
+    let ev = boolean::evaluate(
+        &a,
+        &b,
+        Names { a: "torus", b: "sphere" },
+        &boolean::Options::default(),
+        Some(run.ctx),
+    )?;
+    let mut blocks = vec![Block::Para(format!(
+        "A torus (A, {} triangles) and a sphere through its tube (B, {} triangles), refined along their \
+         intersection ({} cut triangles), cut curve in yellow; right: the result, faces coloured by the operand \
+         they come from.",
+        a.num_faces(),
+        b.num_faces(),
+        ev.refinement.stats.cut_a + ev.refinement.stats.cut_b
+    ))];
+    for op in [Operation::Union, Operation::Intersection, Operation::Difference] {
+        let content = crate::render::boolean::content(&ev, op, true)?;
+        let mut model = Model::new(run.ctx, content, 0, Look::default(), None)?;
+        let scene = model.scene(run.ctx)?;
+        let (lo, hi) = scene.bounds().ok_or_else(|| super::ReproduceError::Usage("empty Boolean scene".into()))?;
+        let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
+        let picture = render(run, &scene, camera)?;
+        let faces = ev.result(op, true)?.num_faces();
+        let record = FigureRecord {
+            kind: "boolean".into(),
+            model: "builtin torus, sphere".into(),
+            camera: camera.into(),
+            note: format!("{} ({}): {faces} result triangles", op.name(), op.symbol()),
+            ..FigureRecord::default()
+        };
+        let caption = format!("A {} B: torus and sphere, {faces} result triangles", op.symbol());
+        blocks.push(run.picture(&picture, &format!("boolean-{}", op.name()), &caption, record)?);
+    }
+    Ok(blocks)
 }

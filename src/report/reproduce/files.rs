@@ -1,8 +1,7 @@
-//! Output files of a reproduction: every file is written whole or not at all (a
-//! temporary file in the same folder, then renamed over the target), and the output
-//! folder is checked writable before a run that takes minutes starts.
+//! Output files of a reproduction: every file is written whole or not at all
+//! ([`crate::output`]), and the output folder is checked writable before a run that
+//! takes minutes starts.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::{ReproduceError, Result};
@@ -11,33 +10,19 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ReproduceError + '_ {
     move |source| ReproduceError::Io { path: path.to_path_buf(), source }
 }
 
-/// Writes `bytes` to `path` atomically: readers see the old file or the whole new one.
+/// Writes `bytes` to `path` atomically ([`crate::output`]): readers see the old file or
+/// the whole new one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| ReproduceError::Usage(format!("{}: not a file name", path.display())))?;
-    let tmp = path.with_file_name(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
-    let written = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written.map_err(io(path))
+    crate::output::write_bytes(path, bytes).map_err(from_output)
 }
 
 /// Creates `dir` (and its parents) if needed and checks a file can be created in it.
 pub fn check_writable(dir: &Path) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(ReproduceError::Usage(format!("{}: exists and is not a folder", dir.display())));
-    }
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let probe = dir.join(format!(".texgeo-write-test{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(io(dir))?;
-    std::fs::remove_file(&probe).map_err(io(&probe))
+    crate::output::check_dir(dir).map_err(from_output)
+}
+
+fn from_output(e: crate::output::Error) -> ReproduceError {
+    ReproduceError::Io { path: e.path, source: e.error }
 }
 
 /// The folders of a report: `csv/`, `plots/`, `figures/` under the output folder.
@@ -90,7 +75,13 @@ mod tests {
     fn a_file_in_the_way_is_not_a_folder() {
         let file = std::env::temp_dir().join(format!("texgeo-notdir-{}", std::process::id()));
         std::fs::write(&file, b"x").unwrap();
-        assert!(matches!(check_writable(&file), Err(ReproduceError::Usage(_))));
+        match check_writable(&file) {
+            Err(ReproduceError::Io { path, source }) => {
+                assert_eq!(path, file);
+                assert!(source.to_string().contains("not a folder"), "{source}");
+            }
+            other => panic!("expected an I/O error on the path, got {other:?}"),
+        }
         std::fs::remove_file(&file).unwrap();
     }
 }

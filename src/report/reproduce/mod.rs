@@ -62,6 +62,8 @@ pub enum ReproduceError {
     Subdiv(#[from] crate::subdiv::SubdivError),
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
+    #[error(transparent)]
+    Boolean(#[from] crate::boolean::BooleanError),
 }
 
 impl ReproduceError {
@@ -75,6 +77,10 @@ impl ReproduceError {
             ReproduceError::Voxel(crate::voxel::VoxelError::Gpu(g)) => g,
             ReproduceError::Subdiv(crate::subdiv::SubdivError::Gpu(g)) => g,
             ReproduceError::Render(crate::render::RenderError::Gpu(g)) => g,
+            ReproduceError::Boolean(crate::boolean::BooleanError::Inclusion {
+                source: crate::inclusion::InclusionError::Gpu(g),
+                ..
+            }) => g,
             _ => return None,
         };
         match gpu {

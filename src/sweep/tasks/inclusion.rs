@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::gpu::Context;
 use crate::inclusion::solver::Solver;
 use crate::inclusion::{self, Class, InclusionError, Method};
+use crate::mesh::solidity::{Policy, require_solid};
 use crate::mesh::{Mesh, Report};
 use crate::random::Rng;
 use crate::sweep::record::{Fnv, Record};
@@ -88,6 +89,9 @@ impl Task for Inclusion {
         out: &mut Record,
     ) -> Result<(), Failure> {
         let method: Method = o.method.parse().map_err(|e| Failure::failed("options", e))?;
+        // The same gate as `texgeo inclusion`: what the command refuses, the sweep refuses.
+        let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
+        let mesh = &require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?.mesh;
         let (lo, hi) = mesh.bounds();
         let points = Rng::new(o.seed).points_in_box(o.points, lo, hi);
         out.size("points", points.len());
@@ -142,7 +146,8 @@ fn refusal(e: InclusionError) -> Failure {
         InclusionError::Resolution(_)
         | InclusionError::OctreeDepth(_)
         | InclusionError::Options(_)
-        | InclusionError::UnknownMethod(_) => Failure::refused("options", e),
+        | InclusionError::UnknownMethod { .. }
+        | InclusionError::OpenNeedsWinding { .. } => Failure::refused("options", e),
         InclusionError::Gpu(_) => Failure::failed("gpu", e),
         InclusionError::NeedsGpu(_) => Failure::failed("device", e),
     }

@@ -6,10 +6,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::gpu::Context;
+use crate::mesh::solidity::{Policy, require_solid};
 use crate::mesh::{Mesh, Report};
 use crate::sweep::record::{Fnv, Record};
 use crate::sweep::task::{Failure, Task};
-use crate::voxel::{Grid, Method, Solid, VoxelError, Voxelizer, grid};
+use crate::voxel::{Grid, Method, Solid, VoxelError, Voxelizer, Zone, grid};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -54,7 +55,7 @@ impl Voxelize {
             self.with_device = ctx.is_some();
         }
         let v = self.voxelizer.get_or_insert_with(|| Voxelizer::new(None));
-        v.zone = zone;
+        v.zone = zone.and_then(std::num::NonZeroUsize::new).map(Zone::Slices).unwrap_or_default();
         v
     }
 }
@@ -86,6 +87,8 @@ impl Task for Voxelize {
     ) -> Result<(), Failure> {
         let m = method(&o.method).map_err(|e| Failure::failed("options", e))?;
         let refusal = |e: VoxelError| refusal(e, report);
+        // The same gate as `texgeo voxelize`: what the command refuses, the sweep refuses.
+        let mesh = &require_solid(mesh.clone(), Policy::default()).map_err(Failure::not_solid)?.mesh;
         let t = Instant::now();
         let grid = Grid::for_mesh(mesh, o.res).map_err(refusal)?;
         let solid = Solid::new(mesh).map_err(refusal)?;

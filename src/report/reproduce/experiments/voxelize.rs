@@ -28,7 +28,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         resolutions: if r.quick { vec![64, 128] } else { DEFAULT_RESOLUTIONS.to_vec() },
         methods: Method::ALL.to_vec(),
         runs: 3,
-        zone: None,
+        zone: crate::voxel::Zone::Auto,
     };
     let models: Vec<voxelize::Model> = models
         .into_iter()

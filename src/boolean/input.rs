@@ -1,0 +1,129 @@
+//! What a Boolean operand must be, checked before any work: a closed, consistently
+//! oriented solid of positive volume whose faces do not cross each other. Non-manifold
+//! solids (two cubes sharing an edge), cavities and polygon faces are fine.
+//!
+//! Each refusal names the operand and the reason; the command exits with status 2 and
+//! writes nothing. (NaN and infinite coordinates never get this far: the mesh readers
+//! refuse them.)
+
+use crate::mesh::Mesh;
+use crate::mesh::intersect::{TriangleSoup, is_degenerate};
+use crate::mesh::solidity::{self, NotSolid, Policy};
+use crate::mesh::triangulate::TriangulateError;
+
+/// Why an operand is refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum InputError {
+    #[error("it has no faces")]
+    Empty,
+    /// Not a valid solid by the rule every command follows ([`crate::mesh::solidity`]):
+    /// open, inconsistently oriented, inverted, badly nested or self-intersecting.
+    #[error("{}{}", .0.defect, remedy(&.0.defect))]
+    NotSolid(#[from] NotSolid),
+    #[error("face {face} cannot be triangulated in its plane: {reason}")]
+    Face { face: usize, reason: TriangulateError },
+    #[error("face {face} has no area (its corners are collinear)")]
+    Degenerate { face: usize },
+    #[error("it encloses no volume")]
+    Flat,
+}
+
+/// The `boolean` flag that accepts a defect, as a hint.
+fn remedy(defect: &solidity::Defect) -> &'static str {
+    match defect {
+        solidity::Defect::SelfIntersecting { .. } | solidity::Defect::CrossingShells { .. } => {
+            " (pass --allow-self-intersections to go on anyway)"
+        }
+        solidity::Defect::Inverted { .. } => " (pass --flip-inverted to reverse its faces)",
+        _ => "",
+    }
+}
+
+/// Checks one operand and returns its triangles (polygon faces tessellated, vertices
+/// welded by position): the shared solid check of every command, then what refinement
+/// needs on top (faces with area, a volume). `allow_self_intersections` excuses faces that
+/// cross; an inverted operand is refused (the command flips it first when asked).
+pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
+    if mesh.num_faces() == 0 {
+        return Err(InputError::Empty);
+    }
+    let solid = solidity::check(mesh);
+    let policy = Policy { allow_self_intersections, ..Policy::default() };
+    if let Some(defect) = solidity::first_refusal(&solid, policy) {
+        return Err(NotSolid { defect: defect.clone() }.into());
+    }
+    let soup = TriangleSoup::new(mesh);
+    if let Some((face, reason)) = soup.failed.first().cloned() {
+        return Err(if reason == TriangulateError::Degenerate {
+            InputError::Degenerate { face: face as usize }
+        } else {
+            InputError::Face { face: face as usize, reason }
+        });
+    }
+    if let Some(t) = (0..soup.triangles.len()).find(|&t| is_degenerate(soup.triangle(t))) {
+        return Err(InputError::Degenerate { face: soup.face_of[t] as usize });
+    }
+    let volume = solid.volume.unwrap_or(0.0);
+    let (lo, hi) = mesh.bounds();
+    if volume.abs() <= 1e-12 * (hi - lo).max_element().powi(3) {
+        return Err(InputError::Flat);
+    }
+    Ok(soup)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::mesh::procedural;
+    use crate::mesh::solidity::Defect;
+
+    fn flipped(m: &Mesh, which: impl Fn(usize) -> bool) -> Mesh {
+        let faces = m
+            .faces()
+            .enumerate()
+            .map(|(f, face)| if which(f) { face.iter().rev().copied().collect() } else { face.to_vec() })
+            .collect();
+        Mesh::new(m.positions().to_vec(), faces).unwrap()
+    }
+
+    fn defect(r: Result<TriangleSoup, InputError>) -> Defect {
+        match r {
+            Err(InputError::NotSolid(e)) => e.defect,
+            other => panic!("expected a refusal by the solid check, got {:?}", other.map(|_| ())),
+        }
+    }
+
+    #[test]
+    fn refusals_name_the_reason() {
+        let cube = procedural::cube();
+        assert!(check(&cube, false).is_ok());
+        assert!(check(&procedural::two_cubes_sharing_edge(), false).is_ok());
+        assert!(check(&procedural::cube_with_cavity(), false).is_ok());
+        assert!(check(&procedural::l_prism(), false).is_ok());
+        let open = Mesh::new(cube.positions().to_vec(), cube.faces().skip(1).map(<[u32]>::to_vec).collect())
+            .unwrap();
+        assert!(matches!(defect(check(&open, false)), Defect::Open(_)));
+        assert!(matches!(defect(check(&flipped(&cube, |f| f == 2), false)), Defect::Open(_)));
+        assert!(
+            matches!(defect(check(&flipped(&cube, |_| true), false)), Defect::Inverted { volume } if (volume + 8.0).abs() < 1e-12)
+        );
+        let s = procedural::sphere(6, 8);
+        let two = {
+            let mut p = s.positions().to_vec();
+            let n = p.len() as u32;
+            p.extend(s.positions().iter().map(|&x| x + DVec3::new(0.5, 0.0, 0.0)));
+            let mut f: Vec<Vec<u32>> = s.faces().map(<[u32]>::to_vec).collect();
+            f.extend(s.faces().map(|x| x.iter().map(|&i| i + n).collect::<Vec<_>>()));
+            Mesh::new(p, f).unwrap()
+        };
+        let e = check(&two, false).unwrap_err();
+        assert!(
+            matches!(&e, InputError::NotSolid(n) if matches!(n.defect, Defect::SelfIntersecting { .. } | Defect::CrossingShells { .. })),
+            "{e}"
+        );
+        assert!(e.to_string().contains("--allow-self-intersections"), "{e}");
+        assert!(check(&two, true).is_ok());
+    }
+}

@@ -1,0 +1,412 @@
+//! Triangle–triangle intersection of one candidate pair (§6.4): which part of t ∈ A
+//! meets u ∈ B, decided with exact predicates on the f64 inputs.
+//!
+//! A point where the two surfaces meet is named by the pair of smallest simplices that
+//! hold it, one of A (vertex, edge or triangle) and one of B: a [`Key`]. Keys are exact
+//! (every simplex is found by exact orientation signs) and canonical (the same point
+//! gets the same key from every pair of triangles that finds it), so each intersection
+//! point is created once and shared by both meshes and by every triangle around it:
+//! the cut curve has no cracks. Coordinates are computed later, once per key, from the
+//! key alone ([`Key::position`]).
+//!
+//! A pair that is not coplanar meets in a segment, a point or nothing: the part of t on
+//! u's plane clipped by u, and vice versa; its ends are the ends of either part that lie
+//! in the other triangle. A coplanar pair meets in a convex polygon; its boundary within
+//! t is made of u's edges clipped to t (constraints for t) and within u of t's edges
+//! clipped to u (constraints for u).
+
+use glam::{DVec2, DVec3};
+
+use crate::mesh::intersect::{orient2d, orient3d, triangle_projection};
+use crate::mesh::triangulate::Projection;
+
+/// The smallest simplex of one mesh that holds a point (vertex ids are position-welded
+/// ids of that mesh; an edge's ends are in increasing order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Simplex {
+    Vertex(u32),
+    Edge(u32, u32),
+    Face(u32),
+}
+
+impl Simplex {
+    fn edge(a: u32, b: u32) -> Simplex {
+        Simplex::Edge(a.min(b), a.max(b))
+    }
+
+    /// True when this simplex is the edge (a, b) or one of its ends.
+    pub fn within_edge(self, a: u32, b: u32) -> bool {
+        match self {
+            Simplex::Vertex(v) => v == a || v == b,
+            Simplex::Edge(p, q) => (p, q) == (a.min(b), a.max(b)),
+            Simplex::Face(_) => false,
+        }
+    }
+}
+
+/// An intersection point: the simplex of A and the simplex of B holding it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Key {
+    pub a: Simplex,
+    pub b: Simplex,
+}
+
+/// The two input meshes as triangles over welded vertex ids.
+pub struct Operands<'a> {
+    pub a_positions: &'a [DVec3],
+    pub a_triangles: &'a [[u32; 3]],
+    pub b_positions: &'a [DVec3],
+    pub b_triangles: &'a [[u32; 3]],
+}
+
+impl Operands<'_> {
+    fn a_tri(&self, t: u32) -> [DVec3; 3] {
+        self.a_triangles[t as usize].map(|i| self.a_positions[i as usize])
+    }
+
+    fn b_tri(&self, u: u32) -> [DVec3; 3] {
+        self.b_triangles[u as usize].map(|i| self.b_positions[i as usize])
+    }
+}
+
+impl Key {
+    /// The point's coordinates, computed from the key alone (so every triangle that
+    /// uses the point sees the same f64 value): an input vertex as it is, an edge
+    /// crossing a triangle's plane, or two edges crossing each other.
+    pub fn position(&self, ops: &Operands) -> DVec3 {
+        let (pa, pb) = (ops.a_positions, ops.b_positions);
+        match (self.a, self.b) {
+            (Simplex::Vertex(v), _) => pa[v as usize],
+            (_, Simplex::Vertex(v)) => pb[v as usize],
+            (Simplex::Edge(p, q), Simplex::Face(u)) => {
+                edge_plane(pa[p as usize], pa[q as usize], ops.b_tri(u))
+            }
+            (Simplex::Face(t), Simplex::Edge(p, q)) => {
+                edge_plane(pb[p as usize], pb[q as usize], ops.a_tri(t))
+            }
+            (Simplex::Edge(p, q), Simplex::Edge(r, s)) => {
+                edge_edge(pa[p as usize], pa[q as usize], pb[r as usize], pb[s as usize])
+            }
+            // Two triangles' interiors never hold an end of their intersection.
+            (Simplex::Face(t), Simplex::Face(_)) => {
+                let [a, b, c] = ops.a_tri(t);
+                (a + b + c) / 3.0
+            }
+        }
+    }
+}
+
+/// Where segment pq crosses the plane of t (p, q strictly on opposite sides).
+fn edge_plane(p: DVec3, q: DVec3, t: [DVec3; 3]) -> DVec3 {
+    let dp = orient3d(t[0], t[1], t[2], p);
+    let dq = orient3d(t[0], t[1], t[2], q);
+    let l = (dp / (dp - dq)).clamp(0.0, 1.0);
+    if l.is_finite() { p + (q - p) * l } else { p }
+}
+
+/// Where the coplanar segments pq and rs cross.
+fn edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> DVec3 {
+    let n = (q - p).cross(s - r);
+    let Some(proj) = Projection::along(n) else { return (p + q) * 0.5 };
+    let [p2, q2, r2, s2] = [p, q, r, s].map(|x| proj.apply(x));
+    let dp = orient2d(r2, s2, p2);
+    let dq = orient2d(r2, s2, q2);
+    let l = (dp / (dp - dq)).clamp(0.0, 1.0);
+    if l.is_finite() { p + (q - p) * l } else { p }
+}
+
+#[inline]
+fn sign(x: f64) -> i8 {
+    (x > 0.0) as i8 - (x < 0.0) as i8
+}
+
+/// How one candidate pair meets.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Meeting {
+    #[default]
+    Apart,
+    /// A single point.
+    Point(Key),
+    /// A segment, a constraint in both triangles.
+    Segment([Key; 2]),
+    /// Coplanar triangles: segments to insert in t (u's edges clipped to t), in u (t's
+    /// edges clipped to u), and whether u faces the same way as t.
+    Coplanar { in_a: Vec<[Key; 2]>, in_b: Vec<[Key; 2]>, points: Vec<Key>, same: bool },
+}
+
+/// The minimal simplex of triangle `tri` (ids `ids`) holding the coplanar point x, in the
+/// projection `proj` of that plane; `None` when x lies outside.
+fn locate_2d(tri: [DVec2; 3], ids: [u32; 3], face: u32, x: DVec2) -> Option<Simplex> {
+    let s = sign(orient2d(tri[0], tri[1], tri[2]));
+    let o = [0, 1, 2].map(|k| s * sign(orient2d(tri[k], tri[(k + 1) % 3], x)));
+    if o.contains(&-1) {
+        return None;
+    }
+    Some(match o.iter().filter(|&&v| v == 0).count() {
+        0 => Simplex::Face(face),
+        1 => {
+            let k = o.iter().position(|&v| v == 0).unwrap_or(0);
+            Simplex::edge(ids[k], ids[(k + 1) % 3])
+        }
+        // On two edges: their common vertex (edges k and k+1 share vertex k+1).
+        _ => {
+            let k = (0..3).find(|&k| o[k] == 0 && o[(k + 1) % 3] == 0).unwrap_or(0);
+            Simplex::Vertex(ids[(k + 1) % 3])
+        }
+    })
+}
+
+/// The minimal simplex of triangle `tri` (ids `ids`) where the segment pq, which
+/// reaches its plane at one point, crosses it; `None` when it passes outside.
+fn locate_crossing(p: DVec3, q: DVec3, tri: [DVec3; 3], ids: [u32; 3], face: u32) -> Option<Simplex> {
+    let o = [0, 1, 2].map(|k| sign(orient3d(p, q, tri[k], tri[(k + 1) % 3])));
+    if o.contains(&1) && o.contains(&-1) {
+        return None;
+    }
+    Some(match o.iter().filter(|&&v| v == 0).count() {
+        0 => Simplex::Face(face),
+        1 => {
+            let k = o.iter().position(|&v| v == 0).unwrap_or(0);
+            Simplex::edge(ids[k], ids[(k + 1) % 3])
+        }
+        _ => {
+            let k = (0..3).find(|&k| o[k] == 0 && o[(k + 1) % 3] == 0).unwrap_or(0);
+            Simplex::Vertex(ids[(k + 1) % 3])
+        }
+    })
+}
+
+/// Up to two distinct keys (more would mean the inputs are not what the exact tests
+/// said, which cannot happen; extra ones are ignored).
+#[derive(Default)]
+struct Ends {
+    keys: [Option<Key>; 3],
+}
+
+impl Ends {
+    fn push(&mut self, k: Key) {
+        for slot in &mut self.keys {
+            match slot {
+                Some(x) if *x == k => return,
+                None => {
+                    *slot = Some(k);
+                    return;
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn meeting(&self) -> Meeting {
+        match self.keys {
+            [None, ..] => Meeting::Apart,
+            [Some(k), None, _] => Meeting::Point(k),
+            [Some(a), Some(b), _] => Meeting::Segment([a, b]),
+        }
+    }
+}
+
+/// Decides how triangle t of A and triangle u of B meet (both non-degenerate).
+pub fn meet(ops: &Operands, t: u32, u: u32) -> Meeting {
+    let (ta, tb) = (ops.a_tri(t), ops.b_tri(u));
+    let (ia, ib) = (ops.a_triangles[t as usize], ops.b_triangles[u as usize]);
+    let sa = ta.map(|p| sign(orient3d(tb[0], tb[1], tb[2], p)));
+    if sa == [1, 1, 1] || sa == [-1, -1, -1] {
+        return Meeting::Apart;
+    }
+    let sb = tb.map(|p| sign(orient3d(ta[0], ta[1], ta[2], p)));
+    if sb == [1, 1, 1] || sb == [-1, -1, -1] {
+        return Meeting::Apart;
+    }
+    if sa == [0, 0, 0] {
+        return coplanar(ops, t, u);
+    }
+    let mut ends = Ends::default();
+    // Ends of t ∩ plane(u) that lie in u.
+    let proj_b = triangle_projection(tb[0], tb[1], tb[2]);
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if sa[i] == 0 {
+            if let Some(proj) = proj_b {
+                let tri = tb.map(|p| proj.apply(p));
+                if let Some(s) = locate_2d(tri, ib, u, proj.apply(ta[i])) {
+                    ends.push(Key { a: Simplex::Vertex(ia[i]), b: s });
+                }
+            }
+        } else if sa[i] * sa[j] < 0 {
+            if let Some(s) = locate_crossing(ta[i], ta[j], tb, ib, u) {
+                ends.push(Key { a: Simplex::edge(ia[i], ia[j]), b: s });
+            }
+        }
+    }
+    // Ends of u ∩ plane(t) that lie in t.
+    let proj_a = triangle_projection(ta[0], ta[1], ta[2]);
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if sb[i] == 0 {
+            if let Some(proj) = proj_a {
+                let tri = ta.map(|p| proj.apply(p));
+                if let Some(s) = locate_2d(tri, ia, t, proj.apply(tb[i])) {
+                    ends.push(Key { a: s, b: Simplex::Vertex(ib[i]) });
+                }
+            }
+        } else if sb[i] * sb[j] < 0 {
+            if let Some(s) = locate_crossing(tb[i], tb[j], ta, ia, t) {
+                ends.push(Key { a: s, b: Simplex::edge(ib[i], ib[j]) });
+            }
+        }
+    }
+    ends.meeting()
+}
+
+/// The coplanar case: each triangle's edges clipped to the other, in t's projection
+/// (exact: all six points lie in one plane).
+fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
+    let (ta, tb) = (ops.a_tri(t), ops.b_tri(u));
+    let (ia, ib) = (ops.a_triangles[t as usize], ops.b_triangles[u as usize]);
+    let Some(proj) = triangle_projection(ta[0], ta[1], ta[2]) else { return Meeting::Apart };
+    let a2 = ta.map(|p| proj.apply(p));
+    let b2 = tb.map(|p| proj.apply(p));
+    let same = sign(orient2d(a2[0], a2[1], a2[2])) == sign(orient2d(b2[0], b2[1], b2[2]));
+    let mut in_a = Vec::new();
+    let mut in_b = Vec::new();
+    let mut points = Vec::new();
+    // u's edges clipped to t.
+    for k in 0..3 {
+        let (j, l) = (k, (k + 1) % 3);
+        let pts = clip(b2[j], b2[l], ib[j], ib[l], a2, ia, t, |own, other| Key { a: other, b: own });
+        emit(&pts, &mut in_a, &mut points);
+    }
+    // t's edges clipped to u.
+    for k in 0..3 {
+        let (j, l) = (k, (k + 1) % 3);
+        let pts = clip(a2[j], a2[l], ia[j], ia[l], b2, ib, u, |own, other| Key { a: own, b: other });
+        emit(&pts, &mut in_b, &mut points);
+    }
+    if in_a.is_empty() && in_b.is_empty() && points.is_empty() {
+        return Meeting::Apart;
+    }
+    Meeting::Coplanar { in_a, in_b, points, same }
+}
+
+/// Consecutive keys along a clipped edge become segments; a lone key is a point.
+fn emit(pts: &[(f64, Key)], segments: &mut Vec<[Key; 2]>, points: &mut Vec<Key>) {
+    match pts.len() {
+        0 => {}
+        1 => points.push(pts[0].1),
+        _ => segments.extend(pts.windows(2).map(|w| [w[0].1, w[1].1])),
+    }
+}
+
+/// The keys of the points of segment pr (ids ip, ir, one mesh) that lie in the
+/// coplanar triangle `tri` (ids `tid`, face `face`, the other mesh), sorted along pr
+/// (by their parameter). `key(own, other)` builds a key from the segment's simplex and
+/// the triangle's.
+#[allow(clippy::too_many_arguments)]
+fn clip(
+    p: DVec2,
+    r: DVec2,
+    ip: u32,
+    ir: u32,
+    tri: [DVec2; 3],
+    tid: [u32; 3],
+    face: u32,
+    key: impl Fn(Simplex, Simplex) -> Key,
+) -> Vec<(f64, Key)> {
+    let mut pts: Vec<(f64, Key)> = Vec::with_capacity(3);
+    let mut push = |l: f64, k: Key| {
+        if !pts.iter().any(|(_, x)| *x == k) {
+            pts.push((l, k));
+        }
+    };
+    let d = r - p;
+    let param = |x: DVec2| (x - p).dot(d) / d.length_squared();
+    if let Some(s) = locate_2d(tri, tid, face, p) {
+        push(0.0, key(Simplex::Vertex(ip), s));
+    }
+    if let Some(s) = locate_2d(tri, tid, face, r) {
+        push(1.0, key(Simplex::Vertex(ir), s));
+    }
+    let own_edge = Simplex::edge(ip, ir);
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        let oa = sign(orient2d(p, r, a));
+        let ob = sign(orient2d(p, r, b));
+        let op = sign(orient2d(a, b, p));
+        let or = sign(orient2d(a, b, r));
+        if oa * ob < 0 && op * or < 0 {
+            // Proper crossing of the two edges' interiors.
+            let l = orient2d(a, b, p) / (orient2d(a, b, p) - orient2d(a, b, r));
+            push(l, key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
+        }
+        // A corner of the triangle on the segment's interior.
+        for (o, v, id) in [(oa, a, tid[k]), (ob, b, tid[(k + 1) % 3])] {
+            if o == 0 {
+                let l = param(v);
+                let within = (v - p).dot(d) > 0.0 && (v - r).dot(d) < 0.0;
+                if within {
+                    push(l, key(own_edge, Simplex::Vertex(id)));
+                }
+            }
+        }
+    }
+    pts.sort_by(|x, y| x.0.total_cmp(&y.0));
+    pts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ops<'a>(pa: &'a [DVec3], ta: &'a [[u32; 3]], pb: &'a [DVec3], tb: &'a [[u32; 3]]) -> Operands<'a> {
+        Operands { a_positions: pa, a_triangles: ta, b_positions: pb, b_triangles: tb }
+    }
+
+    #[test]
+    fn piercing_pair_gives_one_segment_with_edge_face_keys() {
+        let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(4.0, 0.0, 0.0), DVec3::new(0.0, 4.0, 0.0)];
+        let pb = [DVec3::new(1.0, 1.0, -1.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(1.0, 9.0, 0.0)];
+        let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
+        let o = ops(&pa, &ta, &pb, &tb);
+        let m = meet(&o, 0, 0);
+        let Meeting::Segment(keys) = m else { panic!("{m:?}") };
+        // One end: B's edge 0–1 pierces t's interior; the other: t's edge 2–0 (x = 0)? No:
+        // u lies in the plane x = 1, so it meets t's edge 1–2 (x + y = 4) at (1, 3, 0).
+        assert!(keys.contains(&Key { a: Simplex::Face(0), b: Simplex::Edge(0, 1) }), "{keys:?}");
+        let other = keys.iter().find(|k| k.a != Simplex::Face(0)).unwrap();
+        assert_eq!(other.a, Simplex::Edge(1, 2));
+        assert_eq!(other.b, Simplex::Face(0));
+        assert_eq!(other.position(&o), DVec3::new(1.0, 3.0, 0.0));
+        assert_eq!(
+            keys.iter().find(|k| k.a == Simplex::Face(0)).unwrap().position(&o),
+            DVec3::new(1.0, 1.0, 0.0)
+        );
+    }
+
+    #[test]
+    fn coplanar_overlap_clips_both_ways() {
+        let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0)];
+        let pb = [DVec3::new(1.0, -1.0, 0.0), DVec3::new(1.0, 3.0, 0.0), DVec3::new(-1.0, 1.0, 0.0)];
+        let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
+        let o = ops(&pa, &ta, &pb, &tb);
+        let Meeting::Coplanar { in_a, in_b, same, .. } = meet(&o, 0, 0) else { panic!() };
+        assert!(same);
+        // B's edge 0–1 (x = 1) crosses t from (1, 0) to (1, 1).
+        let seg =
+            in_a.iter().find(|s| s.iter().all(|k| k.b == Simplex::Edge(0, 1) || k.b == Simplex::Vertex(0)));
+        let seg = seg.unwrap_or_else(|| panic!("{in_a:?}"));
+        let mut ends: Vec<DVec3> = seg.iter().map(|k| k.position(&o)).collect();
+        ends.sort_by(|a, b| a.y.total_cmp(&b.y));
+        assert_eq!(ends, vec![DVec3::new(1.0, 0.0, 0.0), DVec3::new(1.0, 1.0, 0.0)]);
+        assert!(!in_b.is_empty());
+    }
+
+    #[test]
+    fn touching_at_a_vertex_is_a_point() {
+        let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0)];
+        let pb = [DVec3::new(0.5, 0.5, 0.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(0.0, 1.0, 1.0)];
+        let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
+        let o = ops(&pa, &ta, &pb, &tb);
+        assert_eq!(meet(&o, 0, 0), Meeting::Point(Key { a: Simplex::Face(0), b: Simplex::Vertex(0) }));
+    }
+}

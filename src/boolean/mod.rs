@@ -1,0 +1,265 @@
+//! Boolean operations on triangle-mesh solids (SPEC §6, 2006 thesis Ch. 6).
+//!
+//! The evaluation of §6.3, one file per step:
+//!
+//! 0. [`input`]: both operands must be closed, consistently oriented solids of positive
+//!    volume whose faces do not cross (non-manifold ones and polygon faces included);
+//!    [`transform`] places B (the thesis applies a full transform to each mesh).
+//! 1. **Refinement** (§6.4) — [`index`] finds candidate triangle pairs in one spatial
+//!    index over both meshes, [`intersect`] decides each pair with exact predicates and
+//!    names every intersection point symbolically, [`refine`] re-triangulates each cut
+//!    triangle by constrained Delaunay with the intersection segments as constraints.
+//!    Afterwards every triangle of A is wholly in, out or on B, and vice versa.
+//! 2. **Classification** (§6.5) — [`classify`]: "on" triangles exactly, the others by
+//!    groups of connected triangles (§6.5.1), one point-in-solid test per group with
+//!    any inclusion method: the thesis' GPU test with its exact fallback, or a CPU one
+//!    (the default, `octants`, is the fastest exact one for the few points grouped
+//!    classification tests; on lavapipe the GPU test's set-up alone costs more).
+//! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
+//!    not, picked from the same refinement and classification, then compacted.
+//!
+//! [`cgal`] runs the independent reference (CGAL corefinement with an exact kernel).
+
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::gpu::Context;
+use crate::inclusion::{self, Method, solver::Solver};
+use crate::mesh::Mesh;
+use crate::mesh::intersect::TriangleSoup;
+
+pub mod cgal;
+pub mod classify;
+pub mod index;
+pub mod input;
+pub mod intersect;
+pub mod refine;
+pub mod select;
+pub mod transform;
+
+pub use classify::{Class, Classification, ClassifyStats, Grouping};
+pub use input::InputError;
+pub use refine::{RefineStats, Refinement, Side};
+pub use select::Operation;
+pub use transform::Transform;
+
+/// How to evaluate.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The inclusion method for the point tests.
+    pub method: Method,
+    /// One point test per group (default) or per triangle.
+    pub grouping: Grouping,
+    /// Go on with operands whose faces cross each other (results are then those of the
+    /// refinement of the crossing surfaces, not of a solid).
+    pub allow_self_intersections: bool,
+    /// Settings of the inclusion methods.
+    pub inclusion: inclusion::Options,
+    /// Build the CPU classifiers while the refinement runs (the phases then overlap in
+    /// wall time; benchmarks that split phases turn this off).
+    pub overlap: bool,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            method: Method::Octants,
+            grouping: Grouping::Grouped,
+            allow_self_intersections: false,
+            inclusion: inclusion::Options::default(),
+            overlap: true,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BooleanError {
+    /// An operand is not a valid solid.
+    #[error("{name} is not a valid solid: {reason}")]
+    Input { name: String, reason: InputError },
+    #[error(transparent)]
+    Refine(#[from] refine::RefineError),
+    #[error(transparent)]
+    Classify(#[from] classify::ClassifyError),
+    #[error("preparing the inclusion test of {name}: {source}")]
+    Inclusion { name: String, source: inclusion::InclusionError },
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// A regularized result of closed operands is not closed: a bug, reported.
+    #[error(
+        "internal error: the {op} is not closed ({boundary} boundary edge(s), {misoriented} misoriented); please report it"
+    )]
+    NotClosed { op: Operation, boundary: usize, misoriented: usize },
+}
+
+pub type Result<T, E = BooleanError> = std::result::Result<T, E>;
+
+/// Wall time of each phase (Table 6-1 splits phase 1 = index + refinement and
+/// phase 2 = classification + assembly).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Timings {
+    /// Operand checks (closed, oriented, volume, self-intersection) and tessellation.
+    pub check: Duration,
+    /// Phase 1: index, pair tests, intersection points, re-triangulation.
+    pub refine: Duration,
+    /// Building both inclusion classifiers.
+    pub classifiers: Duration,
+    /// On-tests, groups and point tests.
+    pub classify: Duration,
+}
+
+impl Timings {
+    /// Phase 2 without the assembly of a result (added per operation).
+    pub fn classification(&self) -> Duration {
+        self.classifiers + self.classify
+    }
+}
+
+/// Both operands refined and classified: every operation can be read from it.
+pub struct Evaluation {
+    pub a: TriangleSoup,
+    pub b: TriangleSoup,
+    pub refinement: Refinement,
+    pub classification: Classification,
+    pub timings: Timings,
+    /// Name of the inclusion method used.
+    pub method: String,
+}
+
+/// The two operands' names in messages (e.g. their file names).
+#[derive(Clone, Copy, Debug)]
+pub struct Names<'a> {
+    pub a: &'a str,
+    pub b: &'a str,
+}
+
+impl Default for Names<'_> {
+    fn default() -> Self {
+        Names { a: "A", b: "B" }
+    }
+}
+
+/// Checks both operands (in parallel) and returns their triangles.
+pub fn check_operands(
+    a: &Mesh,
+    b: &Mesh,
+    names: Names,
+    allow_self: bool,
+) -> Result<(TriangleSoup, TriangleSoup)> {
+    let (ra, rb) = rayon::join(|| input::check(a, allow_self), || input::check(b, allow_self));
+    let sa = ra.map_err(|reason| BooleanError::Input { name: names.a.to_string(), reason })?;
+    let sb = rb.map_err(|reason| BooleanError::Input { name: names.b.to_string(), reason })?;
+    Ok((sa, sb))
+}
+
+/// Evaluates A against B (§6.3): checks, refinement, classification. `ctx` is needed by
+/// the GPU inclusion methods.
+pub fn evaluate(
+    a: &Mesh,
+    b: &Mesh,
+    names: Names,
+    options: &Options,
+    ctx: Option<&Context>,
+) -> Result<Evaluation> {
+    let mut timings = Timings::default();
+    let start = Instant::now();
+    let (sa, sb) = check_operands(a, b, names, options.allow_self_intersections)?;
+    timings.check = start.elapsed();
+
+    let build = |mesh: &Mesh, name: &str| {
+        Solver::new(options.method, mesh, &options.inclusion, ctx, None)
+            .map_err(|source| BooleanError::Inclusion { name: name.to_string(), source })
+    };
+    let build_both = || {
+        let start = Instant::now();
+        let solvers = if options.method.is_cpu() {
+            let (x, y) = rayon::join(|| build(a, names.a), || build(b, names.b));
+            x.and_then(|x| Ok((x, y?)))
+        } else {
+            build(a, names.a).and_then(|x| Ok((x, build(b, names.b)?)))
+        };
+        (solvers, start.elapsed())
+    };
+    let refine_timed = || {
+        let start = Instant::now();
+        (refine::refine(&sa, &sb), start.elapsed())
+    };
+    // GPU solvers hold the device: build them on this thread.
+    let ((refinement, t_refine), (solvers, t_build)) = if options.overlap && options.method.is_cpu() {
+        let (r, s) = rayon::join(refine_timed, || {
+            let (s, t) = build_both();
+            (s.map(|(x, y)| (Some(x), Some(y))), t)
+        });
+        (r, s)
+    } else {
+        let r = refine_timed();
+        let (s, t) = build_both();
+        (r, (s.map(|(x, y)| (Some(x), Some(y))), t))
+    };
+    timings.refine = t_refine;
+    timings.classifiers = t_build;
+    let refinement = refinement?;
+    let (Some(mut solver_a), Some(mut solver_b)) = solvers? else { unreachable!("both solvers were built") };
+    let method = solver_a.name().to_string();
+
+    let start = Instant::now();
+    let mut test = |side: Side, points: &[DVec3]| -> inclusion::Result<Vec<inclusion::Class>> {
+        let solver = match side {
+            Side::A => &mut solver_a,
+            Side::B => &mut solver_b,
+        };
+        match solver {
+            Solver::Cpu(c) => Ok(points.par_iter().with_min_len(64).map(|&p| c.classify(p)).collect()),
+            other => other.classify_all(points),
+        }
+    };
+    let classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
+    timings.classify = start.elapsed();
+    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method })
+}
+
+impl Evaluation {
+    /// The result of `op` (regularized or not) as a mesh of triangles. A regularized
+    /// result must be closed and consistently oriented; if it is not, that is a bug and
+    /// is returned as [`BooleanError::NotClosed`].
+    pub fn result(&self, op: Operation, regularized: bool) -> Result<Mesh> {
+        Ok(self.result_by_operand(op, regularized)?.0)
+    }
+
+    /// [`Evaluation::result`] and how many of its faces, the first ones, come from A (the
+    /// rest come from B), for pictures that colour faces by operand (Figs. 6-9 … 6-12).
+    pub fn result_by_operand(&self, op: Operation, regularized: bool) -> Result<(Mesh, usize)> {
+        let (tris, from_a) = select::select(
+            op,
+            regularized,
+            (&self.refinement.a.triangles, &self.classification.a),
+            (&self.refinement.b.triangles, &self.classification.b),
+        );
+        let mesh = select::assemble(&self.refinement.points, &tris);
+        if regularized {
+            let report = mesh.report();
+            if !report.is_closed() {
+                return Err(BooleanError::NotClosed {
+                    op,
+                    boundary: report.boundary_edges,
+                    misoriented: report.misoriented_edges,
+                });
+            }
+        }
+        Ok((mesh, from_a))
+    }
+
+    /// Refined operand A (`b` false) or B (`b` true) as a mesh: its triangles with the cut
+    /// curve among their edges.
+    pub fn refined_operand(&self, b: bool) -> Mesh {
+        let r = if b { &self.refinement.b } else { &self.refinement.a };
+        select::assemble(&self.refinement.points, &r.triangles)
+    }
+
+    /// The cut curve as 3D segments (where the two surfaces meet), for pictures.
+    pub fn cut_curve(&self) -> Vec<[DVec3; 2]> {
+        self.refinement.curve.iter().map(|s| s.map(|i| self.refinement.points[i as usize])).collect()
+    }
+}

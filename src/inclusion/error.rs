@@ -1,0 +1,45 @@
+//! Inclusion errors.
+
+use crate::mesh::covering::UnbalancedEdge;
+
+#[derive(Debug, thiserror::Error)]
+pub enum InclusionError {
+    /// The covering methods need a closed, consistently oriented boundary (SPEC §1).
+    #[error("the mesh is not closed and consistently oriented: {0}")]
+    NotClosed(UnbalancedEdge),
+    #[error("unknown inclusion method '{name}' (expected one of: {expected})")]
+    UnknownMethod { name: String, expected: String },
+    #[error("tetragrid resolution {0} is outside 2..=64")]
+    Resolution(usize),
+    #[error("octree depth {0} is outside 1..=10")]
+    OctreeDepth(u32),
+    #[error("GPU: {0}")]
+    Gpu(crate::gpu::GpuError),
+    #[error("too large for the GPU path: {0}")]
+    TooLarge(String),
+    #[error("invalid options: {0}")]
+    Options(String),
+    #[error("method '{0}' runs on the GPU and needs a Vulkan device")]
+    NeedsGpu(&'static str),
+    /// `--allow-open` on a surface that is not closed: only the generalized winding number
+    /// gives it a meaning (see [`crate::mesh::solidity`]).
+    #[error(
+        "--allow-open: {edge}, so the surface has no inside; its points are classified by the \
+         generalized winding number (inside iff w ≥ ½), which only --method winding computes, not '{method}'"
+    )]
+    OpenNeedsWinding { method: &'static str, edge: UnbalancedEdge },
+}
+
+impl From<crate::gpu::GpuError> for InclusionError {
+    fn from(e: crate::gpu::GpuError) -> InclusionError {
+        InclusionError::Gpu(e)
+    }
+}
+
+impl From<UnbalancedEdge> for InclusionError {
+    fn from(e: UnbalancedEdge) -> InclusionError {
+        InclusionError::NotClosed(e)
+    }
+}
+
+pub type Result<T, E = InclusionError> = std::result::Result<T, E>;

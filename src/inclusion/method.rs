@@ -1,0 +1,140 @@
+//! The inclusion methods and their options, as the command line names them.
+
+use std::fmt;
+use std::str::FromStr;
+
+use glam::DVec3;
+
+use super::error::InclusionError;
+
+/// The inclusion methods (`--method`). [`super::solver::Solver::new`] builds any of them;
+/// [`Method::is_cpu`] says which ones [`super::solver::build`] can make without a device.
+/// A new method is one variant here and one arm in the factory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Method {
+    /// Alg. 4-1 with basic preprocessing, every tetra tested.
+    Cpu,
+    /// Alg. 4-1 over a bounding-box hierarchy of the tetras (§4.3.2.2).
+    Bvh,
+    /// Alg. 4-1 over the tetras of the point's octant (§4.3.2.3).
+    Octants,
+    /// Alg. 4-1 over the tetras of the point's grid cell (§4.3.2.4).
+    #[value(name = "tetragrid")]
+    TetraGrid,
+    /// Ray crossings over every covering triangle (§4.2.2).
+    Jordan,
+    /// Ray crossings over the triangles of the octree leaves the ray passes (§4.2.2).
+    #[value(name = "jordan-octree")]
+    JordanOctree,
+    /// Generalized winding number: the independent oracle.
+    Winding,
+    /// Alg. 4-2 + 4-3 on the GPU: phase 1 draws, 2×2 reduction passes (§4.3.3).
+    Gpu,
+    /// Phase 1 on the GPU, phase 2 summed on the host (the thesis' CPU+GPU).
+    #[value(name = "cpu+gpu")]
+    CpuGpu,
+    /// The GPU method over TetraGrid cells: each cell's points against its tetras.
+    #[value(name = "gpu+tetragrid")]
+    GpuTetraGrid,
+}
+
+impl Method {
+    pub const ALL: [Method; 10] = [
+        Method::Cpu,
+        Method::Bvh,
+        Method::Octants,
+        Method::TetraGrid,
+        Method::Jordan,
+        Method::JordanOctree,
+        Method::Winding,
+        Method::Gpu,
+        Method::CpuGpu,
+        Method::GpuTetraGrid,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Cpu => "cpu",
+            Method::Bvh => "bvh",
+            Method::Octants => "octants",
+            Method::TetraGrid => "tetragrid",
+            Method::Jordan => "jordan",
+            Method::JordanOctree => "jordan-octree",
+            Method::Winding => "winding",
+            Method::Gpu => "gpu",
+            Method::CpuGpu => "cpu+gpu",
+            Method::GpuTetraGrid => "gpu+tetragrid",
+        }
+    }
+
+    pub fn names() -> Vec<&'static str> {
+        Method::ALL.iter().map(|m| m.name()).collect()
+    }
+
+    /// True for methods that run on the CPU alone.
+    pub fn is_cpu(self) -> bool {
+        !matches!(self, Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid)
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = InclusionError;
+    fn from_str(s: &str) -> Result<Method, InclusionError> {
+        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| InclusionError::UnknownMethod {
+            name: s.to_string(),
+            expected: Method::names().join(", "),
+        })
+    }
+}
+
+/// Knobs shared by the builders; `Default` gives the thesis' settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Feito-Torres apex; `None` = [`super::cpu::default_apex`] (near the bounding-box centre).
+    pub apex: Option<DVec3>,
+    /// TetraGrid resolution n (n³ cells), 2..=64.
+    pub tetragrid_resolution: usize,
+    /// Jordan octree depth (the thesis' "Octree-6").
+    pub octree_depth: u32,
+    /// Accept a surface that is not closed and consistently oriented. Only the `winding`
+    /// method classifies such a surface (inside iff its generalized winding number is at
+    /// least ½); the factory refuses the others on it.
+    pub allow_open: bool,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            apex: None,
+            tetragrid_resolution: super::tetragrid::DEFAULT_RESOLUTION,
+            octree_depth: 6,
+            allow_open: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::*;
+    use crate::inclusion::Class;
+
+    #[test]
+    fn method_names_round_trip() {
+        for m in Method::ALL {
+            assert_eq!(m.name().parse::<Method>().unwrap(), m);
+            assert_eq!(m.to_possible_value().unwrap().get_name(), m.name());
+        }
+        assert_eq!(Method::value_variants(), Method::ALL);
+        let e = "gpu+magic".parse::<Method>().unwrap_err().to_string();
+        assert!(e.contains("gpu+magic") && e.contains("jordan-octree"), "{e}");
+        assert_eq!(Class::OnBoundary as u8, 2);
+    }
+}

@@ -1,0 +1,245 @@
+//! Overlapping box pairs by a uniform grid: the spatial index behind self-intersection
+//! detection and the Boolean refinement's candidate pairs.
+//!
+//! Every box is entered in the grid cells it touches (a counting sort by cell), and the
+//! boxes sharing a cell are tested against each other. A pair is reported only by the
+//! cell holding the lower corner of the two boxes' overlap, so it comes out once however
+//! many cells they share. The cell side is the mean box extent (grown when the boxes
+//! would make too many entries), so a cell holds a few triangles of each surface
+//! crossing it, and only cells where the two sets meet give pairs — like the thesis'
+//! octree over both meshes, whose leaves concentrate where the meshes meet (§6.4).
+
+use glam::{DVec3, UVec3};
+use rayon::prelude::*;
+
+/// An axis-aligned box (lower corner, upper corner), closed: touching counts.
+pub type Box3 = (DVec3, DVec3);
+
+/// Entries per box allowed on average before the cells are made coarser.
+const MAX_ENTRIES_PER_BOX: usize = 12;
+
+fn overlaps(a: &Box3, b: &Box3) -> bool {
+    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
+}
+
+struct Grid {
+    origin: DVec3,
+    inv: f64,
+    dims: UVec3,
+}
+
+impl Grid {
+    fn cell(&self, p: DVec3) -> UVec3 {
+        // Non-negative, so truncation is floor (and cheaper than a libm call).
+        let c = ((p - self.origin) * self.inv).max(DVec3::ZERO);
+        c.as_uvec3().min(self.dims - UVec3::ONE)
+    }
+
+    fn key(&self, c: UVec3) -> u64 {
+        (c.z as u64 * self.dims.y as u64 + c.y as u64) * self.dims.x as u64 + c.x as u64
+    }
+
+    fn cells_of(&self, b: &Box3) -> (UVec3, UVec3) {
+        (self.cell(b.0), self.cell(b.1))
+    }
+
+    fn count(&self, b: &Box3) -> usize {
+        let (lo, hi) = self.cells_of(b);
+        let d = hi - lo + UVec3::ONE;
+        d.x as usize * d.y as usize * d.z as usize
+    }
+}
+
+/// Pairs of overlapping boxes: `(i, j)` with i < j within `a` when `b` is `None`, else
+/// `(i, j)` with i in `a` and j in `b`, each once, in no particular order. Only the
+/// region where both sets' boxes meet is gridded.
+pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
+    let hull = |boxes: &[Box3]| -> Box3 {
+        boxes.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(x.0), hi.max(x.1)))
+    };
+    let region = match b {
+        None => hull(a),
+        Some(b) => {
+            let (ha, hb) = (hull(a), hull(b));
+            (ha.0.max(hb.0), ha.1.min(hb.1))
+        }
+    };
+    if a.is_empty() || region.0.cmpgt(region.1).any() || !region.0.is_finite() || !region.1.is_finite() {
+        return Vec::new();
+    }
+    // Entries: (cell key, id with the set in the top bit). Boxes outside the region are left out.
+    let inside = |x: &Box3| overlaps(x, &region);
+    let all: Vec<(u32, &Box3)> = a
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| inside(x))
+        .map(|(i, x)| (i as u32, x))
+        .chain(b.into_iter().flat_map(|b| {
+            b.iter().enumerate().filter(|(_, x)| inside(x)).map(|(j, x)| (j as u32 | 1 << 31, x))
+        }))
+        .collect();
+    if all.is_empty() {
+        return Vec::new();
+    }
+    let extent = region.1 - region.0;
+    let mean = all.iter().map(|(_, x)| (x.1 - x.0).max_element()).sum::<f64>() / all.len() as f64;
+    let mut side = mean.max(extent.max_element() / 1e6).max(f64::MIN_POSITIVE);
+    // Cells: about as many as entries at most, and few entries per box.
+    let grid = loop {
+        let dims = ((extent / side).floor().as_uvec3() + UVec3::ONE).min(UVec3::splat(1 << 20));
+        let grid = Grid { origin: region.0, inv: 1.0 / side, dims };
+        let cells = dims.x as usize * dims.y as usize * dims.z as usize;
+        let entries: usize =
+            all.par_iter().with_min_len(4096).map(|(_, x)| grid.count(&x.clamp_to(&region))).sum();
+        if (entries <= MAX_ENTRIES_PER_BOX * all.len() && cells <= (4 * entries).max(1 << 16)) || cells == 1 {
+            break grid;
+        }
+        side *= 1.5;
+    };
+    let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
+    // Counting sort of the entries by cell: `ids[start[c]..start[c + 1]]` are cell c's boxes.
+    let ranges: Vec<(UVec3, UVec3)> =
+        all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(&region))).collect();
+    let each_cell = |(lo, hi): (UVec3, UVec3), f: &mut dyn FnMut(usize)| {
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                let row = grid.key(UVec3::new(lo.x, y, z)) as usize;
+                for x in 0..=(hi.x - lo.x) as usize {
+                    f(row + x);
+                }
+            }
+        }
+    };
+    let mut start = vec![0u32; cells + 1];
+    for &r in &ranges {
+        each_cell(r, &mut |c| start[c + 1] += 1);
+    }
+    for c in 0..cells {
+        start[c + 1] += start[c];
+    }
+    // Each cell's boxes copied next to each other (with their tagged ids), so the pair
+    // loop reads memory in order.
+    let mut fill = start.clone();
+    let mut entries: Vec<(Box3, u32)> = vec![((DVec3::ZERO, DVec3::ZERO), 0); start[cells] as usize];
+    for (&r, &(id, x)) in ranges.iter().zip(&all) {
+        each_cell(r, &mut |c| {
+            entries[fill[c] as usize] = (*x, id);
+            fill[c] += 1;
+        });
+    }
+    drop(fill);
+    drop(all);
+    let pairs: Vec<u64> = (0..cells)
+        .into_par_iter()
+        .with_min_len(4096)
+        .fold(Vec::new, |mut acc, cell| {
+            let run = &entries[start[cell] as usize..start[cell + 1] as usize];
+            for (k, (bx, tx)) in run.iter().enumerate() {
+                for (by, ty) in &run[k + 1..] {
+                    if b.is_some() && (tx >> 31) == (ty >> 31) {
+                        continue;
+                    }
+                    if !overlaps(bx, by) {
+                        continue;
+                    }
+                    // Report from the cell of the overlap's lower corner only.
+                    if grid.key(grid.cell(bx.0.max(by.0).max(region.0))) as usize != cell {
+                        continue;
+                    }
+                    let (i, j) = if b.is_none() {
+                        (*tx.min(ty), *tx.max(ty))
+                    } else if tx >> 31 == 0 {
+                        (*tx, ty & !(1 << 31))
+                    } else {
+                        (*ty, tx & !(1 << 31))
+                    };
+                    acc.push((i as u64) << 32 | j as u64);
+                }
+            }
+            acc
+        })
+        .reduce(Vec::new, |mut x, mut y| {
+            if x.len() < y.len() {
+                std::mem::swap(&mut x, &mut y);
+            }
+            x.extend(y);
+            x
+        });
+    pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect()
+}
+
+trait ClampTo {
+    fn clamp_to(&self, region: &Box3) -> Box3;
+}
+
+impl ClampTo for Box3 {
+    fn clamp_to(&self, region: &Box3) -> Box3 {
+        (self.0.max(region.0), self.1.min(region.1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Rng;
+
+    #[allow(clippy::needless_range_loop)]
+    fn brute(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        match b {
+            None => {
+                for i in 0..a.len() {
+                    for j in i + 1..a.len() {
+                        if overlaps(&a[i], &a[j]) {
+                            out.push((i as u32, j as u32));
+                        }
+                    }
+                }
+            }
+            Some(b) => {
+                for i in 0..a.len() {
+                    for j in 0..b.len() {
+                        if overlaps(&a[i], &b[j]) {
+                            out.push((i as u32, j as u32));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn random_boxes(n: usize, seed: u64, offset: f64) -> Vec<Box3> {
+        let mut rng = Rng::new(seed);
+        (0..n)
+            .map(|k| {
+                let lo = rng.point_in_box(DVec3::splat(offset), DVec3::splat(offset + 10.0));
+                // Mostly small boxes, a few large ones, some flat.
+                let size = if k % 17 == 0 { 4.0 } else { 0.4 };
+                let mut d = rng.point_in_box(DVec3::ZERO, DVec3::splat(size));
+                if k % 5 == 0 {
+                    d.z = 0.0;
+                }
+                (lo, lo + d)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn same_pairs_as_brute_force() {
+        let a = random_boxes(600, 1, 0.0);
+        let b = random_boxes(500, 2, 5.0);
+        let sorted = |mut v: Vec<(u32, u32)>| {
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(sorted(box_pairs(&a, None)), brute(&a, None));
+        assert_eq!(sorted(box_pairs(&a, Some(&b))), brute(&a, Some(&b)));
+        assert!(!brute(&a, Some(&b)).is_empty());
+        // Touching boxes count; disjoint sets give nothing.
+        let c = vec![(DVec3::ZERO, DVec3::ONE), (DVec3::ONE, DVec3::splat(2.0))];
+        assert_eq!(box_pairs(&c, None), vec![(0, 1)]);
+        let far = vec![(DVec3::splat(50.0), DVec3::splat(51.0))];
+        assert_eq!(box_pairs(&c, Some(&far)), vec![]);
+    }
+}

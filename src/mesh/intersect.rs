@@ -1,0 +1,425 @@
+//! Exact triangle–triangle intersection and self-intersection detection.
+//!
+//! Every decision is a sign of an exact predicate on the f64 input coordinates:
+//! [`orient3d`] (Shewchuk's adaptive determinant, the `robust` crate) in space, and
+//! [`orient2d`] for coplanar pairs, projected along an axis the triangle's exact normal
+//! does not vanish on (projection keeps coordinates as they are, so it adds no rounding).
+//! No point is constructed, so nothing here depends on a tolerance.
+//!
+//! [`self_intersections`] finds the face pairs of a mesh whose intersection is more than
+//! what they are entitled to: nothing for faces with no common vertex, the vertex for
+//! faces sharing one, the edge for faces sharing an edge. Vertices are identified by
+//! position, so a mesh whose shells touch at duplicated vertices counts as touching,
+//! not crossing. Polygon faces are tessellated in their plane ([`super::triangulate`],
+//! never the covering's centroid fan, which overlaps itself on non-convex faces);
+//! triangles of one face are not tested against each other, and a face whose outline
+//! crosses itself is reported paired with itself. Candidate pairs come from a uniform
+//! grid over the triangles' boxes ([`super::boxgrid`]).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::Mesh;
+use super::boxgrid::box_pairs;
+use super::triangulate::{self, Projection, TriangulateError};
+
+/// Exact orientation of d relative to the plane through a, b, c: positive when d lies on
+/// the side the normal (b − a) × (c − a) points to, zero when the four are coplanar.
+#[inline]
+pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    let k = |p: DVec3| robust::Coord3D { x: p.x, y: p.y, z: p.z };
+    // Shewchuk's sign is positive when d lies *below* (a, b, c counter-clockwise from above).
+    -robust::orient3d(k(a), k(b), k(c), k(d))
+}
+
+pub use super::triangulate::orient2d;
+
+/// An exact projection for the plane of triangle (a, b, c): along the axis where its
+/// normal is largest, judged by exact 2D orientations, so the chosen component is
+/// non-zero. `None` when the three points are collinear.
+pub fn triangle_projection(a: DVec3, b: DVec3, c: DVec3) -> Option<Projection> {
+    let n = exact_normal_signs(a, b, c);
+    Projection::along(n)
+}
+
+/// The normal's components as exact 2D orientations in the yz, zx and xy planes (their
+/// signs are exact; their sizes are the determinants' approximate values).
+fn exact_normal_signs(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let o = |u: usize, v: usize| {
+        let q = |p: DVec3| glam::DVec2::new(p[u], p[v]);
+        orient2d(q(a), q(b), q(c))
+    };
+    DVec3::new(o(1, 2), o(2, 0), o(0, 1))
+}
+
+/// True when a, b, c are exactly collinear (or coincide).
+pub fn is_degenerate(t: [DVec3; 3]) -> bool {
+    exact_normal_signs(t[0], t[1], t[2]) == DVec3::ZERO
+}
+
+#[inline]
+fn sign(x: f64) -> i8 {
+    (x > 0.0) as i8 - (x < 0.0) as i8
+}
+
+/// Closed 2D segments [p, q] and [r, s] share a point.
+fn segments_meet_2d(p: glam::DVec2, q: glam::DVec2, r: glam::DVec2, s: glam::DVec2) -> bool {
+    let d1 = sign(orient2d(r, s, p));
+    let d2 = sign(orient2d(r, s, q));
+    let d3 = sign(orient2d(p, q, r));
+    let d4 = sign(orient2d(p, q, s));
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    let within = |a: glam::DVec2, b: glam::DVec2, x: glam::DVec2| {
+        x.x >= a.x.min(b.x) && x.x <= a.x.max(b.x) && x.y >= a.y.min(b.y) && x.y <= a.y.max(b.y)
+    };
+    (d1 == 0 && within(r, s, p))
+        || (d2 == 0 && within(r, s, q))
+        || (d3 == 0 && within(p, q, r))
+        || (d4 == 0 && within(p, q, s))
+}
+
+/// Closed 2D triangle (any orientation, non-degenerate) holds x.
+fn triangle_holds_2d(t: [glam::DVec2; 3], x: glam::DVec2) -> bool {
+    let s = [0, 1, 2].map(|k| sign(orient2d(t[k], t[(k + 1) % 3], x)));
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+/// The closed segment [p, q] and the closed, non-degenerate triangle t share a point.
+pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let [a, b, c] = t;
+    let sp = sign(orient3d(a, b, c, p));
+    let sq = sign(orient3d(a, b, c, q));
+    if sp * sq > 0 {
+        return false;
+    }
+    if sp == 0 && sq == 0 {
+        let Some(proj) = triangle_projection(a, b, c) else { return false };
+        let t2 = t.map(|v| proj.apply(v));
+        let (p2, q2) = (proj.apply(p), proj.apply(q));
+        return triangle_holds_2d(t2, p2)
+            || triangle_holds_2d(t2, q2)
+            || (0..3).any(|k| segments_meet_2d(p2, q2, t2[k], t2[(k + 1) % 3]));
+    }
+    // The segment reaches the plane at one point; the line pq passes through the closed
+    // triangle iff the three edge orientations do not disagree.
+    let s = [sign(orient3d(p, q, a, b)), sign(orient3d(p, q, b, c)), sign(orient3d(p, q, c, a))];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+/// The closed, non-degenerate triangles t and u share a point.
+///
+/// Two closed triangles meet iff an edge of one meets the other (the ends of their
+/// common segment, or of their common polygon's edges, lie on edges), after a quick
+/// rejection when one lies strictly on one side of the other's plane.
+pub fn triangles_meet(t: [DVec3; 3], u: [DVec3; 3]) -> bool {
+    let side = |plane: [DVec3; 3], pts: [DVec3; 3]| {
+        let s = pts.map(|p| sign(orient3d(plane[0], plane[1], plane[2], p)));
+        s == [1, 1, 1] || s == [-1, -1, -1]
+    };
+    if side(u, t) || side(t, u) {
+        return false;
+    }
+    (0..3).any(|k| segment_meets_triangle(t[k], t[(k + 1) % 3], u))
+        || (0..3).any(|k| segment_meets_triangle(u[k], u[(k + 1) % 3], t))
+}
+
+/// The ray from a through x (x coplanar with triangle (a, d, e)) lies in the closed
+/// angle of that triangle at a.
+fn ray_in_angle(a: DVec3, d: DVec3, e: DVec3, x: DVec3) -> bool {
+    let Some(proj) = triangle_projection(a, d, e) else { return false };
+    let [a2, d2, e2, x2] = [a, d, e, x].map(|p| proj.apply(p));
+    let s = sign(orient2d(a2, d2, e2)) as f64;
+    s * orient2d(a2, d2, x2) >= 0.0 && s * orient2d(a2, x2, e2) >= 0.0
+}
+
+/// Triangles (a, b, c) and (a, d, e), sharing only the vertex a, meet elsewhere too.
+pub fn meet_beyond_vertex(a: DVec3, [b, c]: [DVec3; 2], [d, e]: [DVec3; 2]) -> bool {
+    let t = [a, b, c];
+    let u = [a, d, e];
+    if segment_meets_triangle(b, c, u) || segment_meets_triangle(d, e, t) {
+        return true;
+    }
+    // What is left: the common part runs from a along an edge at a of one triangle that
+    // lies in the other's plane, inside the other's angle at a (this also covers
+    // coplanar pairs, whose angles at a overlap iff a side of one lies in the other).
+    let in_plane = |plane: [DVec3; 3], x: DVec3| orient3d(plane[0], plane[1], plane[2], x) == 0.0;
+    [b, c].into_iter().any(|x| in_plane(u, x) && ray_in_angle(a, d, e, x))
+        || [d, e].into_iter().any(|x| in_plane(t, x) && ray_in_angle(a, b, c, x))
+}
+
+/// Triangles (a, b, c) and (a, b, d), sharing the edge ab, meet beyond it: they are
+/// coplanar and fold onto the same side of ab.
+pub fn meet_beyond_edge(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+    if orient3d(a, b, c, d) != 0.0 {
+        return false;
+    }
+    let Some(proj) = triangle_projection(a, b, c) else { return false };
+    let [a2, b2, c2, d2] = [a, b, c, d].map(|p| proj.apply(p));
+    sign(orient2d(a2, b2, c2)) * sign(orient2d(a2, b2, d2)) > 0
+}
+
+/// The faces of a mesh as non-overlapping triangles over position-welded vertices.
+#[derive(Clone, Debug)]
+pub struct TriangleSoup {
+    /// The mesh's positions (unchanged).
+    pub positions: Vec<DVec3>,
+    /// Triangles as indices into `positions`, each vertex replaced by the first vertex at
+    /// its exact position; oriented like their face.
+    pub triangles: Vec<[u32; 3]>,
+    /// The mesh face of each triangle.
+    pub face_of: Vec<u32>,
+    /// Faces that could not be tessellated, with the reason (self-crossing outline, no area).
+    pub failed: Vec<(u32, TriangulateError)>,
+}
+
+impl TriangleSoup {
+    /// Tessellates every face of `mesh` ([`triangulate::polygon`]) and welds vertices at
+    /// equal positions.
+    pub fn new(mesh: &Mesh) -> TriangleSoup {
+        let weld = weld_by_position(mesh.positions());
+        let per_face: Vec<Result<Vec<[u32; 3]>, TriangulateError>> = (0..mesh.num_faces())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|f| {
+                let face = mesh.face(f);
+                if face.len() == 3 {
+                    return Ok(vec![[face[0], face[1], face[2]].map(|v| weld[v as usize])]);
+                }
+                let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
+                let tris = triangulate::polygon(&corners)?;
+                Ok(tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect())
+            })
+            .collect();
+        let mut soup = TriangleSoup {
+            positions: mesh.positions().to_vec(),
+            triangles: Vec::with_capacity(mesh.num_faces()),
+            face_of: Vec::with_capacity(mesh.num_faces()),
+            failed: Vec::new(),
+        };
+        for (f, r) in per_face.into_iter().enumerate() {
+            match r {
+                Ok(tris) => {
+                    for t in tris {
+                        soup.triangles.push(t);
+                        soup.face_of.push(f as u32);
+                    }
+                }
+                Err(e) => soup.failed.push((f as u32, e)),
+            }
+        }
+        soup
+    }
+
+    /// The corners of triangle `t`.
+    #[inline]
+    pub fn triangle(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// Axis-aligned box of every triangle.
+    pub fn boxes(&self) -> Vec<(DVec3, DVec3)> {
+        self.triangles
+            .par_iter()
+            .with_min_len(4096)
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize]);
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .collect()
+    }
+}
+
+/// For every vertex, the first vertex with exactly the same position (−0 equals +0).
+pub fn weld_by_position(positions: &[DVec3]) -> Vec<u32> {
+    let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
+    let mut order: Vec<u32> = (0..positions.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(positions[i as usize]), i));
+    let mut weld: Vec<u32> = (0..positions.len() as u32).collect();
+    let mut k = 0;
+    while k < order.len() {
+        let first = order[k];
+        let mut j = k + 1;
+        while j < order.len() && key(positions[order[j] as usize]) == key(positions[first as usize]) {
+            weld[order[j] as usize] = first;
+            j += 1;
+        }
+        k = j;
+    }
+    weld
+}
+
+/// How two triangles of one mesh meet, judged by the vertices they share.
+fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
+    let (ti, tj) = (soup.triangles[i], soup.triangles[j]);
+    // Shared corners as (corner of i, corner of j), without allocating.
+    let mut shared = [(0usize, 0usize); 3];
+    let mut k = 0;
+    for (a, va) in ti.iter().enumerate() {
+        for (b, vb) in tj.iter().enumerate() {
+            if va == vb {
+                shared[k] = (a, b);
+                k += 1;
+            }
+        }
+    }
+    let (p, q) = (soup.triangle(i), soup.triangle(j));
+    match k {
+        0 => triangles_meet(p, q),
+        1 => {
+            let (a, b) = shared[0];
+            let (pb, pc) = (p[(a + 1) % 3], p[(a + 2) % 3]);
+            let (qd, qe) = (q[(b + 1) % 3], q[(b + 2) % 3]);
+            // Quick exit: one triangle's free corners strictly on one side of the other's
+            // plane, so it touches that plane at the shared corner only.
+            let side = |plane: [DVec3; 3], x: DVec3, y: DVec3| {
+                let (sx, sy) = (
+                    sign(orient3d(plane[0], plane[1], plane[2], x)),
+                    sign(orient3d(plane[0], plane[1], plane[2], y)),
+                );
+                sx * sy > 0
+            };
+            if side(q, pb, pc) || side(p, qd, qe) {
+                return false;
+            }
+            meet_beyond_vertex(p[a], [pb, pc], [qd, qe])
+        }
+        2 => {
+            let c = (0..3).find(|&x| shared[0].0 != x && shared[1].0 != x).unwrap_or(0);
+            let d = (0..3).find(|&x| shared[0].1 != x && shared[1].1 != x).unwrap_or(0);
+            meet_beyond_edge(p[shared[0].0], p[shared[1].0], p[c], q[d])
+        }
+        // The same three corners: the faces coincide there.
+        _ => true,
+    }
+}
+
+/// Face pairs `(f, g)`, f ≤ g, of `mesh` that intersect more than they may (see the
+/// module docs), at most `limit` of them: the first ones in triangle order, so the
+/// answer is the same on every run. A face whose outline crosses itself is
+/// reported as `(f, f)`. Faces with no area (exactly collinear corners) are skipped:
+/// [`super::validate::Report::degenerate_faces`] counts them.
+pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
+    soup_self_intersections(&TriangleSoup::new(mesh), limit)
+}
+
+/// [`self_intersections`] of a mesh already tessellated (`soup.face_of` names the faces).
+pub fn soup_self_intersections(soup: &TriangleSoup, limit: usize) -> Vec<(usize, usize)> {
+    let mut found: Vec<(usize, usize)> = soup
+        .failed
+        .iter()
+        .filter(|(_, e)| *e == TriangulateError::Crossing || *e == TriangulateError::Duplicate)
+        .map(|&(f, _)| (f as usize, f as usize))
+        .collect();
+    if found.len() >= limit {
+        found.truncate(limit);
+        return found;
+    }
+    let n = soup.triangles.len();
+    let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();
+    let mut pairs: Vec<(u32, u32)> = box_pairs(&soup.boxes(), None)
+        .into_par_iter()
+        .with_min_len(1024)
+        .filter(|&(i, j)| {
+            let (i, j) = (i as usize, j as usize);
+            !degenerate[i]
+                && !degenerate[j]
+                && soup.face_of[i] != soup.face_of[j]
+                && soup_pair_meets(soup, i, j)
+        })
+        .collect();
+    // Triangle-pair order, so the pairs kept under the limit do not depend on timing.
+    pairs.par_sort_unstable();
+    let mut faces: Vec<(usize, usize)> = pairs
+        .into_iter()
+        .map(|(i, j)| {
+            let (f, g) = (soup.face_of[i as usize] as usize, soup.face_of[j as usize] as usize);
+            (f.min(g), f.max(g))
+        })
+        .collect();
+    // Keep the first occurrence of each face pair, in discovery order.
+    let mut seen = std::collections::HashSet::new();
+    faces.retain(|p| seen.insert(*p));
+    found.extend(faces);
+    found.truncate(limit);
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    #[test]
+    fn orient3d_sign_convention() {
+        assert!(orient3d(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z) > 0.0);
+        assert!(orient3d(DVec3::ZERO, DVec3::Y, DVec3::X, DVec3::Z) < 0.0);
+        assert_eq!(orient3d(DVec3::ZERO, DVec3::X, DVec3::Y, v(3.0, -7.0, 0.0)), 0.0);
+    }
+
+    #[test]
+    fn crossing_touching_and_apart() {
+        let t = [v(0.0, 0.0, 0.0), v(2.0, 0.0, 0.0), v(0.0, 2.0, 0.0)];
+        // Pierces t's interior.
+        assert!(triangles_meet(t, [v(0.5, 0.5, -1.0), v(0.5, 0.5, 1.0), v(3.0, 3.0, 0.5)]));
+        // Above t, nearly touching: apart.
+        assert!(!triangles_meet(t, [v(0.5, 0.5, 1e-300), v(1.0, 0.5, 1.0), v(0.5, 1.0, 1.0)]));
+        // A vertex exactly on t's edge: they meet (closed triangles).
+        assert!(triangles_meet(t, [v(1.0, 0.0, 0.0), v(1.0, -1.0, 1.0), v(1.0, -1.0, -1.0)]));
+        // Coplanar, overlapping and disjoint.
+        assert!(triangles_meet(t, [v(0.5, 0.5, 0.0), v(3.0, 0.5, 0.0), v(0.5, 3.0, 0.0)]));
+        assert!(!triangles_meet(t, [v(1.5, 1.5, 0.0), v(3.0, 1.5, 0.0), v(1.5, 3.0, 0.0)]));
+        // Coplanar, one inside the other (no edges cross).
+        assert!(triangles_meet(t, [v(0.1, 0.1, 0.0), v(0.5, 0.1, 0.0), v(0.1, 0.5, 0.0)]));
+    }
+
+    #[test]
+    fn shared_vertex_and_edge_rules() {
+        let a = DVec3::ZERO;
+        // Two fan triangles around a, side by side in a plane: fine.
+        assert!(!meet_beyond_vertex(
+            a,
+            [v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)],
+            [v(-1.0, 0.0, 0.0), v(0.0, -1.0, 0.0)]
+        ));
+        // Coplanar, overlapping sectors: fold.
+        assert!(meet_beyond_vertex(
+            a,
+            [v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)],
+            [v(1.0, 1.0, 0.0), v(-1.0, 2.0, 0.0)]
+        ));
+        // Not coplanar; the second's edge ad lies in the first's plane, inside its angle.
+        assert!(meet_beyond_vertex(
+            a,
+            [v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)],
+            [v(0.3, 0.3, 0.0), v(0.0, 0.0, 1.0)]
+        ));
+        // Not coplanar, only the apex in common.
+        assert!(!meet_beyond_vertex(
+            a,
+            [v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)],
+            [v(-0.3, -0.3, 0.0), v(0.0, 0.0, 1.0)]
+        ));
+        // Crossing through each other's interior at the shared vertex.
+        assert!(meet_beyond_vertex(
+            a,
+            [v(1.0, 0.0, -1.0), v(1.0, 0.0, 1.0)],
+            [v(1.0, -1.0, 0.0), v(1.0, 1.0, 0.0)]
+        ));
+        // Edge sharing: folded flat onto each other vs. opened or bent.
+        let (p, q) = (DVec3::ZERO, DVec3::X);
+        assert!(meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, 3.0, 0.0)));
+        assert!(!meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, -3.0, 0.0)));
+        assert!(!meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, 3.0, 1e-300)));
+    }
+
+    #[test]
+    fn welding_treats_negative_zero_as_zero() {
+        let w = weld_by_position(&[v(0.0, 1.0, 2.0), v(5.0, 5.0, 5.0), v(-0.0, 1.0, 2.0)]);
+        assert_eq!(w, vec![0, 1, 0]);
+    }
+}

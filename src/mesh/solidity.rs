@@ -1,0 +1,511 @@
+//! Is a mesh a solid, and what "inside" means — one rule for every command.
+//!
+//! ## The rule
+//!
+//! A point P is **inside** a mesh iff the winding number w(P) of its faces around P is
+//! at least ½. texgeo's commands only accept meshes on which w is 0 or 1 everywhere off
+//! the surface — *valid solids* — and there the other rules the algorithms compute agree
+//! with it exactly: Feito-Torres sums 2·w (inside iff non-zero), the voxelizers' XOR
+//! accumulates the parity of w, Jordan rays count crossings (parity), and the
+//! winding-number oracle measures w itself. Points within ε of the surface are
+//! OnBoundary for `inclusion` ([`crate::inclusion`] states ε) and decided by the tie rule
+//! for `voxelize` ([`crate::voxel::exact`]).
+//!
+//! A valid solid is:
+//!
+//! 1. **closed and consistently oriented**: every directed edge a→b is matched by a twin
+//!    b→a (non-manifold edges are fine when they pair up);
+//! 2. **measurable**: its area and volume are finite in f64;
+//! 3. **outward**: every shell (a connected component of faces) faces away from the
+//!    region it bounds, so that w = 0 outside and 1 inside. An outer shell has positive
+//!    volume, a shell inside it faces inwards (a cavity, negative volume), an island in
+//!    the cavity faces outwards again, and so on. Two shells with the same orientation,
+//!    one inside the other, give w = 2 between them; an inverted solid gives w = −1;
+//! 4. **not self-intersecting**: no two faces cross (overlapping shells give w = 2 where
+//!    they overlap). Detected by [`super::intersect::self_intersections`] (exact
+//!    triangle–triangle tests on the faces tessellated in their planes); shells that
+//!    overlap are also named as such when a shell has vertices both inside and outside
+//!    another.
+//!
+//! Anything else is refused by `inclusion`, `voxelize` and `boolean` (and skipped by
+//! `sweep` with the same reason) with status 2 and the reason ([`Defect`]), unless a flag
+//! changes the question:
+//!
+//! - `--flip-inverted`: an inverted solid (every face reversed would make it valid) is
+//!   flipped and then treated as the solid it describes;
+//! - `--allow-open` (`inclusion` only): a mesh that is not closed has no inside; a point
+//!   is then classified by the *generalized* winding number of the open surface (inside
+//!   iff w ≥ ½), which only the `winding` method computes: other methods are refused
+//!   under it when the mesh really is open;
+//! - `--allow-self-intersections` (`boolean` only): go on with crossing faces, best effort.
+//!
+//! [`check`] measures everything and lists every defect (`texgeo mesh stats` prints it);
+//! [`require_solid`] is the gate a command puts in front of its algorithm.
+
+use glam::DVec3;
+
+use super::covering::{Covering, UnbalancedEdge, signed_tetra_volume};
+use super::{Mesh, intersect};
+
+/// Vertices sampled per shell to find how deep it is nested.
+const SAMPLES: usize = 8;
+/// A winding number farther than this from an integer means the sample is (nearly) on
+/// the other shell's surface: it says nothing about nesting.
+const WINDING_SLACK: f64 = 0.1;
+
+/// One shell: a connected component of faces (faces sharing a vertex are connected).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shell {
+    /// Number of faces, and the first of them (faces of a shell need not be contiguous).
+    pub faces: usize,
+    pub first_face: usize,
+    /// Signed volume (Alg. 3-1): positive when the shell faces outwards.
+    pub volume: f64,
+    /// Winding number of the *other* shells around this one (0 for a shell inside no
+    /// other, 1 for a cavity's shell, …); `None` when it could not be decided (the shell
+    /// touches another).
+    pub depth: Option<i32>,
+}
+
+/// What keeps a mesh from being a valid solid.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Defect {
+    #[error("the surface is not closed and consistently oriented: {0}")]
+    Open(UnbalancedEdge),
+    #[error("its area or volume overflows f64 (coordinates up to {largest:e}); scale the mesh down")]
+    Overflow { largest: f64 },
+    #[error("the solid is inverted: its faces point inwards (signed volume {volume})")]
+    Inverted { volume: f64 },
+    #[error(
+        "shell {shell} (the shell of face {first_face}) faces inwards but lies inside no other shell: \
+         the winding number is −1 inside it"
+    )]
+    InvertedShell { shell: usize, first_face: usize },
+    #[error(
+        "shell {shell} (the shell of face {first_face}) lies inside shell {outer} and faces the same way: \
+         the winding number is {winding} inside it (a shell inside another must face the other way, like a cavity)"
+    )]
+    NestedShell { shell: usize, first_face: usize, outer: usize, winding: i32 },
+    #[error(
+        "the surface intersects itself: shells {a} and {b} overlap (shell {a} has vertices both inside \
+         and outside shell {b}), so the winding number is not 0 or 1 where they overlap"
+    )]
+    CrossingShells { a: usize, b: usize },
+    #[error("faces {a} and {b} cross each other (the surface intersects itself)")]
+    SelfIntersecting { a: usize, b: usize },
+}
+
+impl Defect {
+    /// A short, stable name of the defect (counted in sweep summaries).
+    pub fn slug(&self) -> &'static str {
+        match self {
+            Defect::Open(_) => "not-closed",
+            Defect::Overflow { .. } => "overflow",
+            Defect::Inverted { .. } => "inverted",
+            Defect::InvertedShell { .. } => "inverted-shell",
+            Defect::NestedShell { .. } => "nested-shell",
+            Defect::CrossingShells { .. } => "crossing-shells",
+            Defect::SelfIntersecting { .. } => "self-intersecting",
+        }
+    }
+
+    /// The command-line flag that accepts a mesh with this defect, if any.
+    pub fn remedy(&self) -> Option<&'static str> {
+        match self {
+            Defect::Open(_) => Some("--allow-open"),
+            Defect::Inverted { .. } => Some("--flip-inverted"),
+            _ => None,
+        }
+    }
+}
+
+/// What [`check`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solidity {
+    /// Total surface area (§3.6.2).
+    pub area: f64,
+    /// Signed volume (Alg. 3-1) when the surface is closed and oriented.
+    pub volume: Option<f64>,
+    pub shells: Vec<Shell>,
+    /// Every defect found, in the order of the rule's points (empty: a valid solid).
+    pub defects: Vec<Defect>,
+}
+
+impl Solidity {
+    pub fn is_solid(&self) -> bool {
+        self.defects.is_empty()
+    }
+
+    /// Shells that face inwards inside another (cavities).
+    pub fn cavities(&self) -> usize {
+        self.shells.iter().filter(|s| s.volume < 0.0 && s.depth.is_some_and(|d| d > 0)).count()
+    }
+}
+
+impl std::fmt::Display for Solidity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let cavities = self.cavities();
+        write!(f, "shells                 {}", self.shells.len())?;
+        if cavities > 0 {
+            write!(f, " ({cavities} cavit{})", if cavities == 1 { "y" } else { "ies" })?;
+        }
+        writeln!(f)?;
+        match self.defects.first() {
+            None => write!(f, "solid: yes (inside = winding number 1)"),
+            Some(d) => {
+                write!(f, "solid: no: {d}")?;
+                for d in &self.defects[1..] {
+                    write!(f, "\n       also: {d}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Measures `mesh` against the rule of the module docs and lists its defects.
+pub fn check(mesh: &Mesh) -> Solidity {
+    let covering = Covering::new(mesh);
+    let area = covering.area();
+    let mut report = Solidity { area, volume: None, shells: Vec::new(), defects: Vec::new() };
+    let unbalanced = covering.unbalanced_edge();
+    if let Some(e) = unbalanced {
+        report.defects.push(Defect::Open(e));
+    }
+    let (lo, hi) = mesh.bounds();
+    let apex = (lo + hi) * 0.5;
+    let groups = shells_of(mesh);
+    let volumes: Vec<f64> = groups
+        .iter()
+        .map(|faces| {
+            faces
+                .iter()
+                .flat_map(|&f| covering.face_triangles(f as usize))
+                .map(|t| {
+                    let [a, b, c] = covering.triangle(t);
+                    signed_tetra_volume(apex, a, b, c)
+                })
+                .sum()
+        })
+        .collect();
+    let volume: f64 = volumes.iter().sum();
+    report.shells = groups
+        .iter()
+        .zip(&volumes)
+        .map(|(faces, &v)| Shell {
+            faces: faces.len(),
+            first_face: faces[0] as usize,
+            volume: v,
+            depth: None,
+        })
+        .collect();
+    if !area.is_finite() || !volume.is_finite() {
+        let largest = mesh.positions().iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
+        report.defects.push(Defect::Overflow { largest });
+        return report;
+    }
+    if unbalanced.is_some() {
+        return report;
+    }
+    report.volume = Some(volume);
+    nesting(mesh, &covering, &groups, &mut report);
+    orientation(&mut report);
+    // Exact triangle–triangle tests: faces that cross make the winding number 2 (or −1)
+    // somewhere even when every shell on its own is fine.
+    if let Some(&(a, b)) = intersect::self_intersections(mesh, 1).first() {
+        report.defects.push(Defect::SelfIntersecting { a, b });
+    }
+    report
+}
+
+/// The faces of each shell (vertex-connected components), ordered by first face.
+fn shells_of(mesh: &Mesh) -> Vec<Vec<u32>> {
+    let n = mesh.num_vertices();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            let g = parent[parent[x as usize] as usize];
+            parent[x as usize] = g;
+            x = g;
+        }
+        x
+    }
+    for face in mesh.faces() {
+        let a = find(&mut parent, face[0]);
+        for &v in &face[1..] {
+            let b = find(&mut parent, v);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    let mut shell_of_root = vec![u32::MAX; n];
+    let mut shells: Vec<Vec<u32>> = Vec::new();
+    for (f, face) in mesh.faces().enumerate() {
+        let r = find(&mut parent, face[0]) as usize;
+        if shell_of_root[r] == u32::MAX {
+            shell_of_root[r] = shells.len() as u32;
+            shells.push(Vec::new());
+        }
+        shells[shell_of_root[r] as usize].push(f as u32);
+    }
+    shells
+}
+
+/// Fills each shell's depth: the winding number of the other shells around a few of its
+/// vertices; vertices that disagree mean the shells overlap.
+fn nesting(mesh: &Mesh, covering: &Covering, groups: &[Vec<u32>], report: &mut Solidity) {
+    if groups.len() == 1 {
+        report.shells[0].depth = Some(0);
+        return;
+    }
+    let pos = mesh.positions();
+    let boxes: Vec<(DVec3, DVec3)> = groups
+        .iter()
+        .map(|faces| {
+            faces
+                .iter()
+                .flat_map(|&f| mesh.face(f as usize))
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(pos[v as usize]), hi.max(pos[v as usize]))
+                })
+        })
+        .collect();
+    let triangles = |s: usize| groups[s].iter().flat_map(|&f| covering.face_triangles(f as usize));
+    for s in 0..groups.len() {
+        let mut vertices: Vec<u32> = groups[s].iter().flat_map(|&f| mesh.face(f as usize)).copied().collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        let step = vertices.len().div_ceil(SAMPLES).max(1);
+        // Per sample, the rounded winding number of every other shell (0 when outside its box).
+        let mut seen: Option<Vec<i32>> = None;
+        for &v in vertices.iter().step_by(step) {
+            let p = pos[v as usize];
+            let mut windings = vec![0i32; groups.len()];
+            let mut clear = true;
+            for (t, &(lo, hi)) in boxes.iter().enumerate() {
+                if t == s || !(p.cmpge(lo).all() && p.cmple(hi).all()) {
+                    continue;
+                }
+                let w = covering.winding_number(triangles(t), p);
+                if (w - w.round()).abs() > WINDING_SLACK {
+                    clear = false;
+                    break;
+                }
+                windings[t] = w.round() as i32;
+            }
+            if !clear {
+                continue;
+            }
+            match &seen {
+                None => seen = Some(windings),
+                Some(first) => {
+                    if let Some(t) = (0..groups.len()).find(|&t| first[t] != windings[t]) {
+                        report.defects.push(Defect::CrossingShells { a: s, b: t });
+                        seen = None;
+                        break;
+                    }
+                }
+            }
+        }
+        report.shells[s].depth = seen.map(|w| w.iter().sum());
+    }
+}
+
+/// Checks every shell's orientation against its depth (point 3 of the rule).
+fn orientation(report: &mut Solidity) {
+    let sign = |v: f64| {
+        if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    let valid = |d: i32, s: i32| (0..=1).contains(&d) && (0..=1).contains(&(d + s));
+    let shells = &report.shells;
+    let decided = || shells.iter().filter_map(|sh| sh.depth.map(|d| (d, sign(sh.volume))));
+    if decided().all(|(d, s)| valid(d, s)) {
+        return;
+    }
+    if decided().all(|(d, s)| valid(-d, -s)) {
+        let volume = report.volume.unwrap_or(0.0);
+        report.defects.push(Defect::Inverted { volume });
+        return;
+    }
+    let mut found = Vec::new();
+    for (i, sh) in shells.iter().enumerate() {
+        let (Some(d), s) = (sh.depth, sign(sh.volume)) else { continue };
+        if valid(d, s) {
+            continue;
+        }
+        if d == 0 {
+            found.push(Defect::InvertedShell { shell: i, first_face: sh.first_face });
+        } else {
+            // The innermost shell around it with a non-zero winding: the one deepest itself.
+            let outer = shells
+                .iter()
+                .enumerate()
+                .filter(|&(j, o)| j != i && o.depth.is_some_and(|od| od < d) && sign(o.volume) != 0)
+                .max_by_key(|(_, o)| o.depth)
+                .map_or(0, |(j, _)| j);
+            found.push(Defect::NestedShell { shell: i, first_face: sh.first_face, outer, winding: d + s });
+        }
+    }
+    report.defects.extend(found);
+}
+
+/// `mesh` with every face reversed (inside and outside swapped).
+pub fn flipped(mesh: &Mesh) -> Mesh {
+    let (offsets, indices) = mesh.face_parts();
+    let mut reversed = indices.to_vec();
+    for w in offsets.windows(2) {
+        reversed[w[0]..w[1]].reverse();
+    }
+    Mesh::from_parts(mesh.positions().to_vec(), offsets.to_vec(), reversed)
+        .unwrap_or_else(|e| unreachable!("reversing faces keeps a mesh valid: {e}"))
+}
+
+/// What a command may accept besides valid solids (the flags of the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Policy {
+    /// `--allow-open`: accept a surface that is not closed (classified by the generalized
+    /// winding number).
+    pub allow_open: bool,
+    /// `--flip-inverted`: reverse every face of an inverted solid.
+    pub flip_inverted: bool,
+    /// `boolean --allow-self-intersections`: go on with faces that cross (best effort).
+    pub allow_self_intersections: bool,
+}
+
+/// The first defect of `solidity` that `policy` does not excuse (an inverted solid is
+/// excused when the policy flips it; [`require_solid`] then checks the flipped mesh).
+pub fn first_refusal(solidity: &Solidity, policy: Policy) -> Option<&Defect> {
+    solidity.defects.iter().find(|d| match d {
+        Defect::Open(_) => !policy.allow_open,
+        Defect::Inverted { .. } => !policy.flip_inverted,
+        Defect::SelfIntersecting { .. } | Defect::CrossingShells { .. } => !policy.allow_self_intersections,
+        _ => true,
+    })
+}
+
+/// A mesh a command may work on.
+#[derive(Clone, Debug)]
+pub struct Accepted {
+    /// The mesh to use: the input, or its [`flipped`] copy.
+    pub mesh: Mesh,
+    pub solidity: Solidity,
+    /// The faces were reversed (`--flip-inverted`).
+    pub flipped: bool,
+    /// The surface is not closed (`--allow-open`): only the generalized winding number
+    /// classifies it.
+    pub open: bool,
+}
+
+/// Why [`require_solid`] refused a mesh: the first defect the policy does not excuse.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("not a solid: {defect}")]
+pub struct NotSolid {
+    pub defect: Defect,
+}
+
+/// The gate in front of every command that needs a solid: `mesh` if it is a valid solid
+/// (or flipped, or open, as `policy` allows), else the reason it is not.
+pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
+    let solidity = check(&mesh);
+    if let Some(d) = first_refusal(&solidity, policy) {
+        return Err(NotSolid { defect: d.clone() });
+    }
+    let open = solidity.defects.iter().any(|d| matches!(d, Defect::Open(_)));
+    if solidity.defects.iter().any(|d| matches!(d, Defect::Inverted { .. })) {
+        let mesh = flipped(&mesh);
+        let solidity = check(&mesh);
+        return match first_refusal(&solidity, Policy { flip_inverted: false, ..policy }) {
+            None => Ok(Accepted { mesh, solidity, flipped: true, open }),
+            Some(d) => Err(NotSolid { defect: d.clone() }),
+        };
+    }
+    Ok(Accepted { mesh, solidity, flipped: false, open })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::procedural::{self, box_between};
+
+    fn union(parts: &[Mesh]) -> Mesh {
+        let mut positions = Vec::new();
+        let mut faces = Vec::new();
+        for m in parts {
+            let base = positions.len() as u32;
+            positions.extend_from_slice(m.positions());
+            faces.extend(m.faces().map(|f| f.iter().map(|&i| i + base).collect::<Vec<_>>()));
+        }
+        Mesh::new(positions, faces).unwrap()
+    }
+
+    #[test]
+    fn built_ins_are_solids() {
+        for name in procedural::BUILTIN_NAMES {
+            let m = procedural::by_name(name).unwrap();
+            let s = check(&m);
+            assert!(s.is_solid(), "{name}: {:?}", s.defects);
+        }
+        let cavity = check(&procedural::cube_with_cavity());
+        assert_eq!(cavity.shells.len(), 2);
+        assert_eq!(cavity.cavities(), 1);
+        assert!((cavity.volume.unwrap() - 56.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn inverted_and_nested_shells() {
+        let cube = procedural::cube();
+        let inverted = check(&flipped(&cube));
+        assert!(
+            matches!(inverted.defects[..], [Defect::Inverted { volume }] if (volume + 8.0).abs() < 1e-12)
+        );
+        let flipped_cavity = check(&flipped(&procedural::cube_with_cavity()));
+        assert!(
+            matches!(flipped_cavity.defects[..], [Defect::Inverted { .. }]),
+            "{:?}",
+            flipped_cavity.defects
+        );
+
+        // A shell inside a shell, both facing out: w = 2 inside the inner one.
+        let nested = union(&[box_between(DVec3::splat(-2.0), DVec3::splat(2.0)), cube.clone()]);
+        let s = check(&nested);
+        assert_eq!(s.defects, vec![Defect::NestedShell { shell: 1, first_face: 6, outer: 0, winding: 2 }]);
+        // An inward shell next to a good one.
+        let beside = union(&[cube.clone(), flipped(&box_between(DVec3::splat(3.0), DVec3::splat(4.0)))]);
+        assert_eq!(check(&beside).defects, vec![Defect::InvertedShell { shell: 1, first_face: 6 }]);
+        // An island inside a cavity is fine; inside it another outward box is not.
+        let island =
+            union(&[procedural::cube_with_cavity(), box_between(DVec3::splat(-0.5), DVec3::splat(0.5))]);
+        assert!(check(&island).is_solid(), "{:?}", check(&island).defects);
+        // Two overlapping cubes: some vertices of each lie inside the other.
+        let overlap = union(&[cube.clone(), box_between(DVec3::splat(0.0), DVec3::splat(2.0))]);
+        assert!(matches!(check(&overlap).defects[..], [Defect::CrossingShells { .. }, ..]));
+    }
+
+    #[test]
+    fn require_solid_follows_the_policy() {
+        let inverted = flipped(&procedural::cube());
+        let e = require_solid(inverted.clone(), Policy::default()).unwrap_err();
+        assert_eq!(e.defect.remedy(), Some("--flip-inverted"));
+        assert!(e.to_string().starts_with("not a solid: the solid is inverted"), "{e}");
+        let ok = require_solid(inverted, Policy { flip_inverted: true, ..Policy::default() }).unwrap();
+        assert!(ok.flipped && (ok.solidity.volume.unwrap() - 8.0).abs() < 1e-12);
+        let cube = procedural::cube();
+        let open = Mesh::new(cube.positions().to_vec(), cube.faces().skip(1).map(<[u32]>::to_vec).collect())
+            .unwrap();
+        assert!(matches!(
+            require_solid(open.clone(), Policy::default()).unwrap_err().defect,
+            Defect::Open(_)
+        ));
+        assert!(require_solid(open, Policy { allow_open: true, ..Policy::default() }).unwrap().open);
+        let huge = cube.map_positions(|p| p * 1e120).unwrap();
+        let e = require_solid(huge, Policy::default()).unwrap_err();
+        assert!(matches!(e.defect, Defect::Overflow { .. }), "{e}");
+    }
+}

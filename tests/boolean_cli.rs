@@ -1,0 +1,183 @@
+//! `texgeo boolean`: outputs by extension, `--all`, `--stats`, `--transform-b`, and
+//! refusals (open, inverted, inconsistent, self-intersecting, NaN, bad output) with
+//! status 2, a message naming the operand and the reason, and no file written.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use texgeo::mesh::covering::Covering;
+use texgeo::mesh::formats;
+
+fn texgeo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("texgeo-boolean-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn write(path: &Path, text: &str) -> String {
+    std::fs::write(path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn volume(path: &Path) -> f64 {
+    Covering::new(&formats::read(path).unwrap()).volume()
+}
+
+const CUBE_VERTICES: &str = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
+
+fn cube_off(faces: &[&str], vertices: &str) -> String {
+    format!("OFF\n8 {} 0\n{vertices}{}\n", faces.len(), faces.join("\n"))
+}
+
+const FACES: [&str; 6] = ["4 0 4 6 2", "4 1 3 7 5", "4 0 1 5 4", "4 2 6 7 3", "4 0 2 3 1", "4 4 5 7 6"];
+
+#[test]
+fn one_operation_and_all_of_them() {
+    let out = temp("union.obj");
+    let o = texgeo(&[
+        "boolean",
+        "builtin:cube",
+        "builtin:cube",
+        "--transform-b",
+        "translate 1 1 1",
+        "--op",
+        "union",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Two 2×2×2 cubes overlapping in a unit cube.
+    assert!((volume(&out) - 15.0).abs() < 1e-12, "{}", volume(&out));
+    let text = stdout(&o);
+    for want in ["A ∪ B", "candidate pairs", "point tests", "saved", "phase 1", "phase 2"] {
+        assert!(text.contains(want), "{want}: {text}");
+    }
+
+    let dir = temp("all");
+    let o = texgeo(&[
+        "boolean",
+        "builtin:sphere",
+        "builtin:cube",
+        "--transform-b",
+        "scale 0.7; rotate 1 1 0 30",
+        "--all",
+        dir.to_str().unwrap(),
+        "--format",
+        "ply",
+        "--pictures",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Vec<f64> = ["union", "intersection", "difference", "symmetric-difference"]
+        .iter()
+        .map(|op| volume(&dir.join(format!("{op}.ply"))))
+        .collect();
+    assert!((v[0] - v[1] - v[3]).abs() < 1e-9 * v[0], "{v:?}");
+    // One Fig. 6-9 … 6-12 picture per operation, not one colour.
+    for op in ["union", "intersection", "difference", "symmetric-difference"] {
+        let p = texgeo::render::Picture::load_png(dir.join(format!("{op}.png"))).unwrap();
+        assert_eq!((p.width, p.height), (800, 600), "{op}");
+        assert!(p.rgba.chunks_exact(4).any(|c| c != &p.rgba[..4]), "{op}: one colour");
+    }
+}
+
+#[test]
+fn bad_operands_exit_2_and_write_nothing() {
+    let open = write(&temp("open.off"), &cube_off(&FACES[1..], CUBE_VERTICES));
+    let reversed: Vec<String> = FACES
+        .iter()
+        .map(|f| {
+            let mut w: Vec<&str> = f.split(' ').collect();
+            w[1..].reverse();
+            w.join(" ")
+        })
+        .collect();
+    let reversed: Vec<&str> = reversed.iter().map(String::as_str).collect();
+    let inverted = write(&temp("inverted.off"), &cube_off(&reversed, CUBE_VERTICES));
+    let mut mixed = FACES.to_vec();
+    mixed[2] = reversed[2];
+    let inconsistent = write(&temp("inconsistent.off"), &cube_off(&mixed, CUBE_VERTICES));
+    let nan = write(&temp("nan.off"), &cube_off(&FACES, &CUBE_VERTICES.replace("1 1 1", "1 nan 1")));
+    // Two overlapping cubes in one file.
+    let two = format!(
+        "OFF\n16 12 0\n{CUBE_VERTICES}{}\n{}\n{}\n",
+        CUBE_VERTICES
+            .lines()
+            .map(|l| l
+                .split(' ')
+                .map(|x| (x.parse::<f64>().unwrap() + 0.5).to_string())
+                .collect::<Vec<_>>()
+                .join(" "))
+            .collect::<Vec<_>>()
+            .join("\n"),
+        FACES.join("\n"),
+        FACES
+            .iter()
+            .map(|f| {
+                let mut w = f.split(' ');
+                let n = w.next().unwrap();
+                std::iter::once(n.to_string())
+                    .chain(w.map(|i| (i.parse::<u32>().unwrap() + 8).to_string()))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    let crossing = write(&temp("crossing.off"), &two);
+    let out = temp("never.off");
+    for (file, reason) in [
+        (&open, "open"),
+        (&inverted, "inverted"),
+        (&inconsistent, "consistently oriented"),
+        (&crossing, "intersects itself"),
+        (&nan, "not finite"),
+    ] {
+        let o = texgeo(&["boolean", "builtin:cube", file, "--op", "difference", "-o", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{file}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(file.as_str()) && e.to_lowercase().contains(reason), "{file}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(!out.exists(), "{file}: an output was written");
+    }
+    // Self-intersecting operands go through when asked (here B does not meet A).
+    let o = texgeo(&[
+        "boolean",
+        "builtin:sphere",
+        &crossing,
+        "--transform-b",
+        "translate 5 0 0",
+        "--op",
+        "difference",
+        "--allow-self-intersections",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&out).unwrap();
+    // A bad output extension or transform is refused before any work.
+    for args in [
+        vec!["--op", "union", "-o", "out.xyz"],
+        vec!["--op", "onion", "-o", "x.off"],
+        vec!["--op", "union", "--transform-b", "twist 3", "-o", "x.off"],
+    ] {
+        let mut all = vec!["boolean", "builtin:cube", "builtin:cube"];
+        all.extend(args);
+        let o = texgeo(&all);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    }
+    assert!(!Path::new("x.off").exists() && !Path::new("out.xyz").exists());
+}
