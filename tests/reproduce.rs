@@ -110,6 +110,8 @@ fn every_table_is_present_with_every_row_filled() {
         "Table 4-8",
         "Table 4-9",
         "Table 5-2",
+        "Table 6-1 today",
+        "Table 6-1: thesis beside today",
         "Table 5: level 5",
         "The GPU against the CPU level by level",
     ] {
@@ -125,7 +127,8 @@ fn every_table_is_present_with_every_row_filled() {
     assert!(md.contains("**All methods agree on every point**"), "inclusion answers checked");
     assert!(md.contains("**All methods agree on every voxel**"), "voxel answers checked");
     assert!(md.contains("equals OpenSubdiv's on every vertex"), "subdivision answers checked");
-    assert!(md.contains("`texgeo bench boolean` does not exist yet"), "the Boolean section says why it is empty");
+    assert!(md.contains("**All methods agree on every triangle**"), "Boolean answers checked");
+    assert!(md.contains("vol(A∪B) + vol(A∩B) = vol(A) + vol(B)"), "the Boolean section says how it checked");
     for h in ["texgeo", "device", "driver", "Vulkan", "CPU", "machine", "longest experiment"] {
         assert!(md.contains(&format!("| {h} |")), "header names {h}");
     }
@@ -269,9 +272,15 @@ fn every_claim_has_a_verdict() {
         assert!(!row[5].is_empty(), "{row:?}: the measured value or why there is none");
         *verdicts.entry(verdict.to_string()).or_insert(0) += 1;
     }
-    // The Booleans are not measurable yet; the rest were measured.
+    // --quick's Boolean pairs stay below 50 000 triangles: B2 and B3 (about bigger
+    // meshes) cannot be decided, every other Boolean claim is.
     for row in rows.iter().filter(|r| r[0].starts_with('B')) {
-        assert_eq!(&row[6], "not measurable");
+        if ["B2", "B3"].contains(&&row[0]) {
+            assert_eq!(&row[6], "not measurable", "{row:?}");
+            assert!(row[5].starts_with("no pair of meshes"), "{row:?}");
+        } else {
+            assert_ne!(&row[6], "not measurable", "{row:?}");
+        }
     }
     assert!(verdicts.get("holds").copied().unwrap_or(0) + verdicts.get("does not hold").copied().unwrap_or(0) >= 20);
 }
@@ -283,7 +292,7 @@ fn the_html_report_is_self_contained() {
     let md_tables = tables(&report(dir)).len();
     assert_eq!(html.matches("<table>").count(), md_tables);
     let images: Vec<&str> = html.split("<img src=\"").skip(1).collect();
-    assert!(images.len() >= 17, "{} images", images.len());
+    assert!(images.len() >= 22, "{} images", images.len());
     for img in images {
         assert!(img.starts_with("data:image/png;base64,") || img.starts_with("data:image/svg+xml;base64,"));
     }

@@ -80,8 +80,10 @@ fn ms(d: Duration) -> String {
     format!("{:.1}", d.as_secs_f64() * 1e3)
 }
 
-/// One timed evaluation: (phase 1, phase 2 without assembly, assembly per op, evaluation).
-fn measure(
+/// One timed evaluation: (phase 1, phase 2 without assembly, assembly per op of
+/// [`OPERATIONS`], the last evaluation). `runs` timed runs after a warm-up; `ctx` for the
+/// GPU point tests. `texgeo reproduce` measures Table 6-1 with it too.
+pub fn measure(
     pair: &Pair,
     options: &Options,
     ctx: Option<&Context>,
@@ -107,6 +109,12 @@ fn measure(
     Ok((p1, p2, assembly, ev))
 }
 
+/// The options of a timed evaluation: phases one after the other (no overlap of the
+/// classifiers' build with the refinement), so each phase's time is its own.
+pub fn sequential(method: Method, grouping: Grouping) -> Options {
+    Options { method, grouping, overlap: false, ..Options::default() }
+}
+
 /// Runs the benchmark.
 pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Report> {
     let mut table = Table::new(
@@ -129,12 +137,6 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         ],
     )
     .named("table6-1");
-    let sequential = |method: Method, grouping: Grouping| Options {
-        method,
-        grouping,
-        overlap: false,
-        ..Options::default()
-    };
     let mut refused = Vec::new();
     for pair in pairs {
         let triangles = pair.a.num_faces() + pair.b.num_faces();

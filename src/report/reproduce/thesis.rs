@@ -2,7 +2,7 @@
 //! claim is computed the same way from both.
 
 use super::facts::{Facts, Source, Stat};
-use crate::report::bench::{inclusion, subdiv, voxelize};
+use crate::report::bench::{boolean, inclusion, subdiv, voxelize};
 
 /// (column of the thesis CSV, fact key, unit, scale to texgeo's unit).
 type Columns<'a> = &'a [(&'a str, &'a str, &'static str)];
@@ -139,7 +139,25 @@ pub fn facts() -> Facts {
         f.add("subdivide", &model, "faces", "", Stat::exact(faces));
         f.add("subdivide", &model, "fragments", "", Stat::exact(fragments));
     }
-    f.skipped("boolean", "Table 6-1 is not transcribed in reference/ yet");
+    // Table 6-1: one row per (pair, operation); phases from the difference, which every
+    // pair has. The thesis' grouped ("optimizado") runs used the GPU point test.
+    for line in boolean::THESIS_TABLE.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+        let c: Vec<&str> = line.split(',').collect();
+        let v: Vec<Option<f64>> = c.iter().map(|x| x.trim().parse::<f64>().ok()).collect();
+        let (Some(pair), Some(op), Some(Some(triangles))) = (c.first(), c.get(1), v.get(2)) else { continue };
+        let Some(&[Some(p1), Some(p2), Some(pt), Some(g1), Some(g2), Some(gt)]) = v.get(3..9) else { continue };
+        let _ = g1;
+        f.model("boolean", pair, *triangles, pair);
+        let b = |f: &mut Facts, key: &str, v: f64| f.add("boolean", pair, key, "s", Stat::exact(v));
+        b(&mut f, &format!("time:plain:{op}"), pt);
+        b(&mut f, &format!("time:grouped:{op}"), gt);
+        if *op == "difference" {
+            b(&mut f, "time:phase1", p1);
+            b(&mut f, "time:phase2-plain", p2);
+            b(&mut f, "time:phase2-grouped", g2);
+            b(&mut f, "time:total", gt);
+        }
+    }
     f
 }
 
@@ -155,5 +173,9 @@ mod tests {
         assert_eq!(f.get("voxelize", "Armadillo", "time:zoned@256").unwrap().value, 0.008743);
         assert_eq!(f.get("subdivide", "row 1: cube", "time:gpu-path").unwrap().value, 0.015 + 0.031);
         assert_eq!(f.models_of("inclusion").len(), 9);
+        assert_eq!(f.get("boolean", "Armadillo", "time:grouped:difference").unwrap().value, 102.500169);
+        assert_eq!(f.get("boolean", "Torre", "time:phase2-plain").unwrap().value, 0.676856);
+        assert_eq!(f.size("boolean", "LionHd"), Some(44032.0));
+        assert_eq!(f.models_of("boolean").len(), 12);
     }
 }

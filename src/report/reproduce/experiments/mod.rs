@@ -2,6 +2,7 @@
 //! models (built-in ones for `--quick`, the thesis' stand-ins otherwise), today-beside-
 //! thesis tables and curves.
 
+mod boolean;
 mod inclusion;
 mod subdivide;
 mod voxelize;
@@ -82,15 +83,13 @@ pub const EXPERIMENTS: &[Experiment] = &[
         title: "Boolean operations",
         tables: "2006 thesis, Ch. 6, Table 6-1",
         command: "texgeo bench boolean",
-        runner: Err(
-            "`texgeo bench boolean` does not exist yet (issue 9); this section fills in once it does",
-        ),
+        runner: Ok(boolean::run),
         claims: claims::BOOLEAN,
         figures: &[Figure {
             key: "boolean-results",
             title: "Boolean results",
             thesis: "2006 Figs. 6-9 … 6-12",
-            draw: Err("`texgeo boolean` does not exist yet"),
+            draw: Ok(figures::boolean_results),
         }],
     },
     Experiment {
