@@ -115,7 +115,8 @@ fn every_table_is_present_with_every_row_filled() {
         "Table 5: level 5",
         "The GPU against the CPU level by level",
     ] {
-        let t = all.iter().find(|t| t.title.starts_with(wanted)).unwrap_or_else(|| panic!("no table {wanted}"));
+        let t =
+            all.iter().find(|t| t.title.starts_with(wanted)).unwrap_or_else(|| panic!("no table {wanted}"));
         assert!(!t.rows.is_empty(), "{wanted} has no rows");
     }
     for t in &all {
@@ -145,8 +146,10 @@ fn csvs_hold_the_numbers_of_the_markdown() {
         let mut r = csv::Reader::from_path(dir.join(&t.csv)).unwrap_or_else(|e| panic!("{}: {e}", t.csv));
         let header: Vec<String> = r.headers().unwrap().iter().map(|c| c.replace('|', "/")).collect();
         assert_eq!(header, t.columns, "{}", t.csv);
-        let rows: Vec<Vec<String>> =
-            r.records().map(|rec| rec.unwrap().iter().map(|c| c.replace('|', "/").replace('\n', " ")).collect()).collect();
+        let rows: Vec<Vec<String>> = r
+            .records()
+            .map(|rec| rec.unwrap().iter().map(|c| c.replace('|', "/").replace('\n', " ")).collect())
+            .collect();
         assert_eq!(rows, t.rows, "{}: CSV and Markdown differ", t.csv);
     }
     // Every measured value is there with the range of its runs.
@@ -154,7 +157,8 @@ fn csvs_hold_the_numbers_of_the_markdown() {
     let mut n = 0;
     for rec in m.records() {
         let rec = rec.unwrap();
-        let (v, lo, hi): (f64, f64, f64) = (rec[4].parse().unwrap(), rec[5].parse().unwrap(), rec[6].parse().unwrap());
+        let (v, lo, hi): (f64, f64, f64) =
+            (rec[4].parse().unwrap(), rec[5].parse().unwrap(), rec[6].parse().unwrap());
         assert!(lo <= v && v <= hi, "{rec:?}");
         n += 1;
     }
@@ -190,7 +194,11 @@ fn every_figure_is_a_png_of_its_stated_size_and_not_one_colour() {
         if let Some(i) = line.find("[PNG](") {
             let path = line[i + 6..].split(')').next().unwrap();
             let p = Picture::load_png(dir.join(path)).unwrap();
-            assert_eq!((p.width, p.height), (texgeo::report::plot::WIDTH, texgeo::report::plot::HEIGHT), "{path}");
+            assert_eq!(
+                (p.width, p.height),
+                (texgeo::report::plot::WIDTH, texgeo::report::plot::HEIGHT),
+                "{path}"
+            );
             assert!(not_uniform(&p), "{path} is one colour");
             let svg = std::fs::read_to_string(dir.join(path.replace(".png", ".svg"))).unwrap();
             assert!(svg.contains("<svg") && svg.contains("</svg>"), "{path}: its SVG");
@@ -282,7 +290,10 @@ fn every_claim_has_a_verdict() {
             assert_ne!(&row[6], "not measurable", "{row:?}");
         }
     }
-    assert!(verdicts.get("holds").copied().unwrap_or(0) + verdicts.get("does not hold").copied().unwrap_or(0) >= 20);
+    assert!(
+        verdicts.get("holds").copied().unwrap_or(0) + verdicts.get("does not hold").copied().unwrap_or(0)
+            >= 20
+    );
 }
 
 #[test]
@@ -357,7 +368,11 @@ fn bad_options_are_refused_before_anything_runs() {
     std::fs::write(&dir, b"a file").unwrap();
     let o = texgeo(&["reproduce", "--quick", "-o", d], &[]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not a folder"), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("not a folder"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     std::fs::remove_file(&dir).unwrap();
 
     let empty = temp("empty");

@@ -209,9 +209,7 @@ impl Chart {
                     .map_err(|e| err(&e))?;
             } else {
                 chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2))).map_err(|e| err(&e))?;
-                chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))
-                    .map_err(|e| err(&e))?;
+                chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(|e| err(&e))?;
             }
         }
         // The legend in its own column, so it never hides a curve.
@@ -220,11 +218,15 @@ impl Chart {
             let y = 50 + 20 * i as i32;
             if s.thesis {
                 for x in [8, 22] {
-                    legend.draw(&PathElement::new(vec![(x, y), (x + 9, y)], c.stroke_width(2))).map_err(|e| err(&e))?;
+                    legend
+                        .draw(&PathElement::new(vec![(x, y), (x + 9, y)], c.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
                 }
                 legend.draw(&TriangleMarker::new((20, y), 5, c.stroke_width(1))).map_err(|e| err(&e))?;
             } else {
-                legend.draw(&PathElement::new(vec![(8, y), (32, y)], c.stroke_width(2))).map_err(|e| err(&e))?;
+                legend
+                    .draw(&PathElement::new(vec![(8, y), (32, y)], c.stroke_width(2)))
+                    .map_err(|e| err(&e))?;
                 legend.draw(&Circle::new((20, y), 4, c.filled())).map_err(|e| err(&e))?;
             }
             legend

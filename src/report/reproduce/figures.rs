@@ -288,7 +288,8 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
             }
         }
         if cut.len() == 2 {
-            scene = scene.with_line(Polyline::new(cut.iter().map(|p| *p + lift).collect(), colour::CURVE, 2.0));
+            scene =
+                scene.with_line(Polyline::new(cut.iter().map(|p| *p + lift).collect(), colour::CURVE, 2.0));
         }
     }
     let camera = Camera::fit(DVec3::new(lo.x, lo.y, z), DVec3::new(hi.x, hi.y, z), 0.0, 0.0, aspect());
@@ -332,7 +333,8 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
     let frag = fragments.fragments()[0];
     let start = fragments.fragment_start(&layout, 0) as usize;
     let len = frag.class.len(radius) as usize;
-    let entries: Vec<DVec3> = stream[start..start + len].iter().map(|t| DVec3::new(t[0], t[1], t[2])).collect();
+    let entries: Vec<DVec3> =
+        stream[start..start + len].iter().map(|t| DVec3::new(t[0], t[1], t[2])).collect();
     let sectors = frag.class.valence as usize + usize::from(frag.class.boundary);
     const SECTOR: [colour::Rgba; 6] = [
         [230, 80, 60, 255],
@@ -415,7 +417,8 @@ pub fn boolean_results(run: &mut Run) -> Result<Vec<Block>> {
         let content = crate::render::boolean::content(&ev, op, true)?;
         let mut model = Model::new(run.ctx, content, 0, Look::default(), None)?;
         let scene = model.scene(run.ctx)?;
-        let (lo, hi) = scene.bounds().ok_or_else(|| super::ReproduceError::Usage("empty Boolean scene".into()))?;
+        let (lo, hi) =
+            scene.bounds().ok_or_else(|| super::ReproduceError::Usage("empty Boolean scene".into()))?;
         let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
         let picture = render(run, &scene, camera)?;
         let faces = ev.result(op, true)?.num_faces();

@@ -284,7 +284,8 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
                                         b.push(Block::Para(format!("**Not drawn on this device:** {why}.")))
                                     }
                                     None => {
-                                        failures.push((format!("{}: figure {}", e.key, f.key), err.to_string()));
+                                        failures
+                                            .push((format!("{}: figure {}", e.key, f.key), err.to_string()));
                                         b.push(Block::Para(format!("**Figure failed:** {err}")));
                                     }
                                 },

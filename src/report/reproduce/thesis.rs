@@ -145,7 +145,9 @@ pub fn facts() -> Facts {
         let c: Vec<&str> = line.split(',').collect();
         let v: Vec<Option<f64>> = c.iter().map(|x| x.trim().parse::<f64>().ok()).collect();
         let (Some(pair), Some(op), Some(Some(triangles))) = (c.first(), c.get(1), v.get(2)) else { continue };
-        let Some(&[Some(p1), Some(p2), Some(pt), Some(g1), Some(g2), Some(gt)]) = v.get(3..9) else { continue };
+        let Some(&[Some(p1), Some(p2), Some(pt), Some(g1), Some(g2), Some(gt)]) = v.get(3..9) else {
+            continue;
+        };
         let _ = g1;
         f.model("boolean", pair, *triangles, pair);
         let b = |f: &mut Facts, key: &str, v: f64| f.add("boolean", pair, key, "s", Stat::exact(v));

@@ -54,7 +54,8 @@ fn ms(d: Duration) -> String {
 }
 
 pub fn run(r: &mut Run) -> Result<Vec<Block>> {
-    let (models, notes) = if r.quick { (quick_models(), Vec::new()) } else { stand_ins(r.models_dir, STAND_INS)? };
+    let (models, notes) =
+        if r.quick { (quick_models(), Vec::new()) } else { stand_ins(r.models_dir, STAND_INS)? };
     let runs = 3;
     let cgal_ready = cgal::helper_path().is_ok();
     r.progress.total(models.len() as u64);
@@ -177,8 +178,20 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             let grouped_cpu = sum(&[&p1, &p2, &asm[k]]);
             // The plain run's phase 1 is a single run: its median is itself.
             let plain = sum(&[&p1, &p2_plain, &asm_plain[k]]);
-            r.facts.add(EXP, &name, &format!("time:grouped:{}", op.name()), "s", Stat::median_of(&grouped_gpu));
-            r.facts.add(EXP, &name, &format!("time:grouped-cpu:{}", op.name()), "s", Stat::median_of(&grouped_cpu));
+            r.facts.add(
+                EXP,
+                &name,
+                &format!("time:grouped:{}", op.name()),
+                "s",
+                Stat::median_of(&grouped_gpu),
+            );
+            r.facts.add(
+                EXP,
+                &name,
+                &format!("time:grouped-cpu:{}", op.name()),
+                "s",
+                Stat::median_of(&grouped_cpu),
+            );
             r.facts.add(EXP, &name, &format!("time:plain:{}", op.name()), "s", Stat::median_of(&plain));
             let cgal_cell = match &reference {
                 None => "–".to_string(),
@@ -202,7 +215,9 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             };
             let check = match &reference {
                 Some(reference) => match reference.measures(op) {
-                    Some((cv, _)) => format!("CGAL {:.1e}", (vols[k] - cv).abs() / cv.abs().max(f64::MIN_POSITIVE)),
+                    Some((cv, _)) => {
+                        format!("CGAL {:.1e}", (vols[k] - cv).abs() / cv.abs().max(f64::MIN_POSITIVE))
+                    }
                     None => format!("identity {:.1e}", identity.max(difference)),
                 },
                 None => format!("identity {:.1e}", identity.max(difference)),
@@ -282,12 +297,21 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
 
     let mut quantities = Vec::new();
     for op in OPERATIONS {
-        quantities.push(Quantity::same(format!("{} plain total", op.symbol()), format!("time:plain:{}", op.name())));
-        quantities
-            .push(Quantity::same(format!("{} grouped total", op.symbol()), format!("time:grouped:{}", op.name())));
+        quantities.push(Quantity::same(
+            format!("{} plain total", op.symbol()),
+            format!("time:plain:{}", op.name()),
+        ));
+        quantities.push(Quantity::same(
+            format!("{} grouped total", op.symbol()),
+            format!("time:grouped:{}", op.name()),
+        ));
     }
     quantities.push(Quantity::same("phase 1 (A − B)", "time:phase1"));
-    quantities.push(Quantity::new("phase 2 grouped, GPU point tests (A − B)", "time:phase2-gpu", "time:phase2-grouped"));
+    quantities.push(Quantity::new(
+        "phase 2 grouped, GPU point tests (A − B)",
+        "time:phase2-gpu",
+        "time:phase2-grouped",
+    ));
     quantities.push(Quantity::same("phase 2 plain (A − B)", "time:phase2-plain"));
     let t = comparison(r, EXP, "Table 6-1: thesis beside today", "s", &quantities);
     blocks.push(r.table(t, "boolean-table6-1")?);
@@ -321,7 +345,12 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         ratio_curve(r.facts, EXP, "time:phase2-plain", "time:phase2-cpu"),
         ratio_curve(r.thesis, EXP, "time:phase2-plain", "time:phase2-grouped"),
     );
-    series.extend(both("phase 2 CPU / GPU", 1, ratio_curve(r.facts, EXP, "time:phase2-cpu", "time:phase2-gpu"), Vec::new()));
+    series.extend(both(
+        "phase 2 CPU / GPU",
+        1,
+        ratio_curve(r.facts, EXP, "time:phase2-cpu", "time:phase2-gpu"),
+        Vec::new(),
+    ));
     let chart = Chart {
         title: "Boolean operations: grouped classification's and the GPU's speed-ups in phase 2".into(),
         x_label: "triangles (both operands)".into(),

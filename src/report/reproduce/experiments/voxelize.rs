@@ -56,7 +56,9 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
                 r.facts.missing(EXP, &m.model, &key, "s", why);
                 // One line per reason: the methods it stops, every model and resolution.
                 match failed.iter_mut().find(|(w, _)| w == why) {
-                    Some((_, methods)) if !methods.contains(&m.method.to_string()) => methods.push(m.method.to_string()),
+                    Some((_, methods)) if !methods.contains(&m.method.to_string()) => {
+                        methods.push(m.method.to_string())
+                    }
                     Some(_) => {}
                     None => failed.push((why.clone(), vec![m.method.to_string()])),
                 }
@@ -82,7 +84,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         format!("**Volumes that differ from the exact one:** {}.", wrong.join(", "))
     }));
     for (why, methods) in &failed {
-        blocks.push(Block::Para(format!("**Not measurable on this device:** {} ({why}).", methods.join(", "))));
+        blocks
+            .push(Block::Para(format!("**Not measurable on this device:** {} ({why}).", methods.join(", "))));
     }
 
     let mut quantities = Vec::new();
