@@ -393,8 +393,11 @@ pub const INCLUSION: &[Claim] = &[
 
 // ---------------------------------------------------------------- voxelization (Ch. 5)
 
+/// One voxelization time: (model, model size, N, method, time).
+type VoxelTime = (String, f64, usize, String, Stat);
+
 /// (model, N, method) → time, for every voxelization fact.
-fn voxel_times(f: &Facts) -> Result<Vec<(String, f64, usize, String, Stat)>, String> {
+fn voxel_times(f: &Facts) -> Result<Vec<VoxelTime>, String> {
     if let Some(why) = f.why_not_run("voxelize") {
         return Err(why.to_string());
     }
@@ -611,7 +614,7 @@ fn gpu_linear_in_faces(f: &Facts) -> Measure {
     let lo = slopes.iter().map(|s| s.2).fold(f64::INFINITY, f64::min);
     let hi = slopes.iter().map(|s| s.2).fold(f64::NEG_INFINITY, f64::max);
     Ok((
-        format!("slopes {lo:.2} … {hi:.2} (pgpu, zoned; {} resolutions)", slopes.len() / 2.max(1)),
+        format!("slopes {lo:.2} … {hi:.2} (pgpu, zoned; {} resolutions)", slopes.len() / 2),
         lo >= 0.8 && hi <= 1.2,
     ))
 }

@@ -214,7 +214,7 @@ pub fn voxel_aspect(run: &mut Run) -> Result<Vec<Block>> {
         let occupied = volume.count();
         let mut model = Model::new(
             run.ctx,
-            Content::Voxels(v.grid.clone(), volume),
+            Content::Voxels(v.grid, volume),
             0,
             Look::default(),
             Some(Aspect::default()),
