@@ -111,7 +111,9 @@ struct NpyHeader {
 
 fn npy_header(bytes: &[u8], path: &Path) -> Result<NpyHeader, MeshError> {
     let err = |m: String| MeshError::parse(path, Location::File, m);
-    let rest = bytes.strip_prefix(b"\x93NUMPY").ok_or_else(|| err("not a NumPy .npy file (no \\x93NUMPY magic)".into()))?;
+    let rest = bytes
+        .strip_prefix(b"\x93NUMPY")
+        .ok_or_else(|| err("not a NumPy .npy file (no \\x93NUMPY magic)".into()))?;
     let (major, rest) = rest.split_first().ok_or_else(|| err("truncated .npy header".into()))?;
     let rest = rest.get(1..).ok_or_else(|| err("truncated .npy header".into()))?;
     let (len, start) = match major {
@@ -134,7 +136,11 @@ fn npy_header(bytes: &[u8], path: &Path) -> Result<NpyHeader, MeshError> {
         ">f8" => (true, 8),
         "<f4" => (false, 4),
         ">f4" => (true, 4),
-        d => return Err(err(format!("the .npy array holds '{d}'; points must be float64 or float32 ('<f8', '<f4')"))),
+        d => {
+            return Err(err(format!(
+                "the .npy array holds '{d}'; points must be float64 or float32 ('<f8', '<f4')"
+            )));
+        }
     };
     let fortran = field("fortran_order").is_some_and(|v| v.starts_with("True"));
     let shape = field("shape")
@@ -256,8 +262,17 @@ mod tests {
     }
 
     fn npy(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
-        let h = format!("{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}\n", if fortran { "True" } else { "False" });
-        [b"\x93NUMPY\x01\x00".to_vec(), (h.len() as u16).to_le_bytes().to_vec(), h.into_bytes(), data.to_vec()].concat()
+        let h = format!(
+            "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}\n",
+            if fortran { "True" } else { "False" }
+        );
+        [
+            b"\x93NUMPY\x01\x00".to_vec(),
+            (h.len() as u16).to_le_bytes().to_vec(),
+            h.into_bytes(),
+            data.to_vec(),
+        ]
+        .concat()
     }
 
     #[test]
@@ -266,7 +281,8 @@ mod tests {
         let pts = [[1.0, 2.0, 3.0], [4.5, -6.0, 0.25]];
         let le8: Vec<u8> = pts.iter().flatten().flat_map(|v: &f64| v.to_le_bytes()).collect();
         let be4: Vec<u8> = pts.iter().flatten().flat_map(|&v| (v as f32).to_be_bytes()).collect();
-        let fo8: Vec<u8> = (0..3).flat_map(|c| pts.iter().map(move |q| q[c])).flat_map(|v: f64| v.to_le_bytes()).collect();
+        let fo8: Vec<u8> =
+            (0..3).flat_map(|c| pts.iter().map(move |q| q[c])).flat_map(|v: f64| v.to_le_bytes()).collect();
         let want: Vec<DVec3> = pts.iter().map(|&q| DVec3::from_array(q)).collect();
         assert_eq!(parse_npy(&npy("<f8", false, "(2, 3)", &le8), p).unwrap(), want);
         assert_eq!(parse_npy(&npy(">f4", false, "(2, 3)", &be4), p).unwrap(), want);
@@ -286,7 +302,9 @@ mod tests {
         write_classes_npy(&mut out, &[Class::Inside, Class::Outside, Class::OnBoundary]).unwrap();
         assert_eq!(out.len() % 64, 3);
         assert!(out.starts_with(b"\x93NUMPY\x01\x00"));
-        assert!(String::from_utf8_lossy(&out).contains("'descr': '|u1', 'fortran_order': False, 'shape': (3,)"));
+        assert!(
+            String::from_utf8_lossy(&out).contains("'descr': '|u1', 'fortran_order': False, 'shape': (3,)")
+        );
         assert_eq!(&out[out.len() - 3..], &[1, 0, 2]);
         let mut text = Vec::new();
         write_classes(&mut text, &[Class::Inside, Class::Outside, Class::OnBoundary]).unwrap();

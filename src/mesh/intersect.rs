@@ -195,9 +195,9 @@ impl TriangleSoup {
                 }
                 let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
                 match triangulate::polygon(&corners) {
-                    Ok(tris) => {
-                        Tess::Many(tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect())
-                    }
+                    Ok(tris) => Tess::Many(
+                        tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect(),
+                    ),
                     Err(e) => Tess::Failed(e),
                 }
             })

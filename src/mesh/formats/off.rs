@@ -164,7 +164,9 @@ mod tests {
             assert_eq!(read_fast(&out).as_ref(), Some(&m), "{name}");
             texts.push(out);
         }
-        texts.push(b"OFF 4 4\n0 0 0\n1 0 0 # c\n0 1 0\n\n0 0 1 9 9\n3 0 2 1\n3 0 1 3\n3 1 2 3 7\n3 2 0 3\n".to_vec());
+        texts.push(
+            b"OFF 4 4\n0 0 0\n1 0 0 # c\n0 1 0\n\n0 0 1 9 9\n3 0 2 1\n3 0 1 3\n3 1 2 3 7\n3 2 0 3\n".to_vec(),
+        );
         texts.push(b"# lead\nCOFF\n 4\t4 6\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n".to_vec());
         let mut rng = Rng::new(5);
         let alphabet = b"0123456789 .-+e#\n\x0bx";

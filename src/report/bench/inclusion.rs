@@ -238,6 +238,17 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
 }
 
 pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, InclusionError> {
+    // The thesis' CPU columns are one thread: the tables run in a one-thread pool (the
+    // classifiers use every core of the current pool otherwise; `texgeo bench scale`
+    // measures that).
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| InclusionError::Options(format!("a one-thread pool: {e}")))?;
+    one.install(|| run_tables(ctx, models, cfg))
+}
+
+fn run_tables(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, InclusionError> {
     let mut measured = Vec::new();
     for model in models {
         eprintln!("bench inclusion: {} ({} faces)…", model.name, model.mesh.num_faces());
