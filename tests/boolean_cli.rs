@@ -77,6 +77,8 @@ fn one_operation_and_all_of_them() {
         dir.to_str().unwrap(),
         "--format",
         "ply",
+        "--pictures",
+        dir.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: Vec<f64> = ["union", "intersection", "difference", "symmetric-difference"]
@@ -84,6 +86,12 @@ fn one_operation_and_all_of_them() {
         .map(|op| volume(&dir.join(format!("{op}.ply"))))
         .collect();
     assert!((v[0] - v[1] - v[3]).abs() < 1e-9 * v[0], "{v:?}");
+    // One Fig. 6-9 … 6-12 picture per operation, not one colour.
+    for op in ["union", "intersection", "difference", "symmetric-difference"] {
+        let p = texgeo::render::Picture::load_png(dir.join(format!("{op}.png"))).unwrap();
+        assert_eq!((p.width, p.height), (800, 600), "{op}");
+        assert!(p.rgba.chunks_exact(4).any(|c| c != &p.rgba[..4]), "{op}: one colour");
+    }
 }
 
 #[test]

@@ -1,6 +1,7 @@
-//! The modules of `src/inclusion` import each other without cycles: `mod.rs` only declares
-//! and re-exports, shared types live in leaf modules, and one factory (`solver.rs`) builds
-//! every method. Read from the sources (comments and tests left out).
+//! The modules of `src/inclusion` and `src/subdiv` import each other without cycles: in
+//! inclusion `mod.rs` only declares and re-exports, shared types live in leaf modules, and
+//! one factory (`solver.rs`) builds every method. Read from the sources (comments and
+//! tests left out).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -104,4 +105,11 @@ fn inclusion_modules_import_without_cycles() {
     assert_eq!(cycle(&g), None, "{g:?}");
     // mod.rs names no child in its code.
     assert!(g["mod"].is_empty(), "{:?}", g["mod"]);
+}
+
+#[test]
+fn subdiv_modules_import_without_cycles() {
+    let g = graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src/subdiv"));
+    assert!(g.len() > 8, "{g:?}");
+    assert_eq!(cycle(&g), None, "{g:?}");
 }

@@ -314,6 +314,61 @@ fn texgeo(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().unwrap()
 }
 
+/// `--boolean B --op OP`: the operands in their two colours with the cut curve over them,
+/// and beside them the result, its faces coloured by operand (Figs. 6-9 … 6-12).
+#[test]
+fn boolean_pictures_show_both_operands_and_the_cut_curve() {
+    let dir = std::env::temp_dir().join(format!("texgeo-render-boolean-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("torus-and-knot.png");
+    let o = texgeo(&[
+        "render",
+        "builtin:torus",
+        "--boolean",
+        "builtin:knot",
+        "--op",
+        "intersection",
+        "--size",
+        "400x300",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let p = Picture::load_png(&png).unwrap();
+    let pixels: Vec<&[u8]> = p.rgba.chunks_exact(4).collect();
+    // Shaded surfaces keep their hue: A is orange (red ≫ blue), B blue (blue ≫ red).
+    let orange = pixels.iter().filter(|c| c[0] as i32 > c[2] as i32 + 60).count();
+    let blue = pixels.iter().filter(|c| c[2] as i32 > c[0] as i32 + 60).count();
+    let curve = pixels.iter().filter(|c| close([c[0], c[1], c[2], c[3]], colour::CURVE, 8)).count();
+    assert!(orange > 500 && blue > 500 && curve > 100, "orange {orange}, blue {blue}, curve {curve}");
+    let o = texgeo(&["render", "builtin:torus", "--boolean", "builtin:knot", "-o", png.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--op"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An OBJ's crease tags are refined with the mesh and their edges drawn over the surface
+/// in the colour of their sharpness; without the tags (the same mesh as OFF) nothing is.
+#[test]
+fn crease_edges_are_drawn_over_the_subdivided_surface() {
+    let dir = std::env::temp_dir().join(format!("texgeo-render-creases-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tagged = concat!(env!("CARGO_MANIFEST_DIR"), "/reference/subdiv/cube_creases.obj");
+    let plain = dir.join("cube.off");
+    assert!(texgeo(&["mesh", "convert", tagged, plain.to_str().unwrap()]).status.success());
+    let mut counts = Vec::new();
+    for input in [tagged, plain.to_str().unwrap()] {
+        let png = dir.join("creases.png");
+        let o = texgeo(&["render", input, "-l", "2", "--size", "320x240", "-o", png.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let p = Picture::load_png(&png).unwrap();
+        // Crease colours run from yellow to red: strong red, weak blue, unlike the grey surface.
+        counts.push(p.rgba.chunks_exact(4).filter(|c| c[0] > 200 && c[2] < 90).count());
+    }
+    assert!(counts[0] > 100 && counts[1] == 0, "crease pixels with tags, without: {counts:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn render_command_writes_pictures_and_refuses_bad_requests() {
     let dir = std::env::temp_dir().join(format!("texgeo-render-cli-{}", std::process::id()));

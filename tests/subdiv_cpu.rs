@@ -94,6 +94,24 @@ fn matches_committed_reference_files() {
     }
 }
 
+/// The committed OpenSubdiv outputs of sharp shapes (OBJ inputs with tags): reading the
+/// tags gives the test shape back, and the CPU reference equals OpenSubdiv's output.
+#[test]
+fn matches_committed_sharp_references() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
+    for (name, level) in shapes::committed_sharp_references() {
+        let shape = shapes::sharp().into_iter().find(|s| s.name == name).unwrap();
+        let input = texgeo::subdiv::tags::read(dir.join(format!("{name}.obj"))).unwrap();
+        let surface = input.surface(Default::default());
+        assert_eq!(surface, shape.surface, "reference/subdiv/{name}.obj is not the test shape {name}");
+        let path = dir.join(format!("{name}-level{level}.off"));
+        let reference = texgeo::mesh::formats::read(&path).unwrap_or_else(|e| panic!("{e}"));
+        let ours = cpu::refine_surface(&surface, level).unwrap();
+        let c = Comparison::new(&ours.mesh, &reference, TOLERANCE);
+        assert!(c.is_match() && c.same_order, "{}:\n{c}", path.display());
+    }
+}
+
 /// V − E + F of every refined level equals the input's (closed and open meshes).
 #[test]
 fn euler_characteristic_is_preserved() {
@@ -144,8 +162,11 @@ fn one_rings_are_ordered() {
     }
 }
 
+/// What OpenSubdiv tags and subdivides with sharp rules is accepted (fins, bowties,
+/// inconsistently oriented neighbours, degenerate faces), and the result equals
+/// OpenSubdiv's; features that do not fit the mesh are clear errors.
 #[test]
-fn rejects_non_manifold_input() {
+fn non_manifold_input_is_subdivided_as_opensubdiv_does() {
     let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
     // Three triangles on one edge.
     let fin = Mesh::new(
@@ -153,29 +174,28 @@ fn rejects_non_manifold_input() {
         vec![vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]],
     )
     .unwrap();
-    assert!(matches!(cpu::refine(&fin, 1), Err(SubdivError::NonManifoldEdge { a: 0, b: 1, faces: 3 })));
-    // Two tetrahedra sharing only vertex 0 (a bowtie vertex).
-    let t = shapes::tetrahedron();
-    let mut positions = t.positions().to_vec();
-    positions.extend(t.positions()[1..].iter().map(|&q| 2.0 * t.positions()[0] - q));
-    let mut faces: Vec<Vec<u32>> = t.faces().map(<[u32]>::to_vec).collect();
-    let second: Vec<Vec<u32>> =
-        faces.iter().map(|f| f.iter().rev().map(|&v| if v == 0 { 0 } else { v + 3 }).collect()).collect();
-    faces.extend(second);
-    let bowtie = Mesh::new(positions, faces).unwrap();
-    let err = cpu::refine(&bowtie, 1).unwrap_err();
-    assert!(matches!(err, SubdivError::NonManifoldVertex { vertex: 0, faces: 6 }), "{err}");
-    assert!(err.to_string().contains("non-manifold vertex 0"), "{err}");
-    // A flipped face.
+    assert_matches_opensubdiv("fin", &fin, 1..=3);
+    // A flipped face of a cube, and a face using a vertex twice.
     let cube = shapes::cube();
     let mut faces: Vec<Vec<u32>> = cube.faces().map(<[u32]>::to_vec).collect();
     faces[2].reverse();
-    let flipped = Mesh::new(cube.positions().to_vec(), faces).unwrap();
-    assert!(matches!(cpu::refine(&flipped, 1), Err(SubdivError::Inconsistent { .. })));
-    // A face using a vertex twice.
-    let degenerate =
-        Mesh::new(vec![p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)], vec![vec![0, 1, 0, 2]]).unwrap();
-    assert!(matches!(cpu::refine(&degenerate, 1), Err(SubdivError::DegenerateFace { face: 0, vertex: 0 })));
+    assert_matches_opensubdiv("flipped face", &Mesh::new(cube.positions().to_vec(), faces).unwrap(), 1..=3);
+    let degenerate = Mesh::new(
+        vec![p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.), p(1., 1., 0.)],
+        vec![vec![0, 1, 0, 2], vec![1, 3, 2, 0]],
+    )
+    .unwrap();
+    assert_matches_opensubdiv("repeated vertex", &degenerate, 1..=3);
+    assert_matches_opensubdiv("two cubes on an edge", &procedural::two_cubes_sharing_edge(), 1..=3);
+
+    let bad = |creases: &[(u32, u32, f32)], corners: &[(u32, f32)], holes: &[u32]| {
+        let s = shapes::surface(shapes::cube(), creases, corners, holes, Default::default());
+        cpu::refine_surface(&s, 1).unwrap_err().to_string()
+    };
+    assert!(bad(&[(0, 7, 1.0)], &[], &[]).contains("not joined by an edge"));
+    assert!(bad(&[(0, 1, -1.0)], &[], &[]).contains("sharpness"));
+    assert!(bad(&[], &[(8, 1.0)], &[]).contains("out of range"));
+    assert!(bad(&[], &[], &[6]).contains("out of range"));
 }
 
 /// A vertex no face uses stays where it is and keeps its place, as in OpenSubdiv.
@@ -194,4 +214,26 @@ fn isolated_vertices_stay() {
 fn missing_helper_error_says_to_run_setup() {
     let e = SubdivError::HelperMissing { path: "target/tools/osd-refine".into() };
     assert!(e.to_string().contains("run tools/setup"), "{e}");
+}
+
+/// Every shape of the sharp set (creases, corners, holes, boundary modes, Chaikin, smooth
+/// triangles, non-manifold topology) equals OpenSubdiv with the same tags and options:
+/// same vertex order, same faces, positions to 1e-12.
+#[test]
+fn sharp_features_match_opensubdiv() {
+    for shape in shapes::sharp() {
+        for level in 1..=shape.levels {
+            let name = shape.name;
+            let ours = cpu::refine_surface(&shape.surface, level)
+                .unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
+            let reference =
+                osd::refine_surface(&shape.surface, level).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let c = Comparison::new(&ours.mesh, &reference, TOLERANCE);
+            assert!(c.is_match() && c.same_order, "{name} level {level} ({}):\n{c}", shape.covers);
+            assert!(
+                ours.mesh.face_parts() == reference.face_parts(),
+                "{name} level {level}: face lists differ"
+            );
+        }
+    }
 }

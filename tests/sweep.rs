@@ -218,3 +218,56 @@ fn bad_requests_exit_2_with_one_message() {
     assert_eq!(code, Some(2));
     assert!(err.contains("different numbers of shards (1, 2)"), "{err}");
 }
+
+/// `--task boolean`: each mesh against its turned copy, checked by the volume identity and
+/// by CGAL; a solid CGAL refuses (non-manifold) is recorded as declined by the reference,
+/// an open mesh is refused as `texgeo boolean` refuses it, and shards merge to one table.
+#[test]
+fn boolean_task_checks_against_cgal_and_shards_merge_alike() {
+    let dir = temp("boolean");
+    std::fs::write(
+        dir.join("open.off"),
+        "OFF\n8 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n\
+         4 0 3 2 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n",
+    )
+    .unwrap();
+    let m = dir.join("meshes.txt");
+    std::fs::write(&m, "builtin:cube\nbuiltin:two-cubes\nopen.off\nbuiltin:l-prism\nbuiltin:torus\n")
+        .unwrap();
+    let run = |out: &Path, shard: &str| {
+        ok(&texgeo(
+            &[
+                "sweep",
+                m.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--task",
+                "boolean",
+                "--op",
+                "union",
+                "--reference",
+                "cgal",
+                "--shard",
+                shard,
+            ],
+            &[],
+        ))
+    };
+    let whole = dir.join("whole");
+    let text = run(&whole, "0/1");
+    assert!(text.contains("5 meshes: 4 ok, 1 refused"), "{text}");
+    let reference = table(&whole);
+    assert!(reference.lines().any(|l| l.contains(",open.off,refused,not-closed,")), "{reference}");
+    let results = std::fs::read_to_string(whole.join("results-0-of-1.jsonl")).unwrap();
+    let line = |mesh: &str| results.lines().find(|l| l.contains(&format!("\"mesh\":\"{mesh}\""))).unwrap();
+    assert!(line("builtin:two-cubes").contains("\"cgal\":\"declined: self-intersecting\""), "{results}");
+    for mesh in ["builtin:cube", "builtin:torus", "builtin:l-prism"] {
+        assert!(line(mesh).contains("\"cgal_volume\""), "{mesh}: {}", line(mesh));
+    }
+    let sharded = dir.join("sharded");
+    for shard in ["1/2", "0/2"] {
+        run(&sharded, shard);
+    }
+    ok(&texgeo(&["sweep", "merge", sharded.to_str().unwrap()], &[]));
+    assert_eq!(table(&sharded), reference);
+}

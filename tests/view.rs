@@ -118,6 +118,7 @@ fn screenshots_equal_offscreen_pictures() {
         ("knot", vec!["builtin:knot", "--wireframe"]),
         ("voxels", vec!["builtin:torus", "--voxels", "--res", "24", "--aspect", "perlin"]),
         ("valence", vec!["builtin:cube", "--level", "2", "--valence", "--shading", "smooth", "--yaw", "-60"]),
+        ("boolean", vec!["builtin:torus", "--boolean", "builtin:knot", "--op", "intersection"]),
     ] {
         let shot = dir.join(format!("{name}-view.png"));
         let picture = dir.join(format!("{name}-render.png"));

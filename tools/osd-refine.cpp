@@ -1,14 +1,22 @@
 // osd-refine: uniform Catmull-Clark refinement by OpenSubdiv, the independent reference
-// for texgeo's CPU and GPU subdivision (SPEC §5.1, STACK.md "OpenSubdiv facts").
+// for texgeo's CPU and GPU subdivision (SPEC §5.1, issue 14, STACK.md "OpenSubdiv facts").
 //
 //   osd-refine IN LEVEL [OUT] [--repeat N] [--sparse]
+//              [--boundary none|edge-only|edge-and-corner] [--crease-method uniform|chaikin]
+//              [--triangles catmark|smooth]
 //
-// IN is an OFF or OBJ file (OBJ: only `v` and `f` lines are used). The mesh is refined
-// LEVEL times with Sdc::SCHEME_CATMARK, VTX_BOUNDARY_EDGE_ONLY, FVAR_LINEAR_ALL,
-// CREASE_UNIFORM, TRI_SUB_CATMARK and full topology in the last level (--sparse drops
-// it, as an application that only draws would), positions interpolated in double
-// precision. The last level is written to OUT as OFF with %.17g coordinates, in
-// OpenSubdiv's default vertex order (vertex points, face points, edge points).
+// IN is an OFF or OBJ file. OBJ: `v` and `f` lines, and the tags of OpenSubdiv's
+// regression shapes (`t NAME nint/nfloat/nstring ints floats strings`, vertex and face
+// indices 0-based): `crease` (vertex pairs, one sharpness for all or one per pair),
+// `corner` (vertices, one sharpness or one each), `hole` (faces), `interpolateboundary`
+// (0 none, 1 edge-and-corner, 2 edge-only), `creasemethod` (normal|chaikin),
+// `smoothtriangles` (catmark|smooth); other tags are ignored. The mesh is refined LEVEL
+// times with Sdc::SCHEME_CATMARK, FVAR_LINEAR_ALL and by default VTX_BOUNDARY_EDGE_ONLY,
+// CREASE_UNIFORM, TRI_SUB_CATMARK (the tags, then the options, change these), with full
+// topology in the last level (--sparse drops it, as an application that only draws
+// would), positions interpolated in double precision. The last level is written to OUT
+// as OFF with %.17g coordinates, in OpenSubdiv's default vertex order (vertex points,
+// face points, edge points), leaving out faces under holes (their vertices stay).
 //
 // With --repeat N, topology creation + refinement + interpolation is timed N times (the
 // previous run's result is freed outside the timed region) and one line is printed on
@@ -16,7 +24,9 @@
 //   osd-refine: level=L vertices=V faces=F repeat=N min_seconds=S median_seconds=M
 // Errors go to stderr as `file:line: message` and exit with status 1.
 //
-// Face indices are range-checked here: OpenSubdiv itself does not check them.
+// Face indices are range-checked here (OpenSubdiv itself does not check them), and so are
+// the tags: a crease on vertices no edge joins, a corner or hole out of range, a negative
+// sharpness are errors (OpenSubdiv would only warn or clamp).
 
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -45,8 +55,24 @@ struct Mesh {
     std::vector<double> positions;  // xyz per vertex
     std::vector<int> faceSizes;
     std::vector<int> faceIndices;
+    // Sharp features and scheme options from OBJ tags.
+    std::vector<int> creaseVertices;  // pairs
+    std::vector<float> creaseWeights;
+    std::vector<int> cornerVertices;
+    std::vector<float> cornerWeights;
+    std::vector<int> holes;
+    Sdc::Options options;
     int numVertices() const { return int(positions.size() / 3); }
 };
+
+Sdc::Options defaultOptions() {
+    Sdc::Options sdc;
+    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    sdc.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
+    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+    sdc.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+    return sdc;
+}
 
 // A primvar in double precision for PrimvarRefinerReal<double>.
 struct Point {
@@ -115,6 +141,7 @@ Mesh readOff(std::string const& path) {
     Lines lines{std::ifstream(path), path};
     if (!lines.in) fail(path, std::strerror(errno));
     Mesh mesh;
+    mesh.options = defaultOptions();
     std::string line;
     if (!lines.next(line)) fail(path, "empty file, expected an OFF header");
     auto head = tokens(line);
@@ -157,11 +184,124 @@ Mesh readOff(std::string const& path) {
     return mesh;
 }
 
+bool parseFloat(std::string const& tok, float& out) {
+    double d = 0.0;
+    if (!parseDouble(tok, d)) return false;
+    out = float(d);
+    return true;
+}
+
+// One `t NAME nint/nfloat/nstring ints floats strings` line (indices 0-based, checked
+// once the whole file is read).
+void readTag(Mesh& mesh, std::vector<std::string> const& t, std::string const& where) {
+    if (t.size() < 3) fail(where, "a tag needs a name and 'nint/nfloat/nstring' counts");
+    long n[3] = {0, 0, 0};
+    std::string counts = t[2];
+    for (int k = 0; k < 3; ++k) {
+        size_t slash = counts.find('/');
+        std::string part = counts.substr(0, slash);
+        if (!parseLong(part, n[k]) || n[k] < 0 || (k < 2 && slash == std::string::npos))
+            fail(where, "expected 'nint/nfloat/nstring' counts, found '" + t[2] + "'");
+        counts = slash == std::string::npos ? "" : counts.substr(slash + 1);
+    }
+    if (long(t.size()) != 3 + n[0] + n[1] + n[2])
+        fail(where, "the tag announces " + std::to_string(n[0] + n[1] + n[2]) + " arguments, found " +
+                        std::to_string(t.size() - 3));
+    std::vector<int> ints;
+    std::vector<float> floats;
+    std::vector<std::string> strings;
+    for (long k = 0; k < n[0]; ++k) {
+        long v = 0;
+        if (!parseLong(t[3 + k], v) || v < 0 || v > std::numeric_limits<int>::max())
+            fail(where, "'" + t[3 + k] + "' is not an index");
+        ints.push_back(int(v));
+    }
+    for (long k = 0; k < n[1]; ++k) {
+        float v = 0;
+        if (!parseFloat(t[3 + n[0] + k], v) || v < 0) fail(where, "'" + t[3 + n[0] + k] + "' is not a sharpness");
+        floats.push_back(v);
+    }
+    for (long k = 0; k < n[2]; ++k) strings.push_back(t[3 + n[0] + n[1] + k]);
+    std::string const& name = t[1];
+    auto weight = [&](size_t i, size_t items) {
+        if (floats.size() == 1) return floats[0];
+        if (floats.size() == items) return floats[i];
+        fail(where, "'" + name + "' needs one sharpness or one per item");
+    };
+    if (name == "crease") {
+        if (ints.empty() || ints.size() % 2 != 0) fail(where, "'crease' needs vertex pairs");
+        for (size_t i = 0; i < ints.size() / 2; ++i) {
+            mesh.creaseVertices.push_back(ints[2 * i]);
+            mesh.creaseVertices.push_back(ints[2 * i + 1]);
+            mesh.creaseWeights.push_back(weight(i, ints.size() / 2));
+        }
+    } else if (name == "corner") {
+        for (size_t i = 0; i < ints.size(); ++i) {
+            mesh.cornerVertices.push_back(ints[i]);
+            mesh.cornerWeights.push_back(weight(i, ints.size()));
+        }
+    } else if (name == "hole") {
+        mesh.holes.insert(mesh.holes.end(), ints.begin(), ints.end());
+    } else if (name == "interpolateboundary") {
+        if (ints.size() != 1) fail(where, "'interpolateboundary' takes one integer");
+        switch (ints[0]) {
+            case 0: mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE); break;
+            case 1: mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER); break;
+            case 2: mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY); break;
+            default: fail(where, "'interpolateboundary' is 0, 1 or 2");
+        }
+    } else if (name == "creasemethod") {
+        if (strings.size() != 1) fail(where, "'creasemethod' takes one string");
+        if (strings[0] == "normal" || strings[0] == "uniform") {
+            mesh.options.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+        } else if (strings[0] == "chaikin") {
+            mesh.options.SetCreasingMethod(Sdc::Options::CREASE_CHAIKIN);
+        } else {
+            fail(where, "'creasemethod' is normal or chaikin");
+        }
+    } else if (name == "smoothtriangles") {
+        if (strings.size() != 1) fail(where, "'smoothtriangles' takes one string");
+        if (strings[0] == "catmark") {
+            mesh.options.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+        } else if (strings[0] == "smooth") {
+            mesh.options.SetTriangleSubdivision(Sdc::Options::TRI_SUB_SMOOTH);
+        } else {
+            fail(where, "'smoothtriangles' is catmark or smooth");
+        }
+    }
+    // Other tags (face-varying options, hierarchical edits, ...) do not change positions
+    // here and are ignored.
+}
+
+// The tags' indices against the mesh: every crease pair joined by an edge, corners and
+// holes in range.
+void checkTags(Mesh const& mesh, std::string const& path) {
+    std::vector<std::pair<int, int>> edges;
+    for (size_t f = 0, first = 0; f < mesh.faceSizes.size(); first += mesh.faceSizes[f], ++f) {
+        for (int j = 0; j < mesh.faceSizes[f]; ++j) {
+            int a = mesh.faceIndices[first + j], b = mesh.faceIndices[first + (j + 1) % mesh.faceSizes[f]];
+            edges.emplace_back(std::min(a, b), std::max(a, b));
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    for (size_t i = 0; i < mesh.creaseWeights.size(); ++i) {
+        int a = mesh.creaseVertices[2 * i], b = mesh.creaseVertices[2 * i + 1];
+        if (!std::binary_search(edges.begin(), edges.end(), std::make_pair(std::min(a, b), std::max(a, b))))
+            fail(path, "crease: vertices " + std::to_string(a) + " and " + std::to_string(b) +
+                           " are not joined by an edge");
+    }
+    for (int v : mesh.cornerVertices)
+        if (v >= mesh.numVertices()) fail(path, "corner: vertex " + std::to_string(v) + " is out of range");
+    for (int f : mesh.holes)
+        if (f >= int(mesh.faceSizes.size())) fail(path, "hole: face " + std::to_string(f) + " is out of range");
+}
+
 // OBJ: `v x y z` and `f a b c …` (a, b, c may be `i`, `i/t`, `i//n`, `i/t/n`, negative = relative).
 Mesh readObj(std::string const& path) {
     Lines lines{std::ifstream(path), path};
     if (!lines.in) fail(path, std::strerror(errno));
     Mesh mesh;
+    mesh.options = defaultOptions();
     std::string line;
     while (lines.next(line)) {
         auto t = tokens(line);
@@ -185,6 +325,8 @@ Mesh readObj(std::string const& path) {
             }
             checkFace(mesh, at(path, lines.number), first);
             mesh.faceSizes.push_back(int(mesh.faceIndices.size()) - first);
+        } else if (t[0] == "t") {
+            readTag(mesh, t, at(path, lines.number));
         }
     }
     return mesh;
@@ -203,17 +345,21 @@ struct Result {
 
 // Topology creation, uniform refinement and interpolation of every level: what is timed.
 Result refine(Mesh const& mesh, int level, bool fullTopology) {
-    Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
-    sdc.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
-    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-    sdc.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+    Sdc::Options sdc = mesh.options;
 
     Far::TopologyDescriptor desc;
     desc.numVertices = mesh.numVertices();
     desc.numFaces = int(mesh.faceSizes.size());
     desc.numVertsPerFace = mesh.faceSizes.data();
     desc.vertIndicesPerFace = mesh.faceIndices.data();
+    desc.numCreases = int(mesh.creaseWeights.size());
+    desc.creaseVertexIndexPairs = mesh.creaseVertices.data();
+    desc.creaseWeights = mesh.creaseWeights.data();
+    desc.numCorners = int(mesh.cornerWeights.size());
+    desc.cornerVertexIndices = mesh.cornerVertices.data();
+    desc.cornerWeights = mesh.cornerWeights.data();
+    desc.numHoles = int(mesh.holes.size());
+    desc.holeIndices = mesh.holes.data();
 
     using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
     Result r;
@@ -243,10 +389,13 @@ void writeOff(std::string const& path, Result const& r) {
     Point const* p = r.points.data() + (r.points.size() - last.GetNumVertices());
     FILE* out = std::fopen(path.c_str(), "w");
     if (!out) fail(path, std::strerror(errno));
-    std::fprintf(out, "OFF\n%d %d 0\n", last.GetNumVertices(), last.GetNumFaces());
+    int kept = 0;
+    for (int f = 0; f < last.GetNumFaces(); ++f) kept += !last.IsFaceHole(f);
+    std::fprintf(out, "OFF\n%d %d 0\n", last.GetNumVertices(), kept);
     for (int v = 0; v < last.GetNumVertices(); ++v)
         std::fprintf(out, "%.17g %.17g %.17g\n", p[v].p[0], p[v].p[1], p[v].p[2]);
     for (int f = 0; f < last.GetNumFaces(); ++f) {
+        if (last.IsFaceHole(f)) continue;
         Far::ConstIndexArray fv = last.GetFaceVertices(f);
         std::fprintf(out, "%d", fv.size());
         for (int j = 0; j < fv.size(); ++j) std::fprintf(out, " %d", fv[j]);
@@ -256,7 +405,10 @@ void writeOff(std::string const& path, Result const& r) {
 }
 
 [[noreturn]] void usage() {
-    std::fprintf(stderr, "usage: osd-refine IN.(off|obj) LEVEL [OUT.off] [--repeat N] [--sparse]\n");
+    std::fprintf(stderr,
+                 "usage: osd-refine IN.(off|obj) LEVEL [OUT.off] [--repeat N] [--sparse]\n"
+                 "       [--boundary none|edge-only|edge-and-corner] [--crease-method uniform|chaikin]\n"
+                 "       [--triangles catmark|smooth]\n");
     std::exit(2);
 }
 
@@ -266,11 +418,15 @@ int main(int argc, char** argv) {
     std::vector<std::string> positional;
     long repeat = 0;
     bool fullTopology = true;
+    std::string boundary, creaseMethod, triangles;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         if (a == "--repeat") {
             if (i + 1 >= argc || !parseLong(argv[i + 1], repeat) || repeat < 1) usage();
             ++i;
+        } else if (a == "--boundary" || a == "--crease-method" || a == "--triangles") {
+            if (i + 1 >= argc) usage();
+            (a == "--boundary" ? boundary : a == "--crease-method" ? creaseMethod : triangles) = argv[++i];
         } else if (a == "--sparse") {
             fullTopology = false;
         } else if (a.size() > 1 && a[0] == '-') {
@@ -286,6 +442,30 @@ int main(int argc, char** argv) {
     std::string const& in = positional[0];
     Mesh mesh = endsWith(in, ".obj") ? readObj(in) : readOff(in);
     if (mesh.faceSizes.empty()) fail(in, "the mesh has no faces");
+    checkTags(mesh, in);
+    if (boundary == "none") {
+        mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE);
+    } else if (boundary == "edge-only") {
+        mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    } else if (boundary == "edge-and-corner") {
+        mesh.options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
+    } else if (!boundary.empty()) {
+        usage();
+    }
+    if (creaseMethod == "uniform") {
+        mesh.options.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+    } else if (creaseMethod == "chaikin") {
+        mesh.options.SetCreasingMethod(Sdc::Options::CREASE_CHAIKIN);
+    } else if (!creaseMethod.empty()) {
+        usage();
+    }
+    if (triangles == "catmark") {
+        mesh.options.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+    } else if (triangles == "smooth") {
+        mesh.options.SetTriangleSubdivision(Sdc::Options::TRI_SUB_SMOOTH);
+    } else if (!triangles.empty()) {
+        usage();
+    }
 
     Result r;
     std::vector<double> seconds;

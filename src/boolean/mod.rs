@@ -225,7 +225,13 @@ impl Evaluation {
     /// result must be closed and consistently oriented; if it is not, that is a bug and
     /// is returned as [`BooleanError::NotClosed`].
     pub fn result(&self, op: Operation, regularized: bool) -> Result<Mesh> {
-        let tris = select::select(
+        Ok(self.result_by_operand(op, regularized)?.0)
+    }
+
+    /// [`Evaluation::result`] and how many of its faces, the first ones, come from A (the
+    /// rest come from B), for pictures that colour faces by operand (Figs. 6-9 … 6-12).
+    pub fn result_by_operand(&self, op: Operation, regularized: bool) -> Result<(Mesh, usize)> {
+        let (tris, from_a) = select::select(
             op,
             regularized,
             (&self.refinement.a.triangles, &self.classification.a),
@@ -242,7 +248,14 @@ impl Evaluation {
                 });
             }
         }
-        Ok(mesh)
+        Ok((mesh, from_a))
+    }
+
+    /// Refined operand A (`b` false) or B (`b` true) as a mesh: its triangles with the cut
+    /// curve among their edges.
+    pub fn refined_operand(&self, b: bool) -> Mesh {
+        let r = if b { &self.refinement.b } else { &self.refinement.a };
+        select::assemble(&self.refinement.points, &r.triangles)
     }
 
     /// The cut curve as 3D segments (where the two surfaces meet), for pictures.

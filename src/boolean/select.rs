@@ -96,14 +96,16 @@ impl FromStr for Operation {
     }
 }
 
-/// The triangles of `op` from both refined meshes (over the refinement's point ids).
+/// The triangles of `op` from both refined meshes (over the refinement's point ids): those
+/// from A first, then those from B; the second value is how many come from A.
 pub fn select(
     op: Operation,
     regularized: bool,
     a: (&[[u32; 3]], &[Class]),
     b: (&[[u32; 3]], &[Class]),
-) -> Vec<[u32; 3]> {
+) -> (Vec<[u32; 3]>, usize) {
     let mut out = Vec::new();
+    let mut from_a_count = 0;
     for (from_a, (tris, classes)) in [(true, a), (false, b)] {
         for (t, &c) in tris.iter().zip(classes) {
             match op.keeps(from_a, c, regularized) {
@@ -112,8 +114,11 @@ pub fn select(
                 None => {}
             }
         }
+        if from_a {
+            from_a_count = out.len();
+        }
     }
-    out
+    (out, from_a_count)
 }
 
 /// A mesh of `triangles` over `points`, keeping only the points used (in order of

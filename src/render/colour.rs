@@ -19,6 +19,14 @@ pub const FIRST: Rgba = [214, 120, 80, 255];
 pub const SECOND: Rgba = [90, 150, 220, 255];
 pub const CURVE: Rgba = [250, 220, 60, 255];
 
+/// A crease edge by its sharpness: from yellow (barely sharp) through orange to red
+/// (10 or more: infinitely sharp), so semi-sharp creases read apart from sharp ones.
+pub fn crease_colour(sharpness: f32) -> Rgba {
+    let t = (sharpness / 10.0).clamp(0.0, 1.0);
+    let mix = |a: f32, b: f32| (a + (b - a) * t).round() as u8;
+    [mix(255.0, 235.0), mix(225.0, 40.0), mix(60.0, 40.0), 255]
+}
+
 /// The colour of a vertex of valence `k`: regular vertices (4) neutral, extraordinary
 /// ones bright and distinct, so they stand out in a refined mesh.
 pub fn valence_colour(k: usize) -> Rgba {

@@ -23,6 +23,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod boolean;
 mod camera;
 pub mod colour;
 mod error;

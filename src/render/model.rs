@@ -7,7 +7,11 @@ use std::time::Instant;
 
 use crate::gpu::Context;
 use crate::mesh::Mesh;
-use crate::render::{Look, Polyline, Rgba, Scene, Shading};
+use glam::DVec3;
+
+use crate::render::{Look, Polyline, Rgba, Scene, Shading, colour};
+use crate::subdiv::Surface;
+use crate::subdiv::cpu::SharpEdge;
 use crate::subdiv::gpu::{Options, Subdivider};
 use crate::voxel::aspect::{self, Aspect};
 use crate::voxel::{self, Grid, Volume};
@@ -22,9 +26,32 @@ pub enum Content {
     Voxels(Grid, Volume),
     /// A mesh voxelized at `res` voxels per side on the viewer's device.
     Voxelize(Mesh, usize),
+    /// A mesh with sharp features (OpenSubdiv's OBJ tags: creases, corners, holes),
+    /// refined live with them; its crease edges are drawn over the surface, coloured by
+    /// sharpness ([`super::colour::crease_colour`]).
+    Surface(Surface),
     /// Several meshes in their colours, and polylines (e.g. the operands and result of a
     /// Boolean with its cut curve).
     Meshes(Vec<(Mesh, Rgba)>, Vec<Polyline>),
+}
+
+/// Width of crease edges, in pixels.
+const CREASE_WIDTH: f32 = 2.5;
+
+/// The sharp edges of a control mesh (its tagged creases), as a refinement reports them.
+fn control_creases(surface: &Surface) -> Vec<SharpEdge> {
+    surface
+        .features
+        .creases
+        .iter()
+        .filter(|c| c.sharpness > 0.0)
+        .map(|c| SharpEdge {
+            vertices: c.vertices,
+            sharpness: c.sharpness,
+            boundary: false,
+            non_manifold: false,
+        })
+        .collect()
 }
 
 /// Most faces a live level may have (beyond this, memory and frame time explode).
@@ -34,8 +61,9 @@ const MAX_LEVEL_FACES: usize = 8 << 20;
 pub struct Model {
     content: Content,
     pub level: u32,
-    /// The mesh at `level` (Content::Mesh only).
+    /// The mesh at `level` (a single mesh only) and its crease edges.
     refined: Option<Mesh>,
+    creases: Vec<SharpEdge>,
     subdivider: Option<Subdivider>,
     pub look: Look,
     aspect: Option<Aspect>,
@@ -57,18 +85,33 @@ impl Model {
                 let v = voxel::voxelize(Some(ctx), &mesh, res, voxel::Method::Zoned)?;
                 Content::Voxels(v.grid, v.volume)
             }
+            // One path for single meshes: a mesh is a surface without sharp features.
+            Content::Mesh(mesh) => Content::Surface(Surface::from(mesh)),
             c => c,
         };
-        if level > 0 && !matches!(content, Content::Mesh(_)) {
+        if level > 0 && !matches!(content, Content::Surface(_)) {
             return Err(RenderError::Usage("subdivision levels apply to a single mesh".into()));
         }
         let subdivider = match content {
-            Content::Mesh(_) => Some(Subdivider::new(ctx)?),
+            Content::Surface(_) => Some(Subdivider::new(ctx)?),
             _ => None,
         };
         let show_aspect = aspect.is_some();
-        let mut model =
-            Model { content, level: 0, refined: None, subdivider, look, aspect, slices: None, show_aspect };
+        let creases = match &content {
+            Content::Surface(surface) => control_creases(surface),
+            _ => Vec::new(),
+        };
+        let mut model = Model {
+            content,
+            level: 0,
+            refined: None,
+            creases,
+            subdivider,
+            look,
+            aspect,
+            slices: None,
+            show_aspect,
+        };
         if level > 0 {
             model.set_level(ctx, level)?;
         }
@@ -77,7 +120,7 @@ impl Model {
 
     /// Whether `+`/`-` change anything.
     pub fn has_levels(&self) -> bool {
-        matches!(self.content, Content::Mesh(_))
+        matches!(self.content, Content::Surface(_))
     }
 
     pub fn is_voxels(&self) -> bool {
@@ -86,11 +129,13 @@ impl Model {
 
     /// Refines the base mesh to `level` on the GPU; returns a line for the console.
     pub fn set_level(&mut self, ctx: &Context, level: u32) -> Result<String> {
-        let (Content::Mesh(base), Some(subdivider)) = (&self.content, self.subdivider.as_mut()) else {
+        let (Content::Surface(surface), Some(subdivider)) = (&self.content, self.subdivider.as_mut()) else {
             return Err(RenderError::Usage("only a single mesh has subdivision levels".into()));
         };
+        let base = &surface.mesh;
         if level == 0 {
             self.refined = None;
+            self.creases = control_creases(surface);
             self.level = 0;
             return Ok(format!("level 0: {} vertices, {} faces", base.num_vertices(), base.num_faces()));
         }
@@ -104,7 +149,7 @@ impl Model {
             )));
         }
         let start = Instant::now();
-        let run = subdivider.refine(ctx, base, level, &Options::default())?;
+        let run = subdivider.refine_surface(ctx, surface, level, &Options::default())?;
         let line = format!(
             "level {level}: {} vertices, {} faces ({} fragment pass(es) on the GPU, {:.1} ms)",
             run.mesh.num_vertices(),
@@ -113,22 +158,35 @@ impl Model {
             start.elapsed().as_secs_f64() * 1e3
         );
         self.refined = Some(run.mesh);
+        self.creases = run.sharp_edges;
         self.level = level;
         Ok(line)
     }
 
-    /// The mesh on screen (Content::Mesh only).
+    /// The mesh on screen (a single mesh only).
     pub fn shown_mesh(&self) -> Option<&Mesh> {
         match &self.content {
-            Content::Mesh(base) => Some(self.refined.as_ref().unwrap_or(base)),
+            Content::Surface(base) => Some(self.refined.as_ref().unwrap_or(&base.mesh)),
             _ => None,
         }
+    }
+
+    /// The crease edges on screen (interior sharp edges; boundaries are drawn by the
+    /// surface's own outline), as segments with their control sharpness.
+    pub fn creases(&self) -> impl Iterator<Item = ([DVec3; 2], f32)> + '_ {
+        let mesh = self.shown_mesh();
+        self.creases.iter().filter(|e| !e.boundary).filter_map(move |e| {
+            let p = mesh?.positions();
+            Some((e.vertices.map(|v| p[v as usize]), e.sharpness))
+        })
     }
 
     /// Vertices and faces on screen.
     pub fn counts(&self) -> (usize, usize) {
         match &self.content {
-            Content::Mesh(_) => self.shown_mesh().map_or((0, 0), |m| (m.num_vertices(), m.num_faces())),
+            Content::Mesh(_) | Content::Surface(_) => {
+                self.shown_mesh().map_or((0, 0), |m| (m.num_vertices(), m.num_faces()))
+            }
             Content::Meshes(meshes, _) => {
                 meshes.iter().fold((0, 0), |(v, f), (m, _)| (v + m.num_vertices(), f + m.num_faces()))
             }
@@ -155,7 +213,15 @@ impl Model {
         }
         let look = self.look;
         Ok(match &self.content {
-            Content::Mesh(base) => Scene::new().with_mesh(look.mesh(self.refined.as_ref().unwrap_or(base))),
+            Content::Mesh(base) => Scene::new().with_mesh(look.mesh(base)),
+            Content::Surface(base) => {
+                let mut scene =
+                    Scene::new().with_mesh(look.mesh(self.refined.as_ref().unwrap_or(&base.mesh)));
+                scene.lines.extend(self.creases().map(|([p, q], sharpness)| {
+                    Polyline::new(vec![p, q], colour::crease_colour(sharpness), CREASE_WIDTH)
+                }));
+                scene
+            }
             Content::Voxels(grid, volume) => {
                 let slices = if self.show_aspect { self.slices.as_deref() } else { None };
                 Scene::new().with_mesh(look.voxels(grid, volume, slices)?)

@@ -14,29 +14,37 @@
 //!   corner 1, j towards corner 3) → `V + E·(G−1) + f·(G−1)² + (j−1)·(G−1) + i − 1`.
 //!
 //! Each position is gathered from the fragment that owns it (points shared by two or four
-//! owned regions are taken from one of them). Faces and positions are filled in parallel
-//! over blocks of coarse faces and edges.
+//! owned regions are taken from one of them; at a non-manifold vertex or edge, from one
+//! of its fans). Faces and positions are filled in parallel over blocks of coarse faces
+//! and edges.
+//!
+//! Faces come out in OpenSubdiv's order: coarse face by coarse face, and inside one, the
+//! quadtree of its refinement (each quad's four children in corner order), each quad
+//! starting at its corner towards the coarse face's corner 0 — so face `i` of the result
+//! is OpenSubdiv's face `i` with the same rotation, which gives the refinement's own
+//! vertex correspondence (`compare`). Faces under holes are left out; their vertices stay.
 
 use glam::DVec3;
 
 use crate::mesh::Mesh;
 
-use super::fragment::{Class, FragmentMesh};
+use super::cpu;
+use super::fragment::{Built, Class, FragmentMesh, sharp_edges};
 use super::topology::Topology;
-use super::{Result, SubdivError};
+use super::{Result, SubdivError, Surface};
 
-/// Builds the refined mesh from `stream`, a fragment stream of ring radius `radius` in
-/// which every fragment holds its owned region after `levels` fragment levels
-/// (`2^levels ≤ radius` rings). `position` reads one stream entry.
+/// Builds the refined mesh from `stream`, the last fragment stream after `levels`
+/// fragment levels, in which every fragment holds its owned region (`2^levels` rings).
+/// `position` reads one stream entry.
 pub fn assemble<T: Sync>(
     fragments: &FragmentMesh,
     stream: &[T],
-    radius: u32,
     levels: u32,
     position: impl Fn(&T) -> DVec3 + Sync,
 ) -> Result<Mesh> {
     let owned = 1u64 << levels;
-    let layout = fragments.layout(radius);
+    let layout = fragments.layout(levels, levels, 1);
+    let radius = layout.radius;
     if owned > u64::from(radius) || (stream.len() as u64) < layout.total {
         return Err(SubdivError::Fragment(format!(
             "a stream of {} entries at ring radius {radius} cannot hold {owned} owned rings ({} entries needed)",
@@ -55,21 +63,20 @@ pub fn assemble<T: Sync>(
     let grid = Grid { topo, g: g as u32, nv: nv as u32, face0: (nv + ne * (g - 1)) as u32 };
     let n = owned as u32;
 
-    // Faces: a G × G grid of quads per coarse face, in face order.
-    let mut indices = vec![0u32; (4 * quads) as usize];
+    // Faces: a G × G grid of quads per coarse face not under a hole, in face order, each
+    // grid in OpenSubdiv's quadtree order.
+    let kept: Vec<u32> = (0..nf as u32).filter(|&f| !fragments.is_hole(f)).collect();
+    let order = quadtree_order(levels + 1);
+    let mut indices = vec![0u32; 4 * kept.len() * (g * g) as usize];
     let per_face = (4 * g * g) as usize;
     for_each_block(&mut indices, per_face, |first, block| {
         let mut ids = Vec::new();
         for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
-            grid.face_ids((first + k) as u32, &mut ids);
+            grid.face_ids(kept[first + k], &mut ids);
             let row = grid.g as usize + 1;
-            let mut q = 0;
-            for j in 0..grid.g as usize {
-                for i in 0..grid.g as usize {
-                    let c = j * row + i;
-                    out[q..q + 4].copy_from_slice(&[ids[c], ids[c + 1], ids[c + 1 + row], ids[c + row]]);
-                    q += 4;
-                }
+            for (q, &(i, j)) in order.iter().enumerate() {
+                let c = j as usize * row + i as usize;
+                out[4 * q..4 * q + 4].copy_from_slice(&[ids[c], ids[c + 1], ids[c + 1 + row], ids[c + row]]);
             }
         }
     });
@@ -79,7 +86,7 @@ pub fn assemble<T: Sync>(
     let (vertex_part, rest) = positions.split_at_mut(nv as usize);
     let (edge_part, face_part) = rest.split_at_mut((ne * (g - 1)) as usize);
     // Where the owned region of sector s of fragment f starts, and its class.
-    let sector = |f: u32, s: u32| {
+    let sector = |(f, s): (u32, u32)| {
         let class = fragments.fragments()[f as usize].class;
         (fragments.fragment_start(&layout, f), class, s)
     };
@@ -88,23 +95,21 @@ pub fn assemble<T: Sync>(
     };
     for (v, out) in vertex_part.iter_mut().enumerate() {
         *out = match fragments.fragment_of(v as u32) {
-            Some(f) => at(sector(f, 0), 0, 0),
+            Some(f) => at(sector((f, 0)), 0, 0),
             // A vertex no face uses stays where it is.
-            None => fragments.base_positions()[v],
+            None => fragments.isolated_position(v as u32),
         };
     }
     let per_edge = (g - 1) as usize;
     for_each_block(edge_part, per_edge, |first, block| {
         for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
             let e = (first + k) as u32;
-            let [v0, v1] = topo.edge_vertices(e);
-            let own = |v: u32| sector(fragments.fragment_of(v).unwrap_or(0), fragments.spoke_along(e, v));
             let (first_half, second_half) = out.split_at_mut(n as usize);
-            let s0 = own(v0);
+            let s0 = sector(fragments.spoke_along(e, 0));
             for (t, p) in (1..=n).zip(first_half.iter_mut()) {
                 *p = at(s0, t, 0);
             }
-            let s1 = own(v1);
+            let s1 = sector(fragments.spoke_along(e, 1));
             for (t, p) in (n + 1..grid.g).zip(second_half.iter_mut()) {
                 *p = at(s1, grid.g - t, 0);
             }
@@ -122,8 +127,7 @@ pub fn assemble<T: Sync>(
                 // the sector's 2r consecutive entries: read in storage order, written at
                 // their (i, j) in the face's frame.
                 let h = h0 + m;
-                let (start, class, s) =
-                    sector(fragments.fragment_of(topo.origin(h)).unwrap_or(0), fragments.sector_of(h));
+                let (start, class, s) = sector(fragments.corner_sector(h));
                 let g = grid.g as usize;
                 for r in 1..=n as u64 {
                     let ring = start + 1 + class.ring_offset(r) + u64::from(s) * 2 * r;
@@ -144,6 +148,7 @@ pub fn assemble<T: Sync>(
         }
     });
 
+    let quads = kept.len() as u64 * g * g;
     let mut offsets = vec![0usize; quads as usize + 1];
     for_each_block(&mut offsets, 1, |first, block| {
         for (k, o) in block.iter_mut().enumerate() {
@@ -151,6 +156,19 @@ pub fn assemble<T: Sync>(
         }
     });
     Ok(Mesh::from_parts(positions, offsets, indices)?)
+}
+
+/// The cells (i, j) of a 2^depth × 2^depth grid in quadtree order: at each depth the four
+/// children in corner order (0: (0, 0), 1: +i, 2: +i +j, 3: +j).
+fn quadtree_order(depth: u32) -> Vec<(u32, u32)> {
+    let mut order = vec![(0u32, 0u32)];
+    for _ in 0..depth {
+        order = order
+            .iter()
+            .flat_map(|&(i, j)| [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(di, dj)| (2 * i + di, 2 * j + dj)))
+            .collect();
+    }
+    order
 }
 
 /// Output vertex numbering of the (G + 1)² grid points of a coarse face.
@@ -175,7 +193,7 @@ impl Grid<'_> {
         let sides: [(u32, bool); 4] = std::array::from_fn(|m| {
             let h = h0 + m as u32;
             let e = self.topo.edge(h);
-            (self.nv + e * (g - 1), self.topo.edge_half_edge(e) == h)
+            (self.nv + e * (g - 1), !self.topo.is_reversed(h))
         });
         let side = |m: usize, t: u32| {
             let (first, forward) = sides[m];
@@ -219,4 +237,21 @@ fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, 
             scope.spawn(move || work(b * per_block, block));
         }
     });
+}
+
+/// The whole fragment-mesh algorithm on the CPU in f64 (base level, [`FragmentMesh::refine_stream`] per level, assembly): the GPU path's arithmetic without a GPU, to
+/// test the layout, rules and welding exactly. Levels the fragments cannot reach are
+/// refined by [`cpu::refine_surface`].
+pub fn refine(surface: &Surface, level: u32) -> Result<cpu::Refined> {
+    let fragments = match FragmentMesh::build(surface, level)? {
+        Built::Fragments(f) => f,
+        Built::Cpu(_) => return cpu::refine_surface(surface, level),
+    };
+    let levels = level - fragments.cpu_levels();
+    let mut stream = fragments.base_stream(levels, 1, |p| [p.x, p.y, p.z, 1.0], |d| d.map(f64::from));
+    for j in 0..levels {
+        stream = fragments.refine_stream(&stream, j, levels);
+    }
+    let mesh = assemble(&fragments, &stream, levels, |p| DVec3::new(p[0], p[1], p[2]))?;
+    Ok(cpu::Refined { mesh, sharp_edges: sharp_edges(&fragments, levels) })
 }

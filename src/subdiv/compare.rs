@@ -1,11 +1,20 @@
 //! Comparing a refined mesh with a reference (OpenSubdiv, SPEC §5.4): counts, a
-//! one-to-one vertex matching by position, position errors, and faces compared as
-//! vertex cycles under the matching. Vertex order may differ; face orientation may not.
+//! one-to-one vertex correspondence, position errors, and faces compared as vertex cycles
+//! under the correspondence. Vertex order may differ; face orientation may not.
 //!
-//! The matching hashes the reference's vertices into a grid whose cells are much larger
-//! than the tolerance, so almost every query looks in one cell: linear time, a few
-//! seconds for 5 M vertices. When both meshes list their vertices in the same order (as
-//! the CPU reference and OpenSubdiv do) that is found first and costs one pass.
+//! The correspondence is the refinement's own whenever there is one, and positions are
+//! only the check (issue 12, item 7: coincident but distinct vertices must not be
+//! swapped):
+//!
+//! 1. both meshes list their vertices in the same order (the CPU reference and
+//!    OpenSubdiv do): vertex i ↔ vertex i;
+//! 2. both list the same number of faces of the same sizes (the GPU path emits its faces
+//!    in OpenSubdiv's order and rotation, `assemble`): the corners of face i give the
+//!    correspondence, if they do so consistently (one partner per vertex, both ways);
+//!    vertices no face uses are matched by position among themselves;
+//! 3. otherwise, a one-to-one matching by position: the reference's vertices are hashed
+//!    into a grid whose cells are much larger than the tolerance, so almost every query
+//!    looks in one cell — linear time, a few seconds for 5 M vertices.
 
 use std::collections::HashMap;
 use std::fmt;
@@ -36,12 +45,22 @@ pub struct Comparison {
     pub rms_error: f64,
     /// Every vertex matched the reference vertex of the same index.
     pub same_order: bool,
+    /// How the vertices were put in correspondence.
+    pub matching: Matching,
     /// Faces of the mesh whose matched cycle is a reference face (up to rotation).
     pub faces_equal: usize,
     /// Faces whose matched cycle is a reference face traversed backwards.
     pub faces_reversed: usize,
     /// Faces with an unmatched vertex or no counterpart at all.
     pub faces_missing: usize,
+}
+
+/// How [`Comparison`] put the vertices in correspondence (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Matching {
+    SameOrder,
+    Faces,
+    Positions,
 }
 
 impl Comparison {
@@ -51,16 +70,26 @@ impl Comparison {
         let (lo, hi) = reference.bounds();
         let diagonal = (hi - lo).length();
         let tolerance = relative_tolerance * diagonal;
-        let matching = match_vertices(mesh.positions(), reference.positions(), tolerance);
-        let (mut matched, mut max_sq, mut sum_sq) = (0usize, 0.0f64, 0.0f64);
-        for (p, &m) in mesh.positions().iter().zip(&matching) {
+        let (a, b) = (mesh.positions(), reference.positions());
+        let (how, matching) =
+            if a.len() == b.len() && a.iter().zip(b).all(|(p, q)| p.distance(*q) <= tolerance) {
+                (Matching::SameOrder, (0..a.len() as u32).collect())
+            } else if let Some(m) = match_by_faces(mesh, reference, tolerance) {
+                (Matching::Faces, m)
+            } else {
+                (Matching::Positions, match_vertices(a, b, tolerance))
+            };
+        let (mut matched, mut max_sq, mut sum_sq, mut partnered) = (0usize, 0.0f64, 0.0f64, 0usize);
+        for (p, &m) in a.iter().zip(&matching) {
             if m != NONE {
-                let d2 = p.distance_squared(reference.positions()[m as usize]);
-                matched += 1;
+                let d2 = p.distance_squared(b[m as usize]);
+                partnered += 1;
+                matched += usize::from(d2.sqrt() <= tolerance);
                 max_sq = max_sq.max(d2);
                 sum_sq += d2;
             }
         }
+        let matched = matched;
         let same_order = mesh.num_vertices() == reference.num_vertices()
             && matching.iter().enumerate().all(|(i, &m)| m == i as u32);
         let [faces_equal, faces_reversed, faces_missing] = compare_faces(mesh, reference, &matching);
@@ -71,8 +100,9 @@ impl Comparison {
             tolerance,
             matched,
             max_error: max_sq.sqrt(),
-            rms_error: if matched > 0 { (sum_sq / matched as f64).sqrt() } else { 0.0 },
+            rms_error: if partnered > 0 { (sum_sq / partnered as f64).sqrt() } else { 0.0 },
             same_order,
+            matching: how,
             faces_equal,
             faces_reversed,
             faces_missing,
@@ -100,15 +130,19 @@ impl fmt::Display for Comparison {
             self.faces[0],
             self.faces[1]
         )?;
+        let how = match self.matching {
+            Matching::SameOrder => ", same order",
+            Matching::Faces => ", corresponding by faces",
+            Matching::Positions => ", matched by position",
+        };
         writeln!(
             f,
-            "  vertices matched one-to-one within {:.3e} ({:.1e} × diagonal {:.6}): {} of {}{}",
+            "  vertices matched one-to-one within {:.3e} ({:.1e} × diagonal {:.6}): {} of {}{how}",
             self.tolerance,
             relative(self.tolerance),
             self.diagonal,
             self.matched,
             self.vertices[0],
-            if self.same_order { ", same order" } else { "" }
         )?;
         writeln!(
             f,
@@ -126,12 +160,41 @@ impl fmt::Display for Comparison {
     }
 }
 
+/// The correspondence given by aligned faces: corner k of face i of `mesh` ↔ corner k
+/// of face i of `reference`; `None` when the face lists differ in shape or do not
+/// correspond consistently. Vertices no face uses are matched by position among
+/// themselves.
+fn match_by_faces(mesh: &Mesh, reference: &Mesh, tolerance: f64) -> Option<Vec<u32>> {
+    let ((offsets, indices), (ref_offsets, ref_indices)) = (mesh.face_parts(), reference.face_parts());
+    if mesh.num_vertices() != reference.num_vertices() || offsets != ref_offsets {
+        return None;
+    }
+    let mut forward = vec![NONE; mesh.num_vertices()];
+    let mut backward = vec![NONE; reference.num_vertices()];
+    for (&v, &w) in indices.iter().zip(ref_indices) {
+        let (f, b) = (&mut forward[v as usize], &mut backward[w as usize]);
+        if (*f != NONE && *f != w) || (*b != NONE && *b != v) {
+            return None;
+        }
+        (*f, *b) = (w, v);
+    }
+    let free_a: Vec<u32> = (0..forward.len() as u32).filter(|&v| forward[v as usize] == NONE).collect();
+    if !free_a.is_empty() {
+        let free_b: Vec<u32> = (0..backward.len() as u32).filter(|&w| backward[w as usize] == NONE).collect();
+        let pa: Vec<DVec3> = free_a.iter().map(|&v| mesh.positions()[v as usize]).collect();
+        let pb: Vec<DVec3> = free_b.iter().map(|&w| reference.positions()[w as usize]).collect();
+        for (&v, m) in free_a.iter().zip(match_vertices(&pa, &pb, tolerance)) {
+            if m != NONE {
+                forward[v as usize] = free_b[m as usize];
+            }
+        }
+    }
+    Some(forward)
+}
+
 /// For each vertex of `a`, a distinct vertex of `b` within `tolerance` (the nearest one
 /// still free), or `NONE`.
 fn match_vertices(a: &[DVec3], b: &[DVec3], tolerance: f64) -> Vec<u32> {
-    if a.len() == b.len() && a.iter().zip(b).all(|(p, q)| p.distance(*q) <= tolerance) {
-        return (0..a.len() as u32).collect();
-    }
     let grid = Grid::new(b, tolerance);
     let mut taken = vec![false; b.len()];
     a.iter()

@@ -9,19 +9,10 @@ pub type Result<T, E = SubdivError> = std::result::Result<T, E>;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SubdivError {
-    /// A face uses the same vertex twice (OpenSubdiv would tag it non-manifold and
-    /// subdivide it with sharp rules, not the smooth ones of SPEC §5.1).
-    #[error("face {face} uses vertex {vertex} more than once (degenerate face)")]
-    DegenerateFace { face: usize, vertex: u32 },
-    /// An edge shared by more than two faces.
-    #[error("non-manifold edge ({a}, {b}): shared by {faces} faces")]
-    NonManifoldEdge { a: u32, b: u32, faces: usize },
-    /// Two faces traverse their shared edge in the same direction.
-    #[error("faces {f0} and {f1} are inconsistently oriented: both traverse edge ({a}, {b}) from {a} to {b}")]
-    Inconsistent { a: u32, b: u32, f0: usize, f1: usize },
-    /// The faces around a vertex do not form a single fan (e.g. two cones touching at a tip).
-    #[error("non-manifold vertex {vertex}: its {faces} faces do not form a single fan")]
-    NonManifoldVertex { vertex: u32, faces: usize },
+    /// A sharp feature that does not fit the mesh (an edge that does not exist, a vertex
+    /// or face out of range, a negative sharpness).
+    #[error("sharp feature: {0}")]
+    Feature(String),
     /// The mesh has more elements than 32-bit indices can address at the requested level.
     #[error("level {level} would be too large for 32-bit indices ({vertices} vertices)")]
     TooLarge { level: u32, vertices: u64 },

@@ -1,7 +1,22 @@
 //! Catmull-Clark on the GPU with fragment meshes (2010 thesis §3.3, SPEC §5.3): the base
 //! level and the fragments on the CPU, then one full-target fragment pass per level,
 //! ping-ponging between two RGBA32F render targets, one readback, and the topological
-//! assembly on the CPU.
+//! assembly on the CPU. Sharp features (issue 14) run in the same pass: a sharp
+//! fragment's vertex entries each have a data texel (its sharpness and that of its edges,
+//! `fragment`), which the pass reads to apply OpenSubdiv's crease rules and writes,
+//! decayed, for the next level — one target, one shader source, one pass per level.
+//!
+//! # Shader variants
+//!
+//! lavapipe executes every branch of a shader for every texel (its SIMD lanes run under
+//! masks), so rules a texel does not need would still cost it: with one shader, sharp
+//! rules made smooth fragments 3× slower. `glsl/subdiv/refine.glsl` is therefore compiled
+//! into variants — smooth positions, sharp positions (uniform or Chaikin creasing), data
+//! texels (uniform or Chaikin) — and each pass draws, in one render pass, the row ranges of
+//! its output stream that need each: runs without input data (first in the stream), the
+//! other runs' positions, and the data block (which starts on a row of its own). Every
+//! sharp variant also computes smooth texels exactly ([`Options::single_shader`] draws all
+//! positions with it).
 //!
 //! # Packing rule
 //!
@@ -12,7 +27,9 @@
 //! a fragment may continue on the next row. Each level has its own stream (fragments
 //! grow from ring radius 2 to 3, 5, 9, …; the last level keeps only the 2^j owned rings);
 //! the pass finds a texel's run by binary search in a uniform table of run starts and its
-//! fragment by division.
+//! fragment by division. Runs also group fragments by how many levels they carry
+//! sharpness data (their *horizon*), smallest horizon first; after all positions, from
+//! the next row on, come the data texels of the runs that carry them, in the same order.
 //!
 //! # Limits
 //!
@@ -20,7 +37,7 @@
 //! as it needs (the "row split"). What does limit the path, each with a clear
 //! [`SubdivError::GpuLimit`] (use the CPU method then):
 //!
-//! - at most [`MAX_RUNS`] classes (distinct valence/half-fan pairs) per mesh;
+//! - at most [`MAX_RUNS`] classes (distinct valence, half-fan and horizon) per mesh;
 //! - one fragment at most 2^24 texels at the last level (the shader's exact float
 //!   division), i.e. k·R(R+1) < 2^24 at the last radius R = 2^j: valence below 61 680 at
 //!   level 5 of a quad mesh (R = 16), below 4 032 at level 7 (R = 64);
@@ -37,8 +54,10 @@ use crate::gpu::{
 use crate::mesh::Mesh;
 
 use super::assemble::assemble;
-use super::fragment::{BaseLevel, FragmentMesh, StreamLayout, radii};
-use super::{Result, SubdivError, cpu};
+use super::cpu::SharpEdge;
+use super::crease::Method;
+use super::fragment::{self, Built, FragmentMesh, StreamLayout};
+use super::{Result, SubdivError, Surface, cpu};
 
 /// Entries of the run table (`MAX_RUNS` in `glsl/subdiv/refine.frag`).
 pub const MAX_RUNS: usize = 256;
@@ -75,17 +94,21 @@ impl Packing {
                 fragments.runs().len()
             )));
         }
-        let layouts: Vec<StreamLayout> = radii(gpu_levels).into_iter().map(|r| fragments.layout(r)).collect();
-        let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
-        let last = layouts.last().map_or(2, |l| l.radius);
-        if let Some(run) = fragments.runs().iter().max_by_key(|r| r.class.len(last))
-            && run.class.len(last) >= MAX_FRAGMENT_TEXELS
+        let unaligned: Vec<StreamLayout> =
+            (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels, 1)).collect();
+        let texels = unaligned.iter().map(|l| l.total).max().unwrap_or(0).max(1);
+        // The largest fragment of any stream.
+        let widest = unaligned
+            .iter()
+            .flat_map(|l| fragments.runs().iter().map(move |run| (run, l.radius, run.class.len(l.radius))))
+            .max_by_key(|&(_, _, texels)| texels);
+        if let Some((run, radius, texels)) = widest
+            && texels >= MAX_FRAGMENT_TEXELS
         {
             return Err(SubdivError::GpuLimit(format!(
-                "a fragment of valence {} at ring radius {last} ({gpu_levels} fragment levels) needs {} \
+                "a fragment of valence {} at ring radius {radius} ({gpu_levels} fragment levels) needs {texels} \
                  texels, over the pass's {MAX_FRAGMENT_TEXELS}; use fewer levels or the CPU method",
-                run.class.valence,
-                run.class.len(last)
+                run.class.valence
             )));
         }
         let max_width = if max_side == 0 { 1 } else { 1u32 << max_side.ilog2() };
@@ -101,6 +124,10 @@ impl Packing {
                     as u32
             }
         };
+        // Data blocks start on a row of their own (one draw each, see the module docs).
+        let layouts: Vec<StreamLayout> =
+            (0..=gpu_levels).map(|j| fragments.layout(j, gpu_levels, u64::from(width))).collect();
+        let texels = layouts.iter().map(|l| l.total).max().unwrap_or(0).max(1);
         let height = texels.div_ceil(u64::from(width));
         if texels > MAX_STREAM_TEXELS || height > u64::from(max_side) {
             return Err(SubdivError::GpuLimit(format!(
@@ -122,6 +149,9 @@ impl Packing {
 pub struct Options {
     /// Force the texture row width (a power of two); default ≈ √texels.
     pub row_width: Option<u32>,
+    /// Draw every run with the sharp shader variant, not only the runs with sharpness
+    /// data (what a GPU that skips untaken branches would do; slower on lavapipe).
+    pub single_shader: bool,
 }
 
 /// Where the time of one GPU subdivision went.
@@ -155,58 +185,91 @@ impl Times {
 #[derive(Debug)]
 pub struct Run {
     pub mesh: Mesh,
+    /// The refined edges on sharp control edges (creases, boundary, non-manifold edges),
+    /// numbered as `mesh`'s vertices: what a renderer draws over the surface.
+    pub sharp_edges: Vec<SharpEdge>,
     /// Catmull-Clark levels done on the CPU and by fragment passes on the GPU.
     pub cpu_levels: u32,
     pub gpu_levels: u32,
     pub fragments: usize,
-    /// Distinct fragment classes (valence, half-fan).
+    /// Fragments carrying sharpness data (sharp features in reach, or a border).
+    pub sharp_fragments: usize,
+    /// Distinct fragment runs (valence, half-fan, horizon).
     pub classes: usize,
+    /// Why the CPU did more levels than the minimum the fragments need (see
+    /// [`FragmentMesh::reasons`]); empty when it did not.
+    pub cpu_reasons: Vec<String>,
     /// Size of each of the two targets, texels.
     pub texture: [u32; 2],
     pub times: Times,
 }
 
-/// The fragment pass (`glsl/subdiv/refine.frag`) with its two render targets and its
-/// readback buffer, built once and reused: like a texture-era application, which
-/// allocates its FBO textures once, not per frame. Targets grow when a mesh needs more.
+/// The fragment pass (`glsl/subdiv/refine.glsl`: its sharp and smooth variants) with its
+/// two render targets and its readback buffer, built once and reused: like a texture-era
+/// application, which allocates its FBO textures once, not per frame. Targets grow when a
+/// mesh needs more.
 pub struct Subdivider {
-    pipeline: Pipeline,
+    smooth: Pipeline,
+    /// The sharp variants, positions and data: uniform, then Chaikin creasing.
+    sharp: [Pipeline; 2],
+    data: [Pipeline; 2],
     targets: Option<PingPong>,
     readback: Option<Buffer>,
 }
 
 impl Subdivider {
     pub fn new(ctx: &Context) -> Result<Subdivider> {
-        let pipeline =
-            Pipeline::quad(ctx, &shaders::subdiv::REFINE_FRAG, &[TexFormat::Rgba32F], Blend::Replace)?;
-        Ok(Subdivider { pipeline, targets: None, readback: None })
+        let quad = |shader| Pipeline::quad(ctx, shader, &[TexFormat::Rgba32F], Blend::Replace);
+        let smooth = quad(&shaders::subdiv::REFINE_SMOOTH_FRAG)?;
+        let sharp = [quad(&shaders::subdiv::REFINE_FRAG)?, quad(&shaders::subdiv::REFINE_CHAIKIN_FRAG)?];
+        let data =
+            [quad(&shaders::subdiv::REFINE_DATA_FRAG)?, quad(&shaders::subdiv::REFINE_DATA_CHAIKIN_FRAG)?];
+        Ok(Subdivider { smooth, sharp, data, targets: None, readback: None })
     }
 
-    /// Refines `mesh` `level` times: the base level on the CPU, the rest as fragment
-    /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
-    /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0).
+    /// Refines `mesh` (smooth, default options) `level` times; see
+    /// [`Subdivider::refine_surface`].
     pub fn refine(&mut self, ctx: &Context, mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+        self.refine_surface(ctx, &Surface::smooth(mesh.clone()), level, options)
+    }
+
+    /// Refines `surface` `level` times: the base level on the CPU, the rest as fragment
+    /// passes on the GPU. Levels below the base level (level 0, or level 1 of a mesh with
+    /// non-quads) have no fragments and are computed on the CPU (`gpu_levels` = 0), and so
+    /// are levels the fragments cannot express ([`Run::cpu_reasons`]).
+    pub fn refine_surface(
+        &mut self,
+        ctx: &Context,
+        surface: &Surface,
+        level: u32,
+        options: &Options,
+    ) -> Result<Run> {
         let start = Instant::now();
-        let needed = BaseLevel::levels_needed(mesh);
-        if level < needed {
-            let mesh = cpu::refine(mesh, level)?;
-            let total = start.elapsed();
-            let times = Times { base: total, total, ..Times::default() };
-            return Ok(Run {
-                mesh,
-                cpu_levels: level,
-                gpu_levels: 0,
-                fragments: 0,
-                classes: 0,
-                texture: [0, 0],
-                times,
-            });
-        }
-        let base = BaseLevel::new(mesh)?;
+        let fragments = match FragmentMesh::build(surface, level)? {
+            Built::Fragments(f) => f,
+            Built::Cpu(cpu_reasons) => {
+                let refined = cpu::refine_surface(surface, level)?;
+                let total = start.elapsed();
+                let times = Times { base: total, total, ..Times::default() };
+                return Ok(Run {
+                    mesh: refined.mesh,
+                    sharp_edges: refined.sharp_edges,
+                    cpu_levels: level,
+                    gpu_levels: 0,
+                    fragments: 0,
+                    sharp_fragments: 0,
+                    classes: 0,
+                    cpu_reasons,
+                    texture: [0, 0],
+                    times,
+                });
+            }
+        };
+        // The base level and the fragments are built together; the fragment build is
+        // timed again (stream and tables) in `refine_fragments`.
         let base_time = start.elapsed();
         let t = Instant::now();
-        let fragments = FragmentMesh::from_base(base)?;
-        let mut run = self.refine_fragments(ctx, &fragments, level - needed, options, t)?;
+        let mut run = self.refine_fragments(ctx, &fragments, level - fragments.cpu_levels(), options, t)?;
         run.times.base = base_time;
         run.times.total = start.elapsed();
         Ok(run)
@@ -224,22 +287,33 @@ impl Subdivider {
     ) -> Result<Run> {
         let packing = Packing::new(fragments, gpu_levels, ctx.info().max_image_2d, options.row_width)?;
         let width = packing.width;
-        let mut stream = fragments.base_stream(|p| [p.x as f32, p.y as f32, p.z as f32, 1.0]);
+        let mut stream = fragments.base_stream(
+            gpu_levels,
+            u64::from(width),
+            |p| [p.x as f32, p.y as f32, p.z as f32, 1.0],
+            |d| d,
+        );
         let rows0 = packing.rows(0);
         stream.resize((rows0 * width) as usize, [0.0; 4]);
-        // One run table per pass: (valence, half-fan, first input texel, first output texel).
+        // One run table per pass: (valence, flags, first input texel, first output texel),
+        // flags 1 half-fan, 2 data in the input, 4 in the output; then (first input data
+        // texel, first output data texel or -1, 0, 0).
         let tables = packing
             .layouts
             .windows(2)
             .map(|pair| {
-                let mut table = vec![[0i32; 4]; MAX_RUNS];
+                let (lin, lout) = (&pair[0], &pair[1]);
+                let mut table = vec![[0i32; 4]; 2 * MAX_RUNS];
                 for (r, run) in fragments.runs().iter().enumerate() {
                     let c = run.class;
-                    table[r] = [
-                        c.valence as i32,
-                        c.boundary as i32,
-                        pair[0].starts[r] as i32,
-                        pair[1].starts[r] as i32,
+                    let flags =
+                        i32::from(c.boundary) | i32::from(lin.data[r]) << 1 | i32::from(lout.data[r]) << 2;
+                    table[r] = [c.valence as i32, flags, lin.starts[r] as i32, lout.starts[r] as i32];
+                    table[MAX_RUNS + r] = [
+                        if lin.data[r] { lin.data_starts[r] as i32 } else { 0 },
+                        if lout.data[r] { lout.data_starts[r] as i32 } else { -1 },
+                        0,
+                        0,
                     ];
                 }
                 Buffer::with_data(ctx, &table, "subdiv runs")
@@ -260,8 +334,29 @@ impl Subdivider {
         let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
             return Err(SubdivError::GpuLimit("render targets were not created".into()));
         };
-        let pipeline = &self.pipeline;
+        let chaikin = usize::from(fragments.crease_method() == Method::Chaikin);
+        let (smooth, sharp, data) = (&self.smooth, &self.sharp[chaikin], &self.data[chaikin]);
         let timer = Timestamps::new(ctx, gpu_levels + 3)?;
+        // The row ranges of each output stream and the variant that draws each: the runs
+        // without input data (first: runs are sorted by horizon, `fragment`) with the
+        // smooth variant, the other positions with the sharp one, the data block with the
+        // data one.
+        let w = u64::from(width);
+        let draws: Vec<[(&Pipeline, u32, u32); 3]> = (0..gpu_levels as usize)
+            .map(|j| {
+                let (lin, lout) = (&packing.layouts[j], &packing.layouts[j + 1]);
+                let position_rows = lout.positions.div_ceil(w) as u32;
+                let first_sharp = lin.data.iter().position(|&d| d);
+                let split = match first_sharp {
+                    _ if options.single_shader => 0,
+                    Some(r) => (lout.starts[r] / w) as u32,
+                    None => position_rows,
+                };
+                let data_row = (lout.data_start / w) as u32;
+                let data_rows = if lout.data.contains(&true) { packing.rows(j + 1) - data_row } else { 0 };
+                [(smooth, 0, split), (sharp, split, position_rows - split), (data, data_row, data_rows)]
+            })
+            .collect();
         let t = Instant::now();
         ctx.submit(|rec| {
             rec.reset_timestamps(&timer);
@@ -274,6 +369,7 @@ impl Subdivider {
                     lin.radius as i32,
                     lout.radius as i32,
                     fragments.runs().len() as i32,
+                    lout.positions as i32,
                     lout.total as i32,
                     packing.log2_width as i32,
                 ];
@@ -281,11 +377,18 @@ impl Subdivider {
                 let reads = [input];
                 let area = [0, 0, width, packing.rows(j + 1)];
                 rec.render(&[Attachment::new(targets.dst(), Load::Discard)], Some(area), &reads, |pass| {
-                    pass.bind(pipeline)?;
-                    pass.textures(&[(0, input)])?;
-                    pass.uniform(1, table)?;
-                    pass.push(&params)?;
-                    pass.quad()
+                    for &(pipeline, first, count) in &draws[j] {
+                        if count == 0 {
+                            continue;
+                        }
+                        pass.bind(pipeline)?;
+                        pass.viewport([0, first, width, count]);
+                        pass.textures(&[(0, input)])?;
+                        pass.uniform(1, table)?;
+                        pass.push(&params)?;
+                        pass.quad()?;
+                    }
+                    Ok(())
                 })?;
                 targets.swap();
                 rec.timestamp(&timer, 2 + j as u32)?;
@@ -300,10 +403,10 @@ impl Subdivider {
 
         let t = Instant::now();
         let texels = readback.view::<[f32; 4]>()?;
-        let layout = &packing.layouts[last];
-        let mesh = assemble(fragments, texels, layout.radius, gpu_levels, |p| {
+        let mesh = assemble(fragments, texels, gpu_levels, |p| {
             DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
         })?;
+        let sharp_edges = fragment::sharp_edges(fragments, gpu_levels);
         let times = Times {
             fragments: fragments_time,
             upload: ms(0, 1),
@@ -315,10 +418,13 @@ impl Subdivider {
         };
         Ok(Run {
             mesh,
+            sharp_edges,
             cpu_levels: fragments.cpu_levels(),
             gpu_levels,
             fragments: fragments.fragments().len(),
+            sharp_fragments: fragments.sharp_fragments(),
             classes: fragments.runs().len(),
+            cpu_reasons: fragments.reasons().to_vec(),
             texture: [width, packing.height],
             times,
         })
@@ -329,4 +435,9 @@ impl Subdivider {
 /// [`Subdivider`]).
 pub fn refine(ctx: &Context, mesh: &Mesh, level: u32) -> Result<Mesh> {
     Ok(Subdivider::new(ctx)?.refine(ctx, mesh, level, &Options::default())?.mesh)
+}
+
+/// Refines `surface` `level` times on the GPU with a fresh pipeline and targets.
+pub fn refine_surface(ctx: &Context, surface: &Surface, level: u32) -> Result<Run> {
+    Subdivider::new(ctx)?.refine_surface(ctx, surface, level, &Options::default())
 }

@@ -1,16 +1,22 @@
-//! Catmull-Clark subdivision (2010 thesis, Ch. 3; SPEC §5): the CPU reference
-//! ([`cpu`]), the half-edge queries the fragment-mesh path builds on ([`topology`]), the
-//! fragment meshes ([`fragment`]), their GPU passes ([`gpu`]) and the welding of the
-//! result ([`assemble`]), the OpenSubdiv helper as independent reference ([`osd`]) and
-//! the mesh comparison all are judged with ([`compare`]).
+//! Catmull-Clark subdivision (2010 thesis, Ch. 3; SPEC §5; issue 14): the sharp features
+//! and scheme options a control mesh carries ([`features`], read from OBJ tags by
+//! [`tags`]) and their sharpness arithmetic ([`crease`]), the CPU reference ([`cpu`]), the
+//! topology (OpenSubdiv's, non-manifold included) the fragment-mesh path builds on
+//! ([`topology`]), the fragment meshes ([`fragment`]), their GPU passes ([`gpu`]) and the
+//! welding of the result ([`assemble`]), the OpenSubdiv helper as independent reference
+//! ([`osd`]) and the mesh comparison all are judged with ([`compare`]).
 
 pub mod assemble;
 pub mod compare;
 pub mod cpu;
+pub mod crease;
 pub mod error;
+pub mod features;
 pub mod fragment;
 pub mod gpu;
 pub mod osd;
+pub mod tags;
 pub mod topology;
 
 pub use error::{Result, SubdivError};
+pub use features::{Boundary, CreaseMethod, Features, Options, Surface, Triangles};

@@ -1,6 +1,7 @@
 //! OpenSubdiv as the independent reference: runs the helper `tools/osd-refine.cpp`
-//! (built by `tools/setup` into `target/tools/osd-refine`) on a mesh written to a
-//! temporary OFF file and reads its output back.
+//! (built by `tools/setup` into `target/tools/osd-refine`) on a surface written to a
+//! temporary OBJ file — its sharp features and options as tags (`tags`) — and reads its
+//! output back.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -8,7 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::mesh::{Mesh, formats};
 
-use super::{Result, SubdivError};
+use super::{Result, SubdivError, Surface, tags};
 
 /// Environment variable naming the helper binary, overriding the default location.
 pub const HELPER_ENV: &str = "TEXGEO_OSD_REFINE";
@@ -52,33 +53,41 @@ pub struct Run {
     pub median_seconds: Option<f64>,
 }
 
-/// OpenSubdiv's Catmull-Clark refinement of `mesh` to `level`.
+/// OpenSubdiv's Catmull-Clark refinement of `mesh` (smooth, default options) to `level`.
 pub fn refine(mesh: &Mesh, level: u32) -> Result<Mesh> {
-    let run = run(mesh, level, &Options::default())?;
+    refine_surface(&Surface::smooth(mesh.clone()), level)
+}
+
+/// OpenSubdiv's refinement of `surface` (sharp features and options) to `level`; faces
+/// under holes are left out.
+pub fn refine_surface(surface: &Surface, level: u32) -> Result<Mesh> {
+    let run = run(surface, level, &Options::default())?;
     run.mesh.ok_or_else(|| helper_error(Path::new("osd-refine"), "no mesh was produced"))
 }
 
-/// Seconds OpenSubdiv takes to refine `mesh` to `level` (minimum of `repeat` runs).
-pub fn time(mesh: &Mesh, level: u32, repeat: u32) -> Result<f64> {
+/// Seconds OpenSubdiv takes to refine `surface` to `level` (minimum of `repeat` runs).
+pub fn time(surface: &Surface, level: u32, repeat: u32) -> Result<f64> {
     let options = Options { repeat: Some(repeat.max(1)), no_output: true, ..Options::default() };
-    let run = run(mesh, level, &options)?;
+    let run = run(surface, level, &options)?;
     run.min_seconds.ok_or_else(|| helper_error(Path::new("osd-refine"), "no timing was printed"))
 }
 
-/// Median seconds of refine + interpolate of `mesh` to `level` over `repeat` runs.
-pub fn time_median(mesh: &Mesh, level: u32, repeat: u32) -> Result<f64> {
+/// Median seconds of refine + interpolate of `surface` to `level` over `repeat` runs.
+pub fn time_median(surface: &Surface, level: u32, repeat: u32) -> Result<f64> {
     let options = Options { repeat: Some(repeat.max(1)), no_output: true, ..Options::default() };
-    let run = run(mesh, level, &options)?;
+    let run = run(surface, level, &options)?;
     run.median_seconds.ok_or_else(|| helper_error(Path::new("osd-refine"), "no timing was printed"))
 }
 
-/// Runs the helper on `mesh` with `options`.
-pub fn run(mesh: &Mesh, level: u32, options: &Options) -> Result<Run> {
+/// Runs the helper on `surface` with `options`.
+pub fn run(surface: &Surface, level: u32, options: &Options) -> Result<Run> {
     let helper = helper_path()?;
     let dir = TempDir::new()?;
-    let input = dir.path.join("in.off");
+    let input = dir.path.join("in.obj");
     let output = dir.path.join("out.off");
-    formats::write(&input, mesh)?;
+    let mut text = Vec::new();
+    tags::write_obj(&mut text, surface).map_err(|error| SubdivError::Io { path: input.clone(), error })?;
+    std::fs::write(&input, text).map_err(|error| SubdivError::Io { path: input.clone(), error })?;
 
     let mut command = Command::new(&helper);
     command.arg(&input).arg(level.to_string());

@@ -254,6 +254,23 @@ pub fn indices(records: &[Record]) -> BTreeSet<usize> {
     records.iter().map(|r| r.index).collect()
 }
 
+/// FNV-1a of a mesh: faces, then positions as f64 bits (an output's identity in results).
+pub fn mesh_hash(mesh: &crate::mesh::Mesh) -> Fnv {
+    let mut h = Fnv::default();
+    for f in mesh.faces() {
+        h.u64(f.len() as u64);
+        for &v in f {
+            h.u64(u64::from(v));
+        }
+    }
+    for p in mesh.positions() {
+        for c in p.to_array() {
+            h.u64(c.to_bits());
+        }
+    }
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -93,16 +93,19 @@ pub enum TaskKind {
     Inclusion,
     Voxelize,
     Subdivide,
+    Boolean,
 }
 
 impl TaskKind {
-    pub const ALL: [TaskKind; 3] = [TaskKind::Inclusion, TaskKind::Voxelize, TaskKind::Subdivide];
+    pub const ALL: [TaskKind; 4] =
+        [TaskKind::Inclusion, TaskKind::Voxelize, TaskKind::Subdivide, TaskKind::Boolean];
 
     pub fn name(self) -> &'static str {
         match self {
             TaskKind::Inclusion => tasks::inclusion::Inclusion::NAME,
             TaskKind::Voxelize => tasks::voxelize::Voxelize::NAME,
             TaskKind::Subdivide => tasks::subdivide::Subdivide::NAME,
+            TaskKind::Boolean => tasks::boolean::BooleanTask::NAME,
         }
     }
 
@@ -117,6 +120,7 @@ impl TaskKind {
             TaskKind::Inclusion => v.visit::<tasks::inclusion::Inclusion>(),
             TaskKind::Voxelize => v.visit::<tasks::voxelize::Voxelize>(),
             TaskKind::Subdivide => v.visit::<tasks::subdivide::Subdivide>(),
+            TaskKind::Boolean => v.visit::<tasks::boolean::BooleanTask>(),
         }
     }
 

@@ -102,6 +102,14 @@ pub enum Command {
         /// Also compare every GPU result with OpenSubdiv (slow on millions of faces).
         #[arg(long)]
         validate: bool,
+        /// Instead of Table 5: sharp features — each model with its feature edges creased
+        /// against itself without creases (default models: fandisk.off and
+        /// couplingdown.off when fetched, builtin:knot).
+        #[arg(long)]
+        creases: bool,
+        /// With --creases: edges whose faces meet at more than this many degrees are creased.
+        #[arg(long, default_value_t = 30.0)]
+        crease_angle: f64,
         #[command(flatten)]
         common: Common,
     },
@@ -232,8 +240,23 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             }
             finish(bench::reduce::run(&ctx, &sizes, common.runs)?, &common)
         }
-        Command::Subdivide { level, meshes, models, only, validate, common } => {
-            use bench::subdiv::{Model, Settings, default_models};
+        Command::Subdivide { level, meshes, models, only, validate, creases, crease_angle, common } => {
+            use bench::subdiv::{CreaseSettings, Model, Settings, crease_models, default_models};
+            if creases {
+                anyhow::ensure!((0.0..=180.0).contains(&crease_angle), "--crease-angle must be in 0..=180");
+                let mut list = if only { Vec::new() } else { crease_models(&models)? };
+                for m in &meshes {
+                    list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+                }
+                anyhow::ensure!(!list.is_empty(), "no models to measure");
+                let settings = CreaseSettings {
+                    level,
+                    runs: common.runs,
+                    angle_degrees: crease_angle,
+                    sharpness: &[10.0, 2.5],
+                };
+                return finish(bench::subdiv::run_creases(&ctx, &list, settings)?, &common);
+            }
             let mut list = if only { Vec::new() } else { default_models(&models)? };
             for m in &meshes {
                 list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });

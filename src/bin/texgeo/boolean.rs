@@ -4,10 +4,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context as _;
-use texgeo::boolean::{self, Grouping, Names, Operation, Options, Transform};
+use texgeo::boolean::{self, Evaluation, Grouping, Names, Operation, Options, Transform};
+use texgeo::gpu::Context;
 use texgeo::inclusion::Method;
 use texgeo::mesh::formats::{self, Format};
 use texgeo::mesh::{Mesh, covering::Covering, solidity};
+use texgeo::render::{self, Look, Model, Renderer, View};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -57,6 +59,11 @@ pub struct Args {
     /// Print triangle counts, cut triangles, groups, point tests saved and phase times.
     #[arg(long)]
     stats: bool,
+    /// Also draw each written operation into DIR/OP.png (2006 thesis Figs. 6-9 … 6-12: the
+    /// operands in two colours with the cut curve, and beside them the result, its faces
+    /// coloured by operand).
+    #[arg(long, value_name = "DIR")]
+    pictures: Option<PathBuf>,
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
@@ -80,6 +87,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         }
         (None, None) => anyhow::bail!("give -o OUT or --all DIR"),
     };
+    if let Some(dir) = &args.pictures {
+        texgeo::output::check_dir(dir)?;
+    }
     let ta = args.transform_a.as_deref().map(Transform::parse).transpose().map_err(anyhow::Error::msg)?;
     let tb = args.transform_b.as_deref().map(Transform::parse).transpose().map_err(anyhow::Error::msg)?;
 
@@ -117,6 +127,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let write = Instant::now();
     for (_, path, mesh) in &results {
         write_mesh(path, mesh)?;
+    }
+    if let Some(dir) = &args.pictures {
+        let ctx = match &ctx {
+            Some(ctx) => ctx.clone(),
+            None => crate::open_context(device)?,
+        };
+        for (op, _, _) in &results {
+            let path = dir.join(format!("{}.png", op.name()));
+            picture(&ctx, &ev, *op, regularized, &path)?;
+            say!("wrote {}", path.display());
+        }
     }
     let write = write.elapsed();
 
@@ -178,6 +199,24 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             say!("device: {}", ctx.info().label());
         }
     }
+    Ok(())
+}
+
+/// The Fig. 6-9 … 6-12 picture of `op` (800×600, 4 samples per pixel).
+fn picture(
+    ctx: &Context,
+    ev: &Evaluation,
+    op: Operation,
+    regularized: bool,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let content = render::boolean::content(ev, op, regularized)?;
+    let mut model = Model::new(ctx, content, 0, Look::default(), None)?;
+    let scene = model.scene(ctx)?;
+    let mut renderer = Renderer::new(ctx, 4)?;
+    let prepared = renderer.prepare(&scene)?;
+    let view = View::fit(&scene, 800, 600)?;
+    renderer.render(&prepared, &view)?.save_png(path)?;
     Ok(())
 }
 

@@ -6,6 +6,8 @@ use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
 use texgeo::mesh::{Mesh, formats, procedural};
+use texgeo::subdiv::Features;
+use texgeo::subdiv::tags::{self, Tagged, TaggedOptions};
 
 #[derive(clap::Subcommand)]
 pub enum Command {
@@ -39,6 +41,20 @@ pub fn load(spec: &str) -> anyhow::Result<Mesh> {
 /// Reads a mesh and lets it through only if it is a solid ([`solidity::require_solid`]),
 /// or what `policy` accepts; the error names the reason and, among `flags` (the command's
 /// own), the one that would accept it.
+/// Reads a mesh with its sharp-feature tags (OpenSubdiv's `t crease`, … in an OBJ file;
+/// other formats and built-in models have none).
+pub fn load_tagged(spec: &str) -> anyhow::Result<Tagged> {
+    if spec.starts_with("builtin:") {
+        return Ok(Tagged {
+            mesh: load(spec)?,
+            features: Features::default(),
+            options: TaggedOptions::default(),
+            ignored: Vec::new(),
+        });
+    }
+    Ok(tags::read(spec)?)
+}
+
 pub fn load_solid(spec: &str, policy: Policy, flags: &[&str]) -> anyhow::Result<Accepted> {
     let mesh = load(spec)?;
     solidity::require_solid(mesh, policy).map_err(|e| {

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
+use texgeo::boolean::Operation;
 use texgeo::render::{Camera, Content, Look, Model, Renderer, Scene, Shading, View, colour};
 use texgeo::voxel::aspect::{Aspect, Material};
 use texgeo::voxel::binvox;
@@ -68,6 +69,18 @@ pub struct Show {
     /// Samples per pixel (1 = no antialiasing).
     #[arg(long, default_value_t = 4)]
     pub samples: u32,
+    /// Show a Boolean operation of the input (A) and this solid (B), with --op: the two
+    /// operands with their cut curve and, beside them, the result coloured by operand
+    /// (2006 thesis, Figs. 6-9 … 6-12).
+    #[arg(long, value_name = "B", requires = "op")]
+    pub boolean: Option<String>,
+    /// The operation for --boolean: union, intersection, difference, symmetric-difference.
+    #[arg(long, requires = "boolean", value_parser = parse_operation)]
+    pub op: Option<Operation>,
+}
+
+fn parse_operation(s: &str) -> Result<Operation, String> {
+    s.parse()
 }
 
 fn parse_material(s: &str) -> Result<Material, String> {
@@ -124,6 +137,9 @@ impl Show {
         if self.aspect.is_some() && !voxels {
             bail!("--aspect colours voxels: add --voxels or give a .binvox file");
         }
+        if self.boolean.is_some() && (voxels || self.level > 0 || !self.others.is_empty()) {
+            bail!("--boolean shows two solids as meshes: no other models, --voxels or --level");
+        }
         Ok(())
     }
 
@@ -133,12 +149,20 @@ impl Show {
             let (grid, volume) = binvox::read(&self.input)?;
             return Ok(Content::Voxels(grid, volume));
         }
+        if !self.voxels && self.boolean.is_none() && self.others.is_empty() {
+            // One mesh, with the sharp features of its OBJ tags (drawn as crease edges).
+            let tagged = crate::mesh::load_tagged(&self.input)?;
+            return Ok(Content::Surface(tagged.surface(Default::default())));
+        }
         let mesh = crate::mesh::load(&self.input)?;
+        if let (Some(b), Some(op)) = (&self.boolean, self.op) {
+            let other = crate::mesh::load(b)?;
+            let names = texgeo::boolean::Names { a: &self.input, b };
+            let ev = texgeo::boolean::evaluate(&mesh, &other, names, &Default::default(), None)?;
+            return Ok(texgeo::render::boolean::content(&ev, op, true)?);
+        }
         if self.voxels {
             return Ok(Content::Voxelize(mesh, self.res));
-        }
-        if self.others.is_empty() {
-            return Ok(Content::Mesh(mesh));
         }
         let mut meshes = vec![(mesh, PALETTE[0])];
         for (i, other) in self.others.iter().enumerate() {
@@ -154,6 +178,9 @@ impl Show {
 
     /// All inputs, for titles and messages.
     pub fn name(&self) -> String {
+        if let (Some(b), Some(op)) = (&self.boolean, self.op) {
+            return format!("{} {} {b}", self.input, op.symbol());
+        }
         std::iter::once(&self.input).chain(&self.others).cloned().collect::<Vec<_>>().join(" + ")
     }
 
@@ -173,14 +200,15 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         bail!("{}: the picture is written as PNG; name it .png", args.output.display());
     }
+    texgeo::output::check_file(&args.output)?;
     let content = show.content()?;
     let ctx = crate::open_context(device)?;
     let mut model = Model::new(&ctx, content, show.level, show.look(), show.aspect())?;
     let (vertices, faces) = model.counts();
     if model.is_voxels() {
-        println!("{}: {faces} voxels", show.name());
+        say!("{}: {faces} voxels", show.name());
     } else {
-        println!("{}: level {}, {vertices} vertices, {faces} faces", show.name(), model.level);
+        say!("{}: level {}, {vertices} vertices, {faces} faces", show.name(), model.level);
     }
     let scene = model.scene(&ctx)?;
     let mut renderer = Renderer::new(&ctx, show.samples)?;
@@ -196,7 +224,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     };
     let picture = renderer.render(&prepared, &view)?;
     picture.save_png(&args.output)?;
-    println!(
+    say!(
         "wrote {} ({}×{}, {} triangles)",
         args.output.display(),
         view.width,

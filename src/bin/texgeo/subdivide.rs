@@ -1,5 +1,7 @@
 //! `texgeo subdivide`: Catmull-Clark to a level, on the GPU with fragment meshes (2010
-//! thesis Ch. 3) or with the CPU reference, optionally checked against OpenSubdiv.
+//! thesis Ch. 3) or with the CPU reference, optionally checked against OpenSubdiv. Sharp
+//! features come from the OBJ file's tags (OpenSubdiv's `t crease`, `t corner`, `t hole`,
+//! …); the scheme-wide options from its tags, overridden by the command's options.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -7,7 +9,7 @@ use std::time::Instant;
 use texgeo::mesh::{Mesh, formats};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::gpu::{Options, Run, Subdivider};
-use texgeo::subdiv::{SubdivError, cpu, osd};
+use texgeo::subdiv::{Boundary, CreaseMethod, Features, SubdivError, Surface, Triangles, cpu, crease, osd};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
@@ -17,18 +19,64 @@ pub enum Method {
     Cpu,
 }
 
+/// Boundary interpolation (OpenSubdiv's VtxBoundaryInterpolation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BoundaryArg {
+    /// Faces at untagged boundary vertices become holes.
+    None,
+    /// Boundary edges are creases (the default).
+    EdgeOnly,
+    /// Boundary edges are creases and vertices with one face are corners.
+    EdgeAndCorner,
+}
+
+/// How semi-sharp creases decay (OpenSubdiv's CreasingMethod).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CreaseMethodArg {
+    /// Sharpness loses 1 per level (the default).
+    Uniform,
+    /// Chaikin's rule along crease chains.
+    Chaikin,
+}
+
+/// Weights next to triangles (OpenSubdiv's TriangleSubdivision).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrianglesArg {
+    /// Catmull-Clark's masks (the default).
+    Catmark,
+    /// "Smooth triangle" weights.
+    Smooth,
+}
+
 #[derive(clap::Args)]
 pub struct Args {
     /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
+    /// An OBJ file's tags (OpenSubdiv's `t crease`, `t corner`, `t hole`,
+    /// `t interpolateboundary`, `t creasemethod`, `t smoothtriangles`) are applied.
     input: String,
     /// Subdivision level (each level splits every quad into four).
     #[arg(short, long)]
     level: u32,
-    /// Output mesh (.obj or .off; .ply and .stl work too).
+    /// Output mesh (.obj or .off; .ply and .stl work too). Faces under holes are left out.
     #[arg(short, long)]
     output: Option<PathBuf>,
     #[arg(long, value_enum, default_value_t = Method::Gpu)]
     method: Method,
+    /// Boundary interpolation (overrides the file's `t interpolateboundary`).
+    #[arg(long, value_enum)]
+    boundary: Option<BoundaryArg>,
+    /// Creasing method (overrides the file's `t creasemethod`).
+    #[arg(long, value_enum)]
+    crease_method: Option<CreaseMethodArg>,
+    /// Triangle weights (overrides the file's `t smoothtriangles`).
+    #[arg(long, value_enum)]
+    triangles: Option<TrianglesArg>,
+    /// Also crease every edge whose two faces meet at more than DEGREES (feature edges).
+    #[arg(long, value_name = "DEGREES")]
+    crease_angle: Option<f64>,
+    /// Sharpness of the --crease-angle creases (10 or more: infinitely sharp).
+    #[arg(long, default_value_t = 10.0, requires = "crease_angle")]
+    crease_sharpness: f32,
     /// Also refine with OpenSubdiv (tools/setup builds its helper) and compare: vertex and
     /// face counts, max/RMS position error; exit status 1 if the tolerance is exceeded
     /// (1e-5 × bounding-box diagonal for the GPU, 1e-12 for the CPU).
@@ -46,15 +94,29 @@ fn ms(d: std::time::Duration) -> f64 {
 
 fn describe_gpu(run: &Run) {
     let t = &run.times;
+    for reason in &run.cpu_reasons {
+        say!("the fragments cannot express this yet; {reason}");
+    }
     if run.gpu_levels == 0 && run.fragments == 0 {
-        say!("level {} is below the base level: computed on the CPU ({:.1} ms)", run.cpu_levels, ms(t.total));
+        say!(
+            "level {} {}: computed on the CPU ({:.1} ms)",
+            run.cpu_levels,
+            if run.cpu_reasons.is_empty() {
+                "is below the base level"
+            } else {
+                "is reached before fragments"
+            },
+            ms(t.total)
+        );
         return;
     }
     say!(
-        "GPU: {} CPU level(s), {} fragment pass(es); {} fragments in {} classes; targets 2 × {}×{} RGBA32F",
+        "GPU: {} CPU level(s), {} fragment pass(es); {} fragments ({} with sharpness data) in {} runs; \
+         targets 2 × {}×{} RGBA32F",
         run.cpu_levels,
         run.gpu_levels,
         run.fragments,
+        run.sharp_fragments,
         run.classes,
         run.texture[0],
         run.texture[1]
@@ -122,29 +184,92 @@ fn check_size(
     Ok(())
 }
 
+/// One line on the sharp features and options in force.
+fn describe_features(surface: &Surface) {
+    let f = &surface.features;
+    let infinite = f.creases.iter().filter(|c| crease::is_infinite(c.sharpness)).count();
+    let o = &surface.options;
+    say!(
+        "features: {} crease edge(s) ({infinite} infinitely sharp), {} corner(s), {} hole(s); boundary {}, \
+         creasing {}, triangles {}",
+        f.creases.len(),
+        f.corners.len(),
+        f.holes.len(),
+        match o.boundary {
+            Boundary::None => "none",
+            Boundary::EdgeOnly => "edge-only",
+            Boundary::EdgeAndCorner => "edge-and-corner",
+        },
+        match o.crease_method {
+            CreaseMethod::Uniform => "uniform",
+            CreaseMethod::Chaikin => "chaikin",
+        },
+        match o.triangles {
+            Triangles::Catmark => "catmark",
+            Triangles::Smooth => "smooth",
+        },
+    );
+}
+
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
         // A wrong extension or an unwritable folder fails now, not after the subdivision.
         formats::Format::from_path(out)?;
         texgeo::output::check_file(out)?;
     }
-    let mesh = crate::mesh::load(&args.input)?;
-    check_size(&mesh, args.level, args.method, args.output.as_deref())?;
+    let tagged = crate::mesh::load_tagged(&args.input)?;
+    for ignored in &tagged.ignored {
+        say!("{}:{}: tag '{}' ignored: {}", args.input, ignored.line, ignored.name, ignored.why);
+    }
+    let mut surface = tagged.surface(Default::default());
+    if let Some(b) = args.boundary {
+        surface.options.boundary = match b {
+            BoundaryArg::None => Boundary::None,
+            BoundaryArg::EdgeOnly => Boundary::EdgeOnly,
+            BoundaryArg::EdgeAndCorner => Boundary::EdgeAndCorner,
+        };
+    }
+    if let Some(m) = args.crease_method {
+        surface.options.crease_method = match m {
+            CreaseMethodArg::Uniform => CreaseMethod::Uniform,
+            CreaseMethodArg::Chaikin => CreaseMethod::Chaikin,
+        };
+    }
+    if let Some(t) = args.triangles {
+        surface.options.triangles = match t {
+            TrianglesArg::Catmark => Triangles::Catmark,
+            TrianglesArg::Smooth => Triangles::Smooth,
+        };
+    }
+    if let Some(degrees) = args.crease_angle {
+        anyhow::ensure!((0.0..=180.0).contains(&degrees), "--crease-angle must be in 0..=180 degrees");
+        anyhow::ensure!(
+            args.crease_sharpness.is_finite() && args.crease_sharpness >= 0.0,
+            "--crease-sharpness must be a finite number ≥ 0"
+        );
+        let features = Features::feature_edges(&surface.mesh, degrees, args.crease_sharpness);
+        surface.features.creases.extend(features.creases);
+    }
+    let mesh = &surface.mesh;
+    check_size(mesh, args.level, args.method, args.output.as_deref())?;
     say!("{}: {} vertices, {} faces", args.input, mesh.num_vertices(), mesh.num_faces());
+    describe_features(&surface);
     let refined = match args.method {
         Method::Gpu => {
             let ctx = crate::open_context_for(device, "cpu")?;
             say!("device: {}", ctx.info().label());
             let mut subdivider = Subdivider::new(&ctx)?;
-            let run = subdivider.refine(&ctx, &mesh, args.level, &Options::default()).map_err(explain)?;
+            let run = subdivider
+                .refine_surface(&ctx, &surface, args.level, &Options::default())
+                .map_err(explain)?;
             describe_gpu(&run);
             run.mesh
         }
         Method::Cpu => {
             let start = Instant::now();
-            let refined = cpu::refine(&mesh, args.level).map_err(explain)?;
+            let refined = cpu::refine_surface(&surface, args.level).map_err(explain)?;
             say!("CPU reference: {:.1} ms", ms(start.elapsed()));
-            refined
+            refined.mesh
         }
     };
     say!("level {}: {} vertices, {} faces", args.level, refined.num_vertices(), refined.num_faces());
@@ -152,16 +277,16 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         formats::write(out, &refined)?;
         say!("wrote {}", out.display());
     }
-    if args.validate && !validate(&mesh, &refined, args.level, args.method)? {
+    if args.validate && !validate(&surface, &refined, args.level, args.method)? {
         std::process::exit(1);
     }
     Ok(())
 }
 
 /// Compares with OpenSubdiv; prints the comparison and whether it is within tolerance.
-fn validate(mesh: &Mesh, refined: &Mesh, level: u32, method: Method) -> anyhow::Result<bool> {
+fn validate(surface: &Surface, refined: &Mesh, level: u32, method: Method) -> anyhow::Result<bool> {
     let start = Instant::now();
-    let reference = osd::refine(mesh, level)?;
+    let reference = osd::refine_surface(surface, level)?;
     let tolerance = if method == Method::Gpu { GPU_TOLERANCE } else { CPU_TOLERANCE };
     let c = Comparison::new(refined, &reference, tolerance);
     say!("OpenSubdiv ({:.1} ms incl. files): {c}", ms(start.elapsed()));
@@ -173,15 +298,10 @@ fn validate(mesh: &Mesh, refined: &Mesh, level: u32, method: Method) -> anyhow::
     Ok(ok)
 }
 
-/// Adds what to do about input Catmull-Clark cannot refine.
+/// Adds what to do about input that cannot be refined.
 fn explain(e: SubdivError) -> anyhow::Error {
     let hint = match &e {
-        SubdivError::NonManifoldEdge { .. }
-        | SubdivError::NonManifoldVertex { .. }
-        | SubdivError::Inconsistent { .. }
-        | SubdivError::DegenerateFace { .. } => {
-            "Catmull-Clark needs a manifold, consistently oriented mesh (see `texgeo mesh stats`)"
-        }
+        SubdivError::Feature(_) => "check the mesh's tags (t crease, t corner, t hole)",
         SubdivError::GpuLimit(_) => "try --method cpu or a lower level",
         _ => return e.into(),
     };

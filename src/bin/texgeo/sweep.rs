@@ -63,7 +63,8 @@ struct RunArgs {
     #[arg(long, conflicts_with = "resume")]
     restart: bool,
 
-    /// Task method (inclusion: gpu, cpu, …; voxelize: zoned, cpu, …; subdivide: gpu, cpu).
+    /// Task method (inclusion: gpu, cpu, …; voxelize: zoned, cpu, …; subdivide: gpu, cpu;
+    /// boolean: the inclusion method of its point tests).
     #[arg(long, help_heading = "Task options")]
     method: Option<String>,
     /// inclusion: random points per mesh (default 1000).
@@ -90,8 +91,16 @@ struct RunArgs {
     /// subdivide: subdivision level (default 2).
     #[arg(long, short, help_heading = "Task options")]
     level: Option<u64>,
+    /// boolean: union, intersection, difference (default) or symmetric-difference.
+    #[arg(long, help_heading = "Task options")]
+    op: Option<String>,
+    /// boolean: the second operand — `turned` (default: the mesh turned 10° about y and moved
+    /// 1 % of its diagonal), `transform:STEPS` (`texgeo boolean --transform-b` steps) or
+    /// `builtin:NAME`.
+    #[arg(long, help_heading = "Task options")]
+    with: Option<String>,
     /// What every result is compared with (inclusion: cpu; voxelize: scanline; subdivide:
-    /// auto = cpu for gpu, osd for cpu), or `none`.
+    /// auto = cpu for gpu, osd for cpu; boolean: none, or cgal), or `none`.
     #[arg(long, help_heading = "Task options")]
     reference: Option<String>,
     /// Any task option by name (repeatable), e.g. --set tolerance=1e-6.
@@ -148,6 +157,8 @@ fn options(a: &RunArgs) -> anyhow::Result<Map<String, Value>> {
     put("zone", a.zone.map(Value::from));
     put("level", a.level.map(Value::from));
     put("reference", a.reference.clone().map(Value::from));
+    put("op", a.op.clone().map(Value::from));
+    put("with", a.with.clone().map(Value::from));
     for kv in &a.set {
         let (k, v) = kv.split_once('=').with_context(|| format!("--set {kv}: expected KEY=VALUE"))?;
         m.insert(k.trim().to_string(), typed_value(v.trim()));

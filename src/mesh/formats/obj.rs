@@ -13,7 +13,8 @@
 //!    shared and a closed OBJ reads as a closed mesh.
 //!
 //! Vertices no face uses are dropped (`tobj` does not return them); the others keep their
-//! file order. Texture coordinates, normals and colours are checked but not kept. A face
+//! file order ([`read_mapped`] also returns the renumbering). Tags (`t` lines, the sharp
+//! features of subdivision surfaces) are skipped here; `subdiv::tags` reads them. Texture coordinates, normals and colours are checked but not kept. A face
 //! may only use vertices defined before it (positive or relative indices), as written
 //! by every exporter; a forward reference is reported as out of range.
 
@@ -28,7 +29,7 @@ use crate::mesh::{Mesh, MeshError, Result, error::Location};
 /// Statements of the OBJ format that texgeo accepts but ignores.
 #[rustfmt::skip]
 const IGNORED: &[&str] = &[
-    "l", "p", "s", "usemtl", "mtllib", "vp", "cstype", "deg", "bmat", "step", "curv", "curv2",
+    "t", "l", "p", "s", "usemtl", "mtllib", "vp", "cstype", "deg", "bmat", "step", "curv", "curv2",
     "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg", "bevel", "c_interp",
     "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap", "call",
     "csh",
@@ -46,6 +47,12 @@ struct Checked {
 
 /// Reads an OBJ file; `path` only names the source in errors.
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    Ok(read_mapped(bytes, path)?.0)
+}
+
+/// Reads an OBJ file and says where each of the file's vertices went: the mesh vertex,
+/// or `u32::MAX` for a vertex no face uses (dropped).
+pub fn read_mapped(bytes: &[u8], path: &Path) -> Result<(Mesh, Vec<u32>)> {
     let text = utf8(bytes, path, 0, 0)?;
     let checked = check(text, path)?;
     let source = checked.cleaned.as_deref().unwrap_or(text);
@@ -61,8 +68,9 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     assemble(&models, &checked, path)
 }
 
-/// Merges `tobj`'s models into one mesh, using the checked corner list for vertex identity.
-fn assemble(models: &[tobj::Model], checked: &Checked, path: &Path) -> Result<Mesh> {
+/// Merges `tobj`'s models into one mesh, using the checked corner list for vertex identity;
+/// also returns the file-to-mesh vertex renumbering.
+fn assemble(models: &[tobj::Model], checked: &Checked, path: &Path) -> Result<(Mesh, Vec<u32>)> {
     let disagree = |what: &str| {
         MeshError::parse(path, Location::File, format!("tobj and texgeo's check disagree about {what}"))
     };
@@ -129,8 +137,9 @@ fn assemble(models: &[tobj::Model], checked: &Checked, path: &Path) -> Result<Me
     if corner != checked.corners.len() {
         return Err(disagree("the number of face corners"));
     }
-    Mesh::from_parts(positions, offsets, indices)
-        .map_err(|e| MeshError::parse(path, Location::File, e.to_string()))
+    let mesh = Mesh::from_parts(positions, offsets, indices)
+        .map_err(|e| MeshError::parse(path, Location::File, e.to_string()))?;
+    Ok((mesh, renumber))
 }
 
 /// The line-numbered check (step 1 of the module doc).

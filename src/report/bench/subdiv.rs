@@ -145,7 +145,11 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
             cpu::refine(mesh, level)?;
             Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
         })?;
-        let osd_seconds = osd::time_median(mesh, level, settings.runs.max(1) as u32)?;
+        let osd_seconds = osd::time_median(
+            &crate::subdiv::Surface::smooth(mesh.clone()),
+            level,
+            settings.runs.max(1) as u32,
+        )?;
         let verdict = if settings.validate {
             let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
             if c.is_match() {
@@ -236,4 +240,137 @@ pub fn thesis_table5() -> Table {
          not named in the thesis; the first row is the cube (8 fragments).",
     );
     table
+}
+
+/// The issue's speed target for sharp features: a creased model at level 5 costs the GPU
+/// path at most this much more than the same model without creases.
+pub const CREASE_TARGET: f64 = 1.2;
+
+/// Models measured by `texgeo bench subdivide --creases` by default: CGAL's CAD parts
+/// `fandisk.off` (the classic test of creased subdivision) and `couplingdown.off` when
+/// fetched, and the built-in torus knot, whose tube (8 sides) has a crease line along each
+/// of its 8 edges.
+pub const CREASE_MODELS: &[&str] = &["fandisk.off", "couplingdown.off", "builtin:knot"];
+
+/// What the crease benchmark measures.
+#[derive(Clone, Copy, Debug)]
+pub struct CreaseSettings {
+    pub level: u32,
+    /// Timed pairs (smooth, creased) after one warm-up pair; medians are reported.
+    pub runs: usize,
+    /// Edges whose faces meet at more than this angle are creased.
+    pub angle_degrees: f64,
+    /// Sharpness values to measure, one row each (10: infinitely sharp).
+    pub sharpness: &'static [f32],
+}
+
+/// The default crease models found: fetched files in `models_dir`, built-ins.
+pub fn crease_models(models_dir: &Path) -> Result<Vec<Model>> {
+    let mut models = Vec::new();
+    for &name in CREASE_MODELS {
+        if let Some(builtin) = name.strip_prefix("builtin:") {
+            if let Some(mesh) = procedural::by_name(builtin) {
+                models.push(Model { name: name.to_string(), mesh });
+            }
+        } else if models_dir.join(name).is_file() {
+            let path = models_dir.join(name);
+            models.push(Model { name: path.display().to_string(), mesh: formats::read(&path)? });
+        }
+    }
+    Ok(models)
+}
+
+/// Sharp features on the GPU path: each model's feature edges creased (at each sharpness)
+/// against the same model without creases, timed in alternation on the same subdivider,
+/// medians of the whole GPU path and of its passes, and their ratios.
+pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) -> Result<Report> {
+    use crate::subdiv::{Features, Surface};
+    let level = settings.level;
+    let mut table = Table::new(
+        format!("Sharp features on the GPU path: level {level}, creased vs without creases, medians (ms)"),
+        &[
+            "model",
+            "faces",
+            "creased edges",
+            "sharpness",
+            "fragments with data",
+            "GPU path, no creases",
+            "GPU path, creased",
+            "ratio (median of pairs)",
+            "passes, no creases",
+            "passes, creased",
+            "passes ratio",
+            "target ≤ 1.2",
+        ],
+    );
+    let mut subdivider = Subdivider::new(ctx)?;
+    for model in models {
+        let smooth = Surface::smooth(model.mesh.clone());
+        for &sharpness in settings.sharpness {
+            let features = Features::feature_edges(&model.mesh, settings.angle_degrees, sharpness);
+            let creases = features.creases.len();
+            let creased = Surface { features, ..smooth.clone() };
+            let (mut plain, mut sharp) = (Vec::new(), Vec::new());
+            let (mut ratios, mut pass_ratios) = (Vec::new(), Vec::new());
+            let mut fragments = (0, 0);
+            for k in 0..=settings.runs.max(1) {
+                // Alternate, so that both see the same load on a shared machine; the ratio
+                // is the median of the pairs' ratios.
+                let a = subdivider.refine_surface(ctx, &smooth, level, &Options::default())?;
+                let b = subdivider.refine_surface(ctx, &creased, level, &Options::default())?;
+                fragments = (b.sharp_fragments, b.fragments);
+                if k > 0 {
+                    ratios.push(b.times.total.as_secs_f64() / a.times.total.as_secs_f64().max(1e-9));
+                    pass_ratios.push(
+                        b.times.passes_total().as_secs_f64() / a.times.passes_total().as_secs_f64().max(1e-9),
+                    );
+                    plain.push(a.times);
+                    sharp.push(b.times);
+                }
+            }
+            let (p, s) = (median_times(&plain), median_times(&sharp));
+            let median = |v: &mut Vec<f64>| {
+                v.sort_by(f64::total_cmp);
+                let n = v.len();
+                if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+            };
+            let (ratio, passes) = (median(&mut ratios), median(&mut pass_ratios));
+            table.row(vec![
+                model.name.clone(),
+                model.mesh.num_faces().to_string(),
+                creases.to_string(),
+                if crate::subdiv::crease::is_infinite(sharpness) {
+                    "∞".into()
+                } else {
+                    format!("{sharpness}")
+                },
+                format!(
+                    "{} of {} ({:.0} %)",
+                    fragments.0,
+                    fragments.1,
+                    100.0 * fragments.0 as f64 / fragments.1.max(1) as f64
+                ),
+                ms(p.total),
+                ms(s.total),
+                format!("{ratio:.2}"),
+                ms(p.passes_total()),
+                ms(s.passes_total()),
+                format!("{passes:.2}"),
+                if ratio <= CREASE_TARGET { "met".into() } else { "NOT met".into() },
+            ]);
+        }
+    }
+    table.note(format!(
+        "Creased: every edge whose two faces meet at more than {}° (feature edges), at the given sharpness \
+         (∞: infinitely sharp). {} timed pairs after a warm-up pair, the model without and with creases \
+         alternating on the same subdivider; medians. GPU path: base level + fragment build + one submission \
+         (upload, passes, readback) + assembly, wall clock; passes: GPU timestamps. Fragments with data carry \
+         per-texel sharpness and are drawn with the sharp shader variant (the others with the smooth one).",
+        settings.angle_degrees, settings.runs
+    ));
+    Ok(Report {
+        name: "subdivide-creases".into(),
+        environment: Environment::new(ctx.info().label()),
+        tables: vec![table],
+    })
 }

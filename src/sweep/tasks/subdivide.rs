@@ -3,7 +3,6 @@
 
 use std::time::Instant;
 
-use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::gpu::Context;
@@ -11,7 +10,7 @@ use crate::mesh::{Mesh, Report};
 use crate::subdiv::compare::Comparison;
 use crate::subdiv::gpu::{Options as GpuOptions, Subdivider};
 use crate::subdiv::{SubdivError, cpu, osd};
-use crate::sweep::record::{Fnv, Record};
+use crate::sweep::record::{Record, mesh_hash as hash};
 use crate::sweep::task::{Failure, Task, relative};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -158,31 +157,10 @@ impl Task for Subdivide {
     }
 }
 
-/// FNV-1a of the refined mesh: faces, then positions as f64 bits.
-fn hash(mesh: &Mesh) -> Fnv {
-    let mut h = Fnv::default();
-    for f in mesh.faces() {
-        h.u64(f.len() as u64);
-        for &v in f {
-            h.u64(u64::from(v));
-        }
-    }
-    for p in mesh.positions() {
-        let DVec3 { x, y, z } = *p;
-        for c in [x, y, z] {
-            h.u64(c.to_bits());
-        }
-    }
-    h
-}
-
 /// Refusals (input Catmull-Clark cannot refine, levels too large) and failures.
 fn refusal(e: SubdivError) -> Failure {
     let reason = match &e {
-        SubdivError::DegenerateFace { .. } => "degenerate-face",
-        SubdivError::NonManifoldEdge { .. } => "non-manifold-edge",
-        SubdivError::NonManifoldVertex { .. } => "non-manifold-vertex",
-        SubdivError::Inconsistent { .. } => "inconsistent-orientation",
+        SubdivError::Feature(_) => "feature-tags",
         SubdivError::TooLarge { .. } | SubdivError::Memory { .. } => "too-large",
         SubdivError::Fragment(_) => "fragment-mesh",
         SubdivError::GpuLimit(_) => "gpu-limit",
