@@ -31,9 +31,6 @@ pub struct Args {
     /// voxel-space 2..=512 (default: from the mesh and the number of points).
     #[arg(long)]
     grid: Option<usize>,
-    /// Worker threads for the CPU work (default: every core); the output is the same for any count.
-    #[arg(long, value_parser = crate::args::positive_usize)]
-    threads: Option<usize>,
     /// GPU methods: tetrahedra per point-vertex (1 = the thesis' one point per tetrahedron).
     #[arg(long, value_parser = crate::args::positive_u32)]
     batch: Option<u32>,
@@ -55,7 +52,6 @@ pub struct Args {
 const BYTES_PER_POINT: u64 = 64;
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
-    crate::args::use_threads(args.threads)?;
     if let Some(out) = &args.output {
         texgeo::output::check_file(out)?;
     }
