@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 use crate::mesh::MeshError;
 use crate::mesh::error::Location;
-use crate::mesh::formats::text::{Lines, fast, parse_coord};
+use crate::mesh::formats::text::{Lines, parse_coord};
 
 /// Whether `path` names a NumPy file (by extension).
 pub fn is_npy(path: &Path) -> bool {
@@ -54,27 +54,61 @@ fn parse_fast(bytes: &[u8]) -> Option<Vec<DVec3>> {
         let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |e| at + e + 1);
         cuts.push(end);
     }
-    let chunks: Vec<Option<Vec<DVec3>>> = cuts
-        .par_windows(2)
-        .map(|w| {
-            let mut lines = fast::ContentLines::new(&bytes[w[0]..w[1]]);
-            let mut out = Vec::with_capacity((w[1] - w[0]) / 24);
-            for line in lines.by_ref() {
-                let mut t = fast::tokens(line);
-                let p = DVec3::new(fast::coord(t.next()?)?, fast::coord(t.next()?)?, fast::coord(t.next()?)?);
-                if t.next().is_some() {
-                    return None;
-                }
-                out.push(p);
-            }
-            (!lines.failed).then_some(out)
-        })
-        .collect();
+    let chunks: Vec<Option<Vec<DVec3>>> =
+        cuts.par_windows(2).map(|w| parse_chunk(&bytes[w[0]..w[1]])).collect();
     let mut points = Vec::with_capacity(chunks.iter().map(|c| c.as_ref().map_or(0, Vec::len)).sum());
     for c in chunks {
         points.extend_from_slice(&c?);
     }
     Some(points)
+}
+
+/// One chunk of whole lines in a single pass: per line, up to three numbers read in place
+/// by fast-float (correctly rounded, as `str::parse`), each ending at a space, a comment or
+/// the line's end; `None` for anything else (another count, a non-number, a non-finite
+/// value, a non-ASCII byte), which the line reader then explains.
+fn parse_chunk(bytes: &[u8]) -> Option<Vec<DVec3>> {
+    // Spaces within a line: what `split_whitespace` takes among ASCII, but the newline.
+    let space = |b: u8| b == b' ' || b == b'\t' || b == b'\r' || b == 0x0b || b == 0x0c;
+    let mut out = Vec::with_capacity(bytes.len() / 24);
+    let (mut i, n) = (0, bytes.len());
+    while i < n {
+        let mut v = [0.0; 3];
+        let mut k = 0;
+        loop {
+            while i < n && space(bytes[i]) {
+                i += 1;
+            }
+            if i >= n || bytes[i] == b'\n' {
+                break;
+            }
+            if bytes[i] == b'#' {
+                i += bytes[i..].iter().position(|&b| b == b'\n').unwrap_or(n - i);
+                break;
+            }
+            // Only the characters of decimal numbers may start one ("inf", "nan": slow path).
+            if k == 3 || !(bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'-' | b'+')) {
+                return None;
+            }
+            let (x, used): (f64, usize) = fast_float2::parse_partial(&bytes[i..]).ok()?;
+            i += used;
+            if used == 0
+                || !x.is_finite()
+                || (i < n && !(space(bytes[i]) || matches!(bytes[i], b'\n' | b'#')))
+            {
+                return None;
+            }
+            v[k] = x;
+            k += 1;
+        }
+        match k {
+            3 => out.push(DVec3::from_array(v)),
+            0 => {}
+            _ => return None,
+        }
+        i += 1;
+    }
+    Some(out)
 }
 
 /// The line-by-line reader: every accepted file, every error with its line.
@@ -209,10 +243,8 @@ pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class])
     out.flush()
 }
 
-/// Writes the classes as a `.npy` file: a 1-D `uint8` array (0 outside, 1 inside, 2 on the
-/// boundary), for NumPy users.
-pub fn write_classes_npy(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
-    let mut header = format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({},), }}", classes.len());
+fn write_npy_header(out: &mut impl Write, descr: &str, shape: &str) -> std::io::Result<()> {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
     // Magic (6) + version (2) + length (2) + header + newline: a multiple of 64 bytes.
     while (10 + header.len() + 1) % 64 != 0 {
         header.push(' ');
@@ -220,7 +252,23 @@ pub fn write_classes_npy(out: &mut impl Write, classes: &[super::classifier::Cla
     header.push('\n');
     out.write_all(b"\x93NUMPY\x01\x00")?;
     out.write_all(&(header.len() as u16).to_le_bytes())?;
-    out.write_all(header.as_bytes())?;
+    out.write_all(header.as_bytes())
+}
+
+/// Writes points as a `.npy` file: an N×3 little-endian float64 array (what [`read`] takes).
+pub fn write_npy(out: &mut impl Write, points: &[DVec3]) -> std::io::Result<()> {
+    write_npy_header(out, "<f8", &format!("({}, 3)", points.len()))?;
+    for chunk in points.chunks(1 << 16) {
+        let bytes: Vec<u8> = chunk.iter().flat_map(|p| p.to_array()).flat_map(f64::to_le_bytes).collect();
+        out.write_all(&bytes)?;
+    }
+    out.flush()
+}
+
+/// Writes the classes as a `.npy` file: a 1-D `uint8` array (0 outside, 1 inside, 2 on the
+/// boundary), for NumPy users.
+pub fn write_classes_npy(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
+    write_npy_header(out, "|u1", &format!("({},)", classes.len()))?;
     let bytes: Vec<u8> = classes.iter().map(|&c| c as u8).collect();
     out.write_all(&bytes)?;
     out.flush()
@@ -229,6 +277,18 @@ pub fn write_classes_npy(out: &mut impl Write, classes: &[super::classifier::Cla
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_one_pass_reader_agrees_with_the_line_reader() {
+        let p = Path::new("pts.txt");
+        let text = b"1. +2 -.5e-3\n\t1\x0b2\x0c3\r\n  # c\n1e300 0 -0 #x\n7 8 9";
+        assert_eq!(parse_chunk(text).unwrap(), parse_lines(text, p).unwrap());
+        for bad in [&b"1 2 3 4\n"[..], b"1 2\n", b"1 2 inf\n", b"1 2 3x\n", b"1 2 1e999\n", b"1 2 \xc3\xa9\n"]
+        {
+            assert!(parse_chunk(bad).is_none(), "{:?}", String::from_utf8_lossy(bad));
+            assert!(parse(bad, p).is_err(), "{:?}", String::from_utf8_lossy(bad));
+        }
+    }
 
     #[test]
     fn reads_points_and_reports_lines() {
@@ -309,5 +369,8 @@ mod tests {
         let mut text = Vec::new();
         write_classes(&mut text, &[Class::Inside, Class::Outside, Class::OnBoundary]).unwrap();
         assert_eq!(text, b"1\n0\n2\n");
+        let mut out = Vec::new();
+        write_npy(&mut out, &want).unwrap();
+        assert_eq!(parse_npy(&out, p).unwrap(), want);
     }
 }
