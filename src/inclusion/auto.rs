@@ -7,8 +7,10 @@
 //! every size measured (README, Table 4-9: on armadillo `gpu` costs ~52 µs and
 //! `gpu+tetragrid` ~6 µs per point against well under 1 µs for the voxel space; `texgeo
 //! bench scale`), and on other devices texgeo has no measurement to base a choice on. They
-//! stay selectable by name. Nor are the other CPU methods: the voxel space's build is a
-//! few milliseconds more than theirs at most, and its queries are the cheapest.
+//! stay selectable by name. Nor are the other CPU methods: in `texgeo bench scale` on
+//! armadillo (2026-12-02, 1 000 points, build included) the voxel space was 1.6–1.8×
+//! faster than bvh, 2.7–3× than octants and 4.5–4.9× than tetragrid, and its per-point
+//! cost is the lowest.
 
 use super::method::Method;
 

@@ -137,8 +137,10 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
     )
     .named("inclusion");
     let mut skipped = Vec::new();
-    // Last total per (method, threads), to predict the next point count.
-    let mut last: std::collections::HashMap<(Method, usize), (usize, Duration)> = Default::default();
+    // Last (points, total, build) per (method, threads), to predict the next point count:
+    // the build again plus the classification scaled by the points.
+    let mut last: std::collections::HashMap<(Method, usize), (usize, Duration, Duration)> =
+        Default::default();
     for &n in &cfg.points {
         let pts = query_points(mesh, n);
         let mut reference: Option<Vec<Class>> = None;
@@ -150,10 +152,10 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
                 cfg.threads.iter().max().copied().into_iter().collect()
             };
             for &threads in &counts {
-                let prev = last.get(&(method, threads)).copied();
-                if let Some(p) =
-                    over_budget(prev.map(|p| p.1), n as f64 / prev.map_or(1, |p| p.0) as f64, cfg.budget)
-                {
+                let predicted = last.get(&(method, threads)).map(|&(m, total, build)| {
+                    build + total.saturating_sub(build).mul_f64(n as f64 / m as f64)
+                });
+                if let Some(p) = over_budget(predicted, 1.0, cfg.budget) {
                     skipped.push(format!(
                         "{method} at {n} points on {threads} thread(s) (predicted {:.0} s)",
                         p.as_secs_f64()
@@ -189,7 +191,7 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
                     "bench scale: {n} points, {method} ({ran}), {threads} thread(s): {} ms",
                     ms(m.time)
                 );
-                last.insert((method, threads), (n, m.time));
+                last.insert((method, threads), (n, m.time, build));
                 table.row(vec![
                     n.to_string(),
                     method.to_string(),
