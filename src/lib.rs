@@ -5,6 +5,7 @@
 //! runs one of them over a whole mesh collection; `output` writes every file atomically.
 
 pub mod boolean;
+pub mod cache;
 pub mod exact;
 pub mod gpu;
 pub mod host;

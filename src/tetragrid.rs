@@ -107,6 +107,14 @@ impl Cells {
         Some(c)
     }
 
+    /// The integer coordinate along `axis` of a coordinate value `x`, `None` outside the
+    /// cube (the arithmetic of [`Self::coords`]).
+    #[inline]
+    pub fn coords_axis(&self, x: f64, axis: usize) -> Option<usize> {
+        let c = self.coord(x, axis);
+        (c >= 0.0 && c < self.n as f64).then_some(c as usize)
+    }
+
     /// The index of the cell holding `q`, `None` outside the cube.
     #[inline]
     pub fn cell_of(&self, q: DVec3) -> Option<usize> {

@@ -41,7 +41,7 @@ fn errors_exit_2_with_one_message() {
         (vec!["mesh", "stats", "model.xyz"], "unknown mesh format"),
         (
             vec!["inclusion", "builtin:cube", "--random", "10", "--method", "magic"],
-            "invalid value 'magic' for '--method <METHOD>' [possible values: cpu, bvh",
+            "invalid value 'magic' for '--method <METHOD>' [possible values: auto, cpu, bvh",
         ),
     ] {
         assert_refused(&texgeo(&args), &[needle]);

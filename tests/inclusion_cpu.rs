@@ -554,3 +554,62 @@ fn an_empty_mesh_holds_nothing() {
         assert_eq!(c.classify_all(&[DVec3::ZERO, DVec3::ONE]), vec![Outside, Outside], "{}", c.name());
     }
 }
+
+// ---------------------------------------------------------------- voxel space, auto, threads
+
+/// Points spread over the box, near the surface, and on mesh vertices.
+fn mixed_points(mesh: &Mesh, seed: u64) -> Vec<DVec3> {
+    let (lo, hi) = mesh.bounds();
+    let pad = (hi - lo) * 0.1;
+    let mut pts = Rng::new(seed).points_in_box(1500, lo - pad, hi + pad);
+    pts.extend(near_surface_points(mesh, 1500, seed + 1));
+    pts.extend_from_slice(mesh.positions());
+    pts
+}
+
+#[test]
+fn voxel_space_at_any_resolution_and_auto_label_as_cpu() {
+    let rot = glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+    let mut solids = models();
+    solids.push(("rotated l-prism", l_prism().map_positions(|p| rot * p).unwrap()));
+    for (k, (name, mesh)) in solids.into_iter().enumerate() {
+        // At the origin and translated far from it (the grid's cells are then few ulps
+        // wide relative to the coordinates).
+        for shift in [DVec3::ZERO, DVec3::new(1e7, -3e6, 5e5) + 0.25] {
+            let mesh = mesh.map_positions(|p| p + shift).unwrap();
+            let pts = mixed_points(&mesh, 300 + k as u64);
+            let want = build(Method::Cpu, &mesh, &Options::default()).unwrap().classify_all(&pts);
+            for n in [2, 3, 5, 16, 61] {
+                let options = Options { voxel_space_resolution: Some(n), ..Options::default() };
+                let got = build(Method::VoxelSpace, &mesh, &options).unwrap().classify_all(&pts);
+                for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(g, w, "{name} + {shift}, voxel-space {n}³, at {}", pts[i]);
+                }
+            }
+            for points in [0, 1_000, 1_000_000] {
+                let options = Options { points, ..Options::default() };
+                let got = build(Method::Auto, &mesh, &options).unwrap().classify_all(&pts);
+                assert_eq!(got, want, "{name} + {shift}: auto for {points} points");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_labels_do_not_depend_on_the_number_of_threads() {
+    let mesh = procedural::torus_knot();
+    let pts = mixed_points(&mesh, 77);
+    for m in Method::ALL.into_iter().filter(|m| m.is_cpu()) {
+        let c = build(m, &mesh, &Options { points: pts.len(), ..Options::default() }).unwrap();
+        let runs: Vec<Vec<Class>> = [1, 2, 3]
+            .into_iter()
+            .map(|threads| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| c.classify_all(&pts))
+            })
+            .collect();
+        assert!(runs.iter().all(|r| *r == runs[0]), "{m}");
+        let one_by_one: Vec<Class> = pts.iter().map(|&p| c.classify(p)).collect();
+        assert_eq!(runs[0], one_by_one, "{m}");
+    }
+}

@@ -95,7 +95,7 @@ fn every_method_labels_a_translated_solid_as_at_the_origin() {
                 moved_pts.iter().zip(&pts).all(|(&m, &p)| m - shift == p),
                 "{name}: inexact points at {t}"
             );
-            for method in Method::ALL {
+            for method in std::iter::once(Method::Auto).chain(Method::ALL) {
                 let got = labels(method, &moved, &moved_pts, &ctx);
                 let differ: Vec<_> = (0..pts.len()).filter(|&i| got[i] != reference[i]).collect();
                 if let Some(&i) = differ.first() {

@@ -28,8 +28,11 @@ pub trait Classifier: Send + Sync {
     /// The method's name as the CLI spells it.
     fn name(&self) -> &str;
     fn classify(&self, p: DVec3) -> Class;
+    /// Classifies every point on every core of the current rayon pool (`--threads`); each
+    /// answer depends on its point alone, so the output is the same for any thread count.
     fn classify_all(&self, ps: &[DVec3]) -> Vec<Class> {
-        ps.iter().map(|&p| self.classify(p)).collect()
+        use rayon::prelude::*;
+        ps.par_iter().with_min_len(512).map(|&p| self.classify(p)).collect()
     }
     fn build_stats(&self) -> BuildStats;
 }

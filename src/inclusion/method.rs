@@ -9,9 +9,13 @@ use super::error::InclusionError;
 
 /// The inclusion methods (`--method`). [`super::solver::Solver::new`] builds any of them;
 /// [`Method::is_cpu`] says which ones [`super::solver::build`] can make without a device.
-/// A new method is one variant here and one arm in the factory.
+/// A new method is one variant here and one arm in the factory. [`Method::Auto`] is not a
+/// method of its own: the factory replaces it by the one [`super::auto`] picks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Method {
+    /// The fastest exact method for the mesh, the number of points and the device, from
+    /// measured cost models (says which on stderr).
+    Auto,
     /// Alg. 4-1 with basic preprocessing, every tetra tested.
     Cpu,
     /// Alg. 4-1 over a bounding-box hierarchy of the tetras (§4.3.2.2).
@@ -36,10 +40,15 @@ pub enum Method {
     /// The GPU method over TetraGrid cells: each cell's points against its tetras.
     #[value(name = "gpu+tetragrid")]
     GpuTetraGrid,
+    /// Voxel space (§4.2.1.1, exact): cells labelled inside/outside once, points in
+    /// surface cells tested exactly on their cell's triangles.
+    #[value(name = "voxel-space")]
+    VoxelSpace,
 }
 
 impl Method {
-    pub const ALL: [Method; 10] = [
+    /// Every method (not [`Method::Auto`], which picks one of them).
+    pub const ALL: [Method; 11] = [
         Method::Cpu,
         Method::Bvh,
         Method::Octants,
@@ -50,6 +59,7 @@ impl Method {
         Method::Gpu,
         Method::CpuGpu,
         Method::GpuTetraGrid,
+        Method::VoxelSpace,
     ];
 
     pub fn name(self) -> &'static str {
@@ -64,14 +74,16 @@ impl Method {
             Method::Gpu => "gpu",
             Method::CpuGpu => "cpu+gpu",
             Method::GpuTetraGrid => "gpu+tetragrid",
+            Method::VoxelSpace => "voxel-space",
+            Method::Auto => "auto",
         }
     }
 
     pub fn names() -> Vec<&'static str> {
-        Method::ALL.iter().map(|m| m.name()).collect()
+        std::iter::once(Method::Auto).chain(Method::ALL).map(|m| m.name()).collect()
     }
 
-    /// True for methods that run on the CPU alone.
+    /// True for methods that run on the CPU alone (`auto` only picks those).
     pub fn is_cpu(self) -> bool {
         !matches!(self, Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid)
     }
@@ -86,9 +98,8 @@ impl fmt::Display for Method {
 impl FromStr for Method {
     type Err = InclusionError;
     fn from_str(s: &str) -> Result<Method, InclusionError> {
-        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| InclusionError::UnknownMethod {
-            name: s.to_string(),
-            expected: Method::names().join(", "),
+        std::iter::once(Method::Auto).chain(Method::ALL).find(|m| m.name() == s).ok_or_else(|| {
+            InclusionError::UnknownMethod { name: s.to_string(), expected: Method::names().join(", ") }
         })
     }
 }
@@ -100,6 +111,11 @@ pub struct Options {
     pub apex: Option<DVec3>,
     /// TetraGrid resolution n (n³ cells), 2..=64.
     pub tetragrid_resolution: usize,
+    /// Voxel-space resolution n; `None` = from the mesh and [`Self::points`].
+    pub voxel_space_resolution: Option<usize>,
+    /// How many points will be classified (0 = unknown): `auto` and the voxel space size
+    /// themselves by it.
+    pub points: usize,
     /// Jordan octree depth (the thesis' "Octree-6").
     pub octree_depth: u32,
     /// Accept a surface that is not closed and consistently oriented. Only the `winding`
@@ -113,6 +129,8 @@ impl Default for Options {
         Options {
             apex: None,
             tetragrid_resolution: super::tetragrid::DEFAULT_RESOLUTION,
+            voxel_space_resolution: None,
+            points: 0,
             octree_depth: 6,
             allow_open: false,
         }
@@ -132,7 +150,9 @@ mod tests {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
             assert_eq!(m.to_possible_value().unwrap().get_name(), m.name());
         }
-        assert_eq!(Method::value_variants(), Method::ALL);
+        assert_eq!(Method::value_variants()[0], Method::Auto);
+        assert_eq!(Method::value_variants()[1..], Method::ALL);
+        assert_eq!("auto".parse::<Method>().unwrap(), Method::Auto);
         let e = "gpu+magic".parse::<Method>().unwrap_err().to_string();
         assert!(e.contains("gpu+magic") && e.contains("jordan-octree"), "{e}");
         assert_eq!(Class::OnBoundary as u8, 2);

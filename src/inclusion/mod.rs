@@ -49,6 +49,7 @@
 //! [`crate::mesh::solidity`]'s: on a valid solid the winding number is 0 or 1, so the
 //! non-zero rule here, the parity of the voxelizers and "w ≥ ½" agree.
 
+pub mod auto;
 pub mod bvh;
 pub mod classifier;
 pub mod cpu;
@@ -64,6 +65,7 @@ pub mod solver;
 pub mod surface;
 pub mod tetra;
 pub mod tetragrid;
+pub mod voxel_space;
 pub mod winding;
 
 pub use classifier::{BuildStats, Class, Classifier};

@@ -1,24 +1,118 @@
-//! Query point files for `texgeo inclusion --points FILE`: one point per line, `x y z`,
-//! blank lines and `#` comments allowed. Errors name the file and line.
+//! Query point files for `texgeo inclusion --points FILE`: text, one point per line
+//! (`x y z`, blank lines and `#` comments allowed; errors name the file and line), or NumPy
+//! `.npy` (an N×3 array of float64 or float32, either byte order, C or Fortran order).
+//! Classes are written as text (one digit per line) or, to a `.npy` path, as an N-element
+//! `uint8` array.
+//!
+//! Text is parsed at disk speed: plain-ASCII files are cut into chunks at line ends and
+//! the chunks parsed in parallel, a byte at a time, with a correctly rounded float parser
+//! ([`crate::mesh::formats`]' fast path); anything unusual in a chunk sends the whole file
+//! to the line-by-line reader, which accepts the same files and words the errors.
 
 use std::io::Write;
 use std::path::Path;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::mesh::MeshError;
 use crate::mesh::error::Location;
 use crate::mesh::formats::text::{Lines, parse_coord};
 
-/// Reads a point file.
+/// Whether `path` names a NumPy file (by extension).
+pub fn is_npy(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+}
+
+/// Reads a point file (`.npy` by extension, text otherwise).
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<DVec3>, MeshError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
-    parse(&bytes, path)
+    if is_npy(path) { parse_npy(&bytes, path) } else { parse(&bytes, path) }
 }
 
-/// Parses point-file contents; `path` only names the source in errors.
+/// Parses point-file text; `path` only names the source in errors.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
+    match parse_fast(bytes) {
+        Some(points) if !points.is_empty() => Ok(points),
+        _ => parse_lines(bytes, path),
+    }
+}
+
+/// Bytes per parallel chunk of text.
+const CHUNK: usize = 1 << 20;
+
+/// The fast path: chunks cut at line ends, parsed in parallel; `None` when any chunk holds
+/// something the fast parser does not take (the line reader then decides).
+fn parse_fast(bytes: &[u8]) -> Option<Vec<DVec3>> {
+    let mut cuts = vec![0];
+    while let Some(&last) = cuts.last() {
+        if last >= bytes.len() {
+            break;
+        }
+        let at = (last + CHUNK).min(bytes.len());
+        let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |e| at + e + 1);
+        cuts.push(end);
+    }
+    let chunks: Vec<Option<Vec<DVec3>>> =
+        cuts.par_windows(2).map(|w| parse_chunk(&bytes[w[0]..w[1]])).collect();
+    let mut points = Vec::with_capacity(chunks.iter().map(|c| c.as_ref().map_or(0, Vec::len)).sum());
+    for c in chunks {
+        points.extend_from_slice(&c?);
+    }
+    Some(points)
+}
+
+/// One chunk of whole lines in a single pass: per line, up to three numbers read in place
+/// by fast-float (correctly rounded, as `str::parse`), each ending at a space, a comment or
+/// the line's end; `None` for anything else (another count, a non-number, a non-finite
+/// value, a non-ASCII byte), which the line reader then explains.
+fn parse_chunk(bytes: &[u8]) -> Option<Vec<DVec3>> {
+    // Spaces within a line: what `split_whitespace` takes among ASCII, but the newline.
+    let space = |b: u8| b == b' ' || b == b'\t' || b == b'\r' || b == 0x0b || b == 0x0c;
+    let mut out = Vec::with_capacity(bytes.len() / 24);
+    let (mut i, n) = (0, bytes.len());
+    while i < n {
+        let mut v = [0.0; 3];
+        let mut k = 0;
+        loop {
+            while i < n && space(bytes[i]) {
+                i += 1;
+            }
+            if i >= n || bytes[i] == b'\n' {
+                break;
+            }
+            if bytes[i] == b'#' {
+                i += bytes[i..].iter().position(|&b| b == b'\n').unwrap_or(n - i);
+                break;
+            }
+            // Only the characters of decimal numbers may start one ("inf", "nan": slow path).
+            if k == 3 || !(bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'-' | b'+')) {
+                return None;
+            }
+            let (x, used): (f64, usize) = fast_float2::parse_partial(&bytes[i..]).ok()?;
+            i += used;
+            if used == 0
+                || !x.is_finite()
+                || (i < n && !(space(bytes[i]) || matches!(bytes[i], b'\n' | b'#')))
+            {
+                return None;
+            }
+            v[k] = x;
+            k += 1;
+        }
+        match k {
+            3 => out.push(DVec3::from_array(v)),
+            0 => {}
+            _ => return None,
+        }
+        i += 1;
+    }
+    Some(out)
+}
+
+/// The line-by-line reader: every accepted file, every error with its line.
+fn parse_lines(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
     let mut lines = Lines::new(bytes, path)?;
     let mut points = Vec::new();
     while let Some((l, line)) = lines.next_content() {
@@ -38,18 +132,163 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
     Ok(points)
 }
 
-/// Writes one class per line (`1` inside, `0` outside, `2` on the boundary).
-pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(out);
-    for c in classes {
-        writeln!(w, "{}", *c as u8)?;
+/// The header of a `.npy` file: element type, order and shape.
+struct NpyHeader {
+    /// 4 or 8 (float32 or float64).
+    size: usize,
+    big_endian: bool,
+    fortran: bool,
+    shape: Vec<u64>,
+    /// Offset of the data.
+    data: usize,
+}
+
+fn npy_header(bytes: &[u8], path: &Path) -> Result<NpyHeader, MeshError> {
+    let err = |m: String| MeshError::parse(path, Location::File, m);
+    let rest = bytes
+        .strip_prefix(b"\x93NUMPY")
+        .ok_or_else(|| err("not a NumPy .npy file (no \\x93NUMPY magic)".into()))?;
+    let (major, rest) = rest.split_first().ok_or_else(|| err("truncated .npy header".into()))?;
+    let rest = rest.get(1..).ok_or_else(|| err("truncated .npy header".into()))?;
+    let (len, start) = match major {
+        1 => (rest.get(..2).map(|b| u16::from_le_bytes([b[0], b[1]]) as usize), 10),
+        2 | 3 => (rest.get(..4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize), 12),
+        v => return Err(err(format!(".npy format version {v} is not supported (1, 2 or 3)"))),
+    };
+    let len = len.ok_or_else(|| err("truncated .npy header".into()))?;
+    let text = bytes.get(start..start + len).ok_or_else(|| err("truncated .npy header".into()))?;
+    let text = std::str::from_utf8(text).map_err(|_| err("the .npy header is not text".into()))?;
+    let field = |key: &str| -> Option<&str> {
+        let at = text.find(&format!("'{key}'"))? + key.len() + 2;
+        Some(text[at..].trim_start().strip_prefix(':')?.trim_start())
+    };
+    let descr = field("descr")
+        .and_then(|d| d.strip_prefix('\'')?.split('\'').next())
+        .ok_or_else(|| err(format!("the .npy header has no 'descr': {text}")))?;
+    let (big_endian, size) = match descr {
+        "<f8" => (false, 8),
+        ">f8" => (true, 8),
+        "<f4" => (false, 4),
+        ">f4" => (true, 4),
+        d => {
+            return Err(err(format!(
+                "the .npy array holds '{d}'; points must be float64 or float32 ('<f8', '<f4')"
+            )));
+        }
+    };
+    let fortran = field("fortran_order").is_some_and(|v| v.starts_with("True"));
+    let shape = field("shape")
+        .and_then(|s| s.strip_prefix('(')?.split(')').next())
+        .ok_or_else(|| err(format!("the .npy header has no 'shape': {text}")))?;
+    let shape = shape
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| s.trim_end_matches('L').parse::<u64>().map_err(|_| err(format!("bad .npy shape ({shape})"))))
+        .collect::<Result<Vec<u64>, _>>()?;
+    Ok(NpyHeader { size, big_endian, fortran, shape, data: start + len })
+}
+
+/// Parses a `.npy` file holding an N×3 float64 or float32 array.
+pub fn parse_npy(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
+    let err = |m: String| MeshError::parse(path, Location::File, m);
+    let h = npy_header(bytes, path)?;
+    let n = match h.shape[..] {
+        [n, 3] => n as usize,
+        _ => return Err(err(format!("the .npy array has shape {:?}; points need shape (N, 3)", h.shape))),
+    };
+    if n == 0 {
+        return Err(err("no points in the file".into()));
     }
-    w.flush()
+    let data = &bytes[h.data..];
+    let need = n.checked_mul(3 * h.size).ok_or_else(|| err("the .npy shape is too large".into()))?;
+    if data.len() != need {
+        return Err(err(format!(
+            "the .npy data holds {} bytes, but shape ({n}, 3) of {}-byte floats needs {need}",
+            data.len(),
+            h.size
+        )));
+    }
+    let value = |k: usize| -> f64 {
+        let b = &data[k * h.size..(k + 1) * h.size];
+        match (h.size, h.big_endian) {
+            (8, false) => f64::from_le_bytes(b.try_into().unwrap_or_default()),
+            (8, true) => f64::from_be_bytes(b.try_into().unwrap_or_default()),
+            (_, false) => f32::from_le_bytes(b.try_into().unwrap_or_default()) as f64,
+            (_, true) => f32::from_be_bytes(b.try_into().unwrap_or_default()) as f64,
+        }
+    };
+    let at = |i: usize, c: usize| if h.fortran { c * n + i } else { 3 * i + c };
+    let points: Vec<DVec3> = (0..n)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .map(|i| DVec3::new(value(at(i, 0)), value(at(i, 1)), value(at(i, 2))))
+        .collect();
+    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+        return Err(err(format!("point {i} has a coordinate that is not finite ({})", points[i])));
+    }
+    Ok(points)
+}
+
+/// Writes one class per line (`1` inside, `0` outside, `2` on the boundary), in bulk.
+pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
+    let mut buf = Vec::with_capacity(2 * classes.len().min(1 << 20));
+    for chunk in classes.chunks(1 << 20) {
+        buf.clear();
+        for &c in chunk {
+            buf.extend_from_slice(&[b'0' + c as u8, b'\n']);
+        }
+        out.write_all(&buf)?;
+    }
+    out.flush()
+}
+
+fn write_npy_header(out: &mut impl Write, descr: &str, shape: &str) -> std::io::Result<()> {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    // Magic (6) + version (2) + length (2) + header + newline: a multiple of 64 bytes.
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    out.write_all(b"\x93NUMPY\x01\x00")?;
+    out.write_all(&(header.len() as u16).to_le_bytes())?;
+    out.write_all(header.as_bytes())
+}
+
+/// Writes points as a `.npy` file: an N×3 little-endian float64 array (what [`read`] takes).
+pub fn write_npy(out: &mut impl Write, points: &[DVec3]) -> std::io::Result<()> {
+    write_npy_header(out, "<f8", &format!("({}, 3)", points.len()))?;
+    for chunk in points.chunks(1 << 16) {
+        let bytes: Vec<u8> = chunk.iter().flat_map(|p| p.to_array()).flat_map(f64::to_le_bytes).collect();
+        out.write_all(&bytes)?;
+    }
+    out.flush()
+}
+
+/// Writes the classes as a `.npy` file: a 1-D `uint8` array (0 outside, 1 inside, 2 on the
+/// boundary), for NumPy users.
+pub fn write_classes_npy(out: &mut impl Write, classes: &[super::classifier::Class]) -> std::io::Result<()> {
+    write_npy_header(out, "|u1", &format!("({},)", classes.len()))?;
+    let bytes: Vec<u8> = classes.iter().map(|&c| c as u8).collect();
+    out.write_all(&bytes)?;
+    out.flush()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_one_pass_reader_agrees_with_the_line_reader() {
+        let p = Path::new("pts.txt");
+        let text = b"1. +2 -.5e-3\n\t1\x0b2\x0c3\r\n  # c\n1e300 0 -0 #x\n7 8 9";
+        assert_eq!(parse_chunk(text).unwrap(), parse_lines(text, p).unwrap());
+        for bad in [&b"1 2 3 4\n"[..], b"1 2\n", b"1 2 inf\n", b"1 2 3x\n", b"1 2 1e999\n", b"1 2 \xc3\xa9\n"]
+        {
+            assert!(parse_chunk(bad).is_none(), "{:?}", String::from_utf8_lossy(bad));
+            assert!(parse(bad, p).is_err(), "{:?}", String::from_utf8_lossy(bad));
+        }
+    }
 
     #[test]
     fn reads_points_and_reports_lines() {
@@ -66,5 +305,72 @@ mod tests {
         assert_eq!(e, "pts.txt: no points in the file");
         let e = parse(&[0xff, 0xfe], p).unwrap_err().to_string();
         assert_eq!(e, "pts.txt:1: not a text file (invalid UTF-8 at byte 0)");
+        // Many chunks parse in parallel to the same points as the line reader.
+        let mut text = String::new();
+        let mut rng = crate::random::Rng::new(3);
+        for i in 0..120_000 {
+            let q = rng.point_in_box(DVec3::splat(-1e3), DVec3::splat(1e3));
+            text.push_str(&format!("{} {} {}{}\n", q.x, q.y, q.z, if i % 1000 == 0 { " # c" } else { "" }));
+        }
+        let fast = parse_fast(text.as_bytes()).unwrap();
+        assert_eq!(fast.len(), 120_000);
+        assert_eq!(fast, parse_lines(text.as_bytes(), p).unwrap());
+        // A bad line late in the file still gets its line number.
+        let bad = format!("{text}1 2\n");
+        let e = parse(bad.as_bytes(), p).unwrap_err().to_string();
+        assert!(e.contains("pts.txt:120001") && e.contains("expected 'x y z', found 2"), "{e}");
+    }
+
+    fn npy(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
+        let h = format!(
+            "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}\n",
+            if fortran { "True" } else { "False" }
+        );
+        [
+            b"\x93NUMPY\x01\x00".to_vec(),
+            (h.len() as u16).to_le_bytes().to_vec(),
+            h.into_bytes(),
+            data.to_vec(),
+        ]
+        .concat()
+    }
+
+    #[test]
+    fn npy_points_in_every_layout_and_classes_out() {
+        let p = Path::new("pts.npy");
+        let pts = [[1.0, 2.0, 3.0], [4.5, -6.0, 0.25]];
+        let le8: Vec<u8> = pts.iter().flatten().flat_map(|v: &f64| v.to_le_bytes()).collect();
+        let be4: Vec<u8> = pts.iter().flatten().flat_map(|&v| (v as f32).to_be_bytes()).collect();
+        let fo8: Vec<u8> =
+            (0..3).flat_map(|c| pts.iter().map(move |q| q[c])).flat_map(|v: f64| v.to_le_bytes()).collect();
+        let want: Vec<DVec3> = pts.iter().map(|&q| DVec3::from_array(q)).collect();
+        assert_eq!(parse_npy(&npy("<f8", false, "(2, 3)", &le8), p).unwrap(), want);
+        assert_eq!(parse_npy(&npy(">f4", false, "(2, 3)", &be4), p).unwrap(), want);
+        assert_eq!(parse_npy(&npy("<f8", true, "(2, 3)", &fo8), p).unwrap(), want);
+        let e = parse_npy(&npy("<f8", false, "(3, 2)", &le8), p).unwrap_err().to_string();
+        assert!(e.starts_with("pts.npy: ") && e.contains("shape (N, 3)"), "{e}");
+        let e = parse_npy(&npy("<i8", false, "(2, 3)", &le8), p).unwrap_err().to_string();
+        assert!(e.contains("'<i8'") && e.contains("float64 or float32"), "{e}");
+        let e = parse_npy(&npy("<f8", false, "(2, 3)", &le8[..40]), p).unwrap_err().to_string();
+        assert!(e.contains("holds 40 bytes"), "{e}");
+        let nan: Vec<u8> = [0.0, f64::NAN, 0.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let e = parse_npy(&npy("<f8", false, "(1, 3)", &nan), p).unwrap_err().to_string();
+        assert!(e.contains("point 0") && e.contains("not finite"), "{e}");
+        assert!(parse_npy(b"OFF\n", p).unwrap_err().to_string().contains("not a NumPy"));
+        use super::super::classifier::Class;
+        let mut out = Vec::new();
+        write_classes_npy(&mut out, &[Class::Inside, Class::Outside, Class::OnBoundary]).unwrap();
+        assert_eq!(out.len() % 64, 3);
+        assert!(out.starts_with(b"\x93NUMPY\x01\x00"));
+        assert!(
+            String::from_utf8_lossy(&out).contains("'descr': '|u1', 'fortran_order': False, 'shape': (3,)")
+        );
+        assert_eq!(&out[out.len() - 3..], &[1, 0, 2]);
+        let mut text = Vec::new();
+        write_classes(&mut text, &[Class::Inside, Class::Outside, Class::OnBoundary]).unwrap();
+        assert_eq!(text, b"1\n0\n2\n");
+        let mut out = Vec::new();
+        write_npy(&mut out, &want).unwrap();
+        assert_eq!(parse_npy(&out, p).unwrap(), want);
     }
 }

@@ -8,6 +8,7 @@
 
 use glam::DVec3;
 
+use super::auto::{self, Choice};
 use super::bvh::Bvh;
 use super::classifier::{BuildStats, Class, Classifier};
 use super::cpu::{EdgeRule, FeitoTorres};
@@ -19,6 +20,7 @@ use super::method::{Method, Options};
 use super::octants::Octants;
 use super::octree::JordanOctree;
 use super::tetragrid::GridClassifier;
+use super::voxel_space::VoxelSpace;
 use super::winding::WindingNumber;
 use crate::gpu::Context;
 use crate::mesh::Mesh;
@@ -45,8 +47,29 @@ fn check_open(method: Method, mesh: &Mesh, options: &Options) -> Result<()> {
     Ok(())
 }
 
+/// The method `auto` stands for on `mesh` with `options` (other methods: themselves).
+/// Under `allow_open` on a surface that really is open, only `winding` classifies.
+pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Options, Option<Choice>) {
+    if method != Method::Auto {
+        return (method, *options, None);
+    }
+    if options.allow_open && Covering::new(mesh).unbalanced_edge().is_some() {
+        let choice = Choice { method: Method::Winding, resolution: None, predicted: f64::NAN };
+        return (Method::Winding, *options, Some(choice));
+    }
+    let triangles = mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum();
+    let choice = auto::choose(triangles, options.points);
+    let mut options = *options;
+    if choice.resolution.is_some() && options.voxel_space_resolution.is_none() {
+        options.voxel_space_resolution = choice.resolution;
+    }
+    (choice.method, options, Some(choice))
+}
+
 /// Builds the CPU classifier `method` for `mesh` (GPU methods: [`Solver::new`]).
 pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
+    let (method, options, _) = resolve(method, mesh, options);
+    let options = &options;
     check_open(method, mesh, options)?;
     let ft = || FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open);
     Ok(match method {
@@ -59,6 +82,14 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
             Box::new(JordanOctree::with_policy(mesh, options.octree_depth, options.allow_open)?)
         }
         Method::Winding => Box::new(WindingNumber::with_policy(mesh, options.allow_open)?),
+        Method::VoxelSpace => {
+            let triangles = mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum();
+            let n = options
+                .voxel_space_resolution
+                .unwrap_or_else(|| super::voxel_space::resolution_for(triangles, options.points));
+            Box::new(VoxelSpace::new(mesh, n, options.allow_open)?)
+        }
+        Method::Auto => return Err(InclusionError::Options("auto picks a method before building".into())),
         Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => {
             return Err(InclusionError::NeedsGpu(method.name()));
         }
@@ -75,6 +106,8 @@ impl Solver {
         ctx: Option<&Context>,
         batch: Option<u32>,
     ) -> Result<Solver> {
+        let (method, options, _) = resolve(method, mesh, options);
+        let options = &options;
         if method.is_cpu() {
             return Ok(Solver::Cpu(build(method, mesh, options)?));
         }

@@ -11,9 +11,8 @@
 //! `i`, the rest are face centroids, so the identity of every covering vertex is known
 //! (the vertex-set rule of Alg. 4-1 and the GPU upload need it).
 
-use std::collections::HashMap;
-
 use glam::DVec3;
+use rayon::slice::ParallelSliceMut;
 
 use super::Mesh;
 
@@ -234,26 +233,30 @@ impl Covering {
     /// surface (a 2-cycle), which is what the covering methods need; non-manifold edges
     /// (used twice each way) are fine.
     pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
-        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        // Every directed edge as (min, max, direction) packed in a u64, sorted (in
+        // parallel): the uses of an undirected edge are then adjacent, smallest edge first.
+        let mut keys: Vec<u64> = Vec::with_capacity(self.polygon_indices.len());
         for f in 0..self.num_faces() {
             let poly = self.polygon(f);
             for (i, &a) in poly.iter().enumerate() {
                 let b = poly[(i + 1) % poly.len()];
-                if a == b {
-                    continue;
-                }
-                let e = uses.entry((a.min(b), a.max(b))).or_default();
-                if a < b {
-                    e.0 += 1;
-                } else {
-                    e.1 += 1;
+                if a != b {
+                    let (lo, hi) = (a.min(b) as u64, a.max(b) as u64);
+                    keys.push(lo << 33 | hi << 1 | (a > b) as u64);
                 }
             }
         }
-        uses.into_iter()
-            .filter(|(_, (f, b))| f != b)
-            .min_by_key(|(k, _)| *k)
-            .map(|((a, b), (forward, backward))| UnbalancedEdge { a, b, forward, backward })
+        keys.par_sort_unstable();
+        keys.chunk_by(|x, y| x >> 1 == y >> 1).find_map(|run| {
+            let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
+            let forward = run.len() as u32 - backward;
+            (forward != backward).then(|| UnbalancedEdge {
+                a: (run[0] >> 33) as u32,
+                b: (run[0] >> 1 & 0xffff_ffff) as u32,
+                forward,
+                backward,
+            })
+        })
     }
 }
 

@@ -179,17 +179,27 @@ impl TriangleSoup {
     /// equal positions.
     pub fn new(mesh: &Mesh) -> TriangleSoup {
         let weld = weld_by_position(mesh.positions());
-        let per_face: Vec<Result<Vec<[u32; 3]>, TriangulateError>> = (0..mesh.num_faces())
+        // A triangle face needs no allocation; polygons are tessellated in their plane.
+        enum Tess {
+            One([u32; 3]),
+            Many(Vec<[u32; 3]>),
+            Failed(TriangulateError),
+        }
+        let per_face: Vec<Tess> = (0..mesh.num_faces())
             .into_par_iter()
             .with_min_len(1024)
             .map(|f| {
                 let face = mesh.face(f);
                 if face.len() == 3 {
-                    return Ok(vec![[face[0], face[1], face[2]].map(|v| weld[v as usize])]);
+                    return Tess::One([face[0], face[1], face[2]].map(|v| weld[v as usize]));
                 }
                 let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
-                let tris = triangulate::polygon(&corners)?;
-                Ok(tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect())
+                match triangulate::polygon(&corners) {
+                    Ok(tris) => Tess::Many(
+                        tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect(),
+                    ),
+                    Err(e) => Tess::Failed(e),
+                }
             })
             .collect();
         let mut soup = TriangleSoup {
@@ -200,13 +210,17 @@ impl TriangleSoup {
         };
         for (f, r) in per_face.into_iter().enumerate() {
             match r {
-                Ok(tris) => {
+                Tess::One(t) => {
+                    soup.triangles.push(t);
+                    soup.face_of.push(f as u32);
+                }
+                Tess::Many(tris) => {
                     for t in tris {
                         soup.triangles.push(t);
                         soup.face_of.push(f as u32);
                     }
                 }
-                Err(e) => soup.failed.push((f as u32, e)),
+                Tess::Failed(e) => soup.failed.push((f as u32, e)),
             }
         }
         soup

@@ -412,7 +412,98 @@ pub struct NotSolid {
 
 /// The gate in front of every command that needs a solid: `mesh` if it is a valid solid
 /// (or flipped, or open, as `policy` allows), else the reason it is not.
+///
+/// A mesh found to be a valid solid is remembered in the user's cache ([`crate::cache`],
+/// keyed by a BLAKE3 hash of its exact contents and of [`RULES`]): the same mesh read again
+/// is let through without repeating [`check`]. Only valid solids are remembered, so a
+/// mesh is refused, with the same reason, exactly when [`check`] refuses it.
 pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
+    let store = crate::cache::Store::open(CACHE_KIND);
+    let key = store.as_ref().map(|_| verdict_key(&mesh));
+    if let (Some(store), Some(key)) = (&store, &key) {
+        if let Some(solidity) = store.get(key).and_then(|b| decode_solid(&b)) {
+            return Ok(Accepted { mesh, solidity, flipped: false, open: false });
+        }
+    }
+    let accepted = require_solid_uncached(mesh, policy)?;
+    if let (Some(store), Some(key)) = (&store, &key) {
+        if !accepted.flipped && accepted.solidity.is_solid() {
+            store.put(key, &encode_solid(&accepted.solidity));
+        }
+    }
+    Ok(accepted)
+}
+
+/// Names the rules of this module in every cached verdict's key: change it whenever what
+/// counts as a solid (or what [`check`] measures) changes, and old verdicts are not used.
+pub const RULES: &str = "texgeo solidity rules 1 (closed, measurable, outward, not self-intersecting)";
+const CACHE_KIND: &str = "solidity-v1";
+
+/// The cache key of `mesh`: its positions (bit for bit) and faces, under [`RULES`].
+pub fn verdict_key(mesh: &Mesh) -> crate::cache::Key {
+    let mut h = crate::cache::KeyHasher::new(RULES);
+    h.u64(mesh.num_vertices() as u64);
+    for p in mesh.positions() {
+        for c in p.to_array() {
+            h.f64(c);
+        }
+    }
+    let (offsets, indices) = mesh.face_parts();
+    h.u64(offsets.len() as u64);
+    for &o in offsets {
+        h.u64(o as u64);
+    }
+    for &i in indices {
+        h.u64(i as u64);
+    }
+    h.finish()
+}
+
+/// A valid solid's measures: area, volume, then per shell faces, first face, volume, depth.
+fn encode_solid(s: &Solidity) -> Vec<u8> {
+    let mut out = Vec::with_capacity(24 + 28 * s.shells.len());
+    out.extend_from_slice(&s.area.to_le_bytes());
+    out.extend_from_slice(&s.volume.unwrap_or(f64::NAN).to_le_bytes());
+    out.extend_from_slice(&(s.shells.len() as u64).to_le_bytes());
+    for sh in &s.shells {
+        out.extend_from_slice(&(sh.faces as u64).to_le_bytes());
+        out.extend_from_slice(&(sh.first_face as u64).to_le_bytes());
+        out.extend_from_slice(&sh.volume.to_le_bytes());
+        out.extend_from_slice(&sh.depth.unwrap_or(i32::MIN).to_le_bytes());
+    }
+    out
+}
+
+fn decode_solid(b: &[u8]) -> Option<Solidity> {
+    let mut rest = b;
+    let mut take = |n: usize| -> Option<u64> {
+        let (head, tail) = rest.split_at_checked(n)?;
+        rest = tail;
+        let mut v = [0u8; 8];
+        v[..n].copy_from_slice(head);
+        Some(u64::from_le_bytes(v))
+    };
+    let area = f64::from_bits(take(8)?);
+    let volume = f64::from_bits(take(8)?);
+    let count = take(8)? as usize;
+    let mut shells = Vec::with_capacity(count.min(b.len() / 28));
+    for _ in 0..count {
+        let faces = take(8)? as usize;
+        let first_face = take(8)? as usize;
+        let volume = f64::from_bits(take(8)?);
+        let depth = take(4)? as u32 as i32;
+        shells.push(Shell { faces, first_face, volume, depth: (depth != i32::MIN).then_some(depth) });
+    }
+    (take(1).is_none() && !volume.is_nan()).then_some(Solidity {
+        area,
+        volume: Some(volume),
+        shells,
+        defects: Vec::new(),
+    })
+}
+
+/// [`require_solid`] without the cache: always runs [`check`].
+pub fn require_solid_uncached(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
     let solidity = check(&mesh);
     if let Some(d) = first_refusal(&solidity, policy) {
         return Err(NotSolid { defect: d.clone() });

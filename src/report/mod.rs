@@ -12,7 +12,7 @@ pub use timing::{Samples, time_runs, timed};
 
 /// Where a long measurement says what it is doing: `texgeo bench` prints a line per
 /// step, `texgeo reproduce` advances a progress bar.
-pub trait Progress {
+pub trait Progress: Send {
     /// How many more steps follow (called before them; a run of several parts calls it
     /// once per part).
     fn total(&mut self, _steps: u64) {}

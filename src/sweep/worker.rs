@@ -150,7 +150,8 @@ fn run_job<T: Task>(
     faults: &Faults,
 ) -> Record {
     let start = Instant::now();
-    reset_peak_rss();
+    // The kernel's peak-RSS mark reset (Linux ≥ 4.0): the reading below is this mesh's peak.
+    crate::host::reset_peak_rss();
     let mut rec = Record::new(job.index, &job.mesh, T::NAME);
     faults.trigger(&job.mesh);
     let result = (|| -> Result<(), Failure> {
@@ -178,7 +179,7 @@ fn run_job<T: Task>(
     }
     rec.time("total", start.elapsed());
     // Without the reset (kernels before 4.0) this is the worker's peak so far.
-    rec.peak_rss_kib = peak_rss_kib();
+    rec.peak_rss_kib = crate::host::peak_rss_kib();
     rec
 }
 
@@ -215,19 +216,6 @@ fn protocol_output() -> std::io::Result<std::fs::File> {
         }
         Ok(std::fs::File::from_raw_fd(fd))
     }
-}
-
-/// Resets the kernel's peak-RSS mark of this process (Linux ≥ 4.0), so that the next
-/// reading is this mesh's peak.
-fn reset_peak_rss() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// VmHWM of this process, KiB.
-fn peak_rss_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 /// The test-only fault hook (see the module documentation).

@@ -27,3 +27,15 @@ pub fn positive_u32(s: &str) -> Result<u32, String> {
         Err(_) => Err(format!("'{s}' is not a whole number ≥ 1 (up to {})", u32::MAX)),
     }
 }
+
+/// `--threads N`: the size of the global pool every parallel step runs in (default: every
+/// core). Results never depend on it.
+pub fn use_threads(threads: Option<usize>) -> anyhow::Result<()> {
+    if let Some(n) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| anyhow::anyhow!("--threads {n}: {e}"))?;
+    }
+    Ok(())
+}

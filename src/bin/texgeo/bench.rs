@@ -64,6 +64,44 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Issue 13 at scale: inclusion at 1 k / 100 k / 1 M points (every method, `auto`
+    /// included) and voxelization at 128³ … 1024³, time and peak memory per method and
+    /// thread count; point-file and label throughput.
+    Scale {
+        /// The inclusion solid (default: armadillo.off in --models-dir, else builtin:knot).
+        #[arg(long)]
+        mesh: Option<String>,
+        /// The voxelization solid (default: the inclusion one).
+        #[arg(long)]
+        voxel_mesh: Option<String>,
+        /// Where `tools/fetch-models` put the meshes.
+        #[arg(long, default_value = "models")]
+        models_dir: PathBuf,
+        /// Query-point counts.
+        #[arg(long, value_delimiter = ',', default_values_t = bench::scale::DEFAULT_POINTS.to_vec())]
+        points: Vec<usize>,
+        /// Inclusion methods (default: all, `auto` first).
+        #[arg(long, value_delimiter = ',', value_enum)]
+        methods: Vec<texgeo::inclusion::Method>,
+        /// Voxel grid sizes N (N³; empty: no voxelization).
+        #[arg(long, value_delimiter = ',', default_values_t = bench::scale::DEFAULT_SIZES.to_vec())]
+        sizes: Vec<usize>,
+        /// Voxelization methods (default: all).
+        #[arg(long, value_delimiter = ',', value_enum)]
+        voxel_methods: Vec<texgeo::voxel::Method>,
+        /// Pool sizes to measure (default: 1 and every core).
+        #[arg(long, value_delimiter = ',', value_parser = crate::args::positive_usize)]
+        thread_counts: Vec<usize>,
+        /// Skip a measurement predicted to take longer than this many seconds.
+        #[arg(long, default_value_t = 60)]
+        budget: u64,
+        #[arg(long, default_value_t = 3, value_parser = crate::args::positive_usize)]
+        /// Timed runs per measurement (the median is reported).
+        runs: usize,
+        /// Folder for the Markdown and CSV files.
+        #[arg(long, short, default_value = "out/bench")]
+        out: PathBuf,
+    },
     /// XOR rasterization (logic op) of random triangles against the CPU scanline rasterizer.
     Xor {
         /// Target sides to measure.
@@ -175,7 +213,7 @@ fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
 pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
     // The report folder must take files before hours of measuring start.
     let out = match &cmd {
-        Command::Inclusion { out, .. } | Command::Voxelize { out, .. } => out,
+        Command::Inclusion { out, .. } | Command::Voxelize { out, .. } | Command::Scale { out, .. } => out,
         Command::Xor { common, .. }
         | Command::Reduce { common, .. }
         | Command::Subdivide { common, .. }
@@ -206,6 +244,61 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             anyhow::ensure!(!models.is_empty(), "no models to measure");
             let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
             finish(bench::voxelize::run(&ctx, &models, &cfg)?, &Common { runs, out })
+        }
+        Command::Scale {
+            mesh,
+            voxel_mesh,
+            models_dir,
+            points,
+            methods,
+            sizes,
+            voxel_methods,
+            thread_counts,
+            budget,
+            runs,
+            out,
+        } => {
+            use bench::scale::{Config, Model};
+            use texgeo::inclusion::Method;
+            let mesh = mesh.unwrap_or_else(|| {
+                let armadillo = models_dir.join("armadillo.off");
+                if armadillo.exists() { armadillo.display().to_string() } else { "builtin:knot".into() }
+            });
+            let inclusion = Model {
+                name: mesh.clone(),
+                mesh: crate::mesh::load_solid(&mesh, Default::default(), &[])?.mesh,
+            };
+            let voxel = match voxel_mesh {
+                Some(v) => Model {
+                    name: v.clone(),
+                    mesh: crate::mesh::load_solid(&v, Default::default(), &[])?.mesh,
+                },
+                None => Model { name: inclusion.name.clone(), mesh: inclusion.mesh.clone() },
+            };
+            anyhow::ensure!(points.iter().all(|&n| n > 0), "--points takes counts ≥ 1");
+            for &n in &sizes {
+                texgeo::voxel::grid::check_resolution(n)?;
+            }
+            let methods = if methods.is_empty() {
+                std::iter::once(Method::Auto).chain(Method::ALL).collect()
+            } else {
+                methods
+            };
+            let voxel_methods =
+                if voxel_methods.is_empty() { texgeo::voxel::Method::ALL.to_vec() } else { voxel_methods };
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let mut thread_counts = if thread_counts.is_empty() { vec![1, cores] } else { thread_counts };
+            thread_counts.dedup();
+            let cfg = Config {
+                points,
+                methods,
+                sizes,
+                voxel_methods,
+                threads: thread_counts,
+                runs,
+                budget: std::time::Duration::from_secs(budget),
+            };
+            finish(bench::scale::run(&ctx, &inclusion, &voxel, &cfg)?, &Common { runs, out })
         }
         Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {
             use bench::boolean::{Config, Pair, STAND_INS};

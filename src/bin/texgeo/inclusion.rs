@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use texgeo::inclusion::solver::Solver;
+use texgeo::inclusion::solver::{Solver, resolve};
 use texgeo::inclusion::{Class, Method, Options, points};
 use texgeo::mesh::solidity::Policy;
 use texgeo::random::Rng;
@@ -13,7 +13,8 @@ use texgeo::random::Rng;
 pub struct Args {
     /// The solid: a mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
     mesh: String,
-    /// Query points: one `x y z` per line, `#` comments allowed.
+    /// Query points: one `x y z` per line (`#` comments allowed), or a NumPy `.npy` N×3
+    /// array of float64 or float32.
     #[arg(long, value_name = "FILE", conflicts_with = "random", required_unless_present = "random")]
     points: Option<PathBuf>,
     /// N uniform random points in the mesh's bounding box (N ≥ 1).
@@ -22,11 +23,14 @@ pub struct Args {
     /// Seed for `--random`.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    #[arg(long, value_enum, default_value_t = Method::Gpu)]
+    /// `auto` picks the fastest exact method for the mesh and the number of points (and says
+    /// which on stderr); every method gives the same answers.
+    #[arg(long, value_enum, default_value_t = Method::Auto)]
     method: Method,
-    /// TetraGrid resolution n (n³ cells, 2..=64), for tetragrid and gpu+tetragrid.
-    #[arg(long, default_value_t = 32)]
-    grid: usize,
+    /// Grid resolution n (n³ cells): for tetragrid and gpu+tetragrid 2..=64 (default 32), for
+    /// voxel-space 2..=512 (default: from the mesh and the number of points).
+    #[arg(long)]
+    grid: Option<usize>,
     /// GPU methods: tetrahedra per point-vertex (1 = the thesis' one point per tetrahedron).
     #[arg(long, value_parser = crate::args::positive_u32)]
     batch: Option<u32>,
@@ -37,7 +41,8 @@ pub struct Args {
     /// Reverse every face of an inverted solid (faces pointing inwards) instead of refusing it.
     #[arg(long)]
     flip_inverted: bool,
-    /// Write one line per point: 1 inside, 0 outside, 2 on the boundary.
+    /// Write one line per point: 1 inside, 0 outside, 2 on the boundary (to a `.npy` path:
+    /// a uint8 array of those values).
     #[arg(short, long)]
     output: Option<PathBuf>,
 }
@@ -53,9 +58,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     // The size of the request, before anything is read or allocated.
     let count = match (&args.points, args.random) {
         (Some(file), _) => {
-            // A point takes at least 6 bytes of text ("0 0 0\n").
+            // A point takes at least 6 bytes of text ("0 0 0\n"), 12 of .npy.
             let bytes = std::fs::metadata(file).map_err(|e| texgeo::output::Error::new(file, e))?.len();
-            bytes / 6 + 1
+            if points::is_npy(file) { bytes / 12 + 1 } else { bytes / 6 + 1 }
         }
         (None, Some(n)) => n as u64,
         (None, None) => anyhow::bail!("give --points FILE or --random N"),
@@ -77,11 +82,20 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         (None, None) => unreachable!("checked above"),
     };
     let ctx = if args.method.is_cpu() { None } else { Some(crate::open_context_for(device, "cpu")?) };
-    let options =
-        Options { tetragrid_resolution: args.grid, allow_open: args.allow_open, ..Options::default() };
+    let options = Options {
+        tetragrid_resolution: args.grid.unwrap_or(texgeo::inclusion::tetragrid::DEFAULT_RESOLUTION),
+        voxel_space_resolution: args.grid,
+        points: pts.len(),
+        allow_open: args.allow_open,
+        ..Options::default()
+    };
     let t = Instant::now();
-    let mut solver = Solver::new(args.method, &mesh, &options, ctx.as_ref(), args.batch)
-        .with_context(|| format!("preparing {} for {}", args.method, args.mesh))?;
+    let (method, options, choice) = resolve(args.method, &mesh, &options);
+    if let Some(choice) = &choice {
+        eprintln!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), pts.len());
+    }
+    let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
+        .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
     let build = t.elapsed();
     if solid.open {
         eprintln!(
@@ -93,6 +107,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let classes = solver.classify_all(&pts)?;
     let run = t.elapsed();
     match &args.output {
+        Some(path) if points::is_npy(path) => {
+            texgeo::output::write_with(path, |w| points::write_classes_npy(w, &classes))?
+        }
         Some(path) => texgeo::output::write_with(path, |w| points::write_classes(w, &classes))?,
         None => {
             let count = |c: Class| classes.iter().filter(|&&x| x == c).count();

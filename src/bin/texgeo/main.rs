@@ -40,6 +40,10 @@ struct Cli {
     /// Default: TEXGEO_DEVICE, else the first GPU, else lavapipe.
     #[arg(long, global = true, value_name = "NAME|INDEX")]
     device: Option<String>,
+    /// Worker threads for every command's CPU work (default: every core); the output is the
+    /// same for any count.
+    #[arg(long, global = true, value_name = "N", value_parser = args::positive_usize)]
+    threads: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -117,6 +121,10 @@ fn main() {
         }
     };
     let device = cli.device.as_deref();
+    if let Err(e) = args::use_threads(cli.threads) {
+        eprintln!("texgeo: error: {}", one_line(&e));
+        std::process::exit(2);
+    }
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
         Command::Mesh(c) => mesh::run(c),

@@ -9,10 +9,63 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::text::{Lines, parse_coord, parse_index, write_vertices_and_faces};
+use super::text::{Lines, fast, parse_coord, parse_index, write_vertices_and_faces};
 use crate::mesh::{Mesh, Result};
 
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    if let Some(mesh) = read_fast(bytes) {
+        return Ok(mesh);
+    }
+    read_lines(bytes, path)
+}
+
+/// The fast path: plain ASCII read a byte at a time ([`fast`]); `None` sends the file to
+/// [`read_lines`], which reads the same files into the same mesh and words every error.
+fn read_fast(bytes: &[u8]) -> Option<Mesh> {
+    let mut lines = fast::ContentLines::new(bytes);
+    let header = lines.next()?;
+    let mut tokens = fast::tokens(header);
+    if !matches!(tokens.next()?, b"OFF" | b"COFF" | b"NOFF" | b"CNOFF") {
+        return None;
+    }
+    let mut counts: Vec<&[u8]> = tokens.collect();
+    if counts.is_empty() {
+        counts = fast::tokens(lines.next()?).collect();
+    }
+    let (nv, nf) = (fast::index(counts.first()?)?, fast::index(counts.get(1)?)?);
+    if nv > u32::MAX as u64 {
+        return None;
+    }
+    // Sized by what the file can hold, never by the counts alone.
+    let mut positions = Vec::with_capacity((nv as usize).min(bytes.len() / 6));
+    for _ in 0..nv {
+        let mut t = fast::tokens(lines.next()?);
+        let (x, y, z) = (fast::coord(t.next()?)?, fast::coord(t.next()?)?, fast::coord(t.next()?)?);
+        positions.push(DVec3::new(x, y, z));
+    }
+    let mut offsets = Vec::with_capacity((nf as usize).min(bytes.len() / 8) + 1);
+    offsets.push(0usize);
+    let mut indices = Vec::with_capacity(offsets.capacity() * 3);
+    for _ in 0..nf {
+        let mut t = fast::tokens(lines.next()?);
+        let n = fast::index(t.next()?)?;
+        if n < 3 {
+            return None;
+        }
+        for _ in 0..n {
+            let i = fast::index(t.next()?)?;
+            if i >= nv {
+                return None;
+            }
+            indices.push(i as u32);
+        }
+        offsets.push(indices.len());
+    }
+    Mesh::from_parts(positions, offsets, indices).ok()
+}
+
+/// The line-by-line reader: every accepted file, every error with its line.
+fn read_lines(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let mut lines = Lines::new(bytes, path)?;
     let Some((hline, header)) = lines.next_content() else {
         return Err(lines.error(1, "no OFF header (the file holds only comments or blanks)"));
@@ -91,4 +144,50 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     writeln!(w, "{} {} 0", mesh.num_vertices(), mesh.num_faces())?;
     write_vertices_and_faces(&mut w, mesh)?;
     w.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Rng;
+
+    /// The fast path reads what the line reader reads, or leaves the file to it: on valid
+    /// files, on files with comments and odd spacing, and on thousands of byte mutations.
+    #[test]
+    fn fast_path_agrees_with_the_line_reader() {
+        let p = Path::new("m.off");
+        let mut texts: Vec<Vec<u8>> = Vec::new();
+        for name in crate::mesh::procedural::BUILTIN_NAMES {
+            let m = crate::mesh::procedural::by_name(name).unwrap();
+            let mut out = Vec::new();
+            write(&mut out, &m).unwrap();
+            assert_eq!(read_fast(&out).as_ref(), Some(&m), "{name}");
+            texts.push(out);
+        }
+        texts.push(
+            b"OFF 4 4\n0 0 0\n1 0 0 # c\n0 1 0\n\n0 0 1 9 9\n3 0 2 1\n3 0 1 3\n3 1 2 3 7\n3 2 0 3\n".to_vec(),
+        );
+        texts.push(b"# lead\nCOFF\n 4\t4 6\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n".to_vec());
+        let mut rng = Rng::new(5);
+        let alphabet = b"0123456789 .-+e#\n\x0bx";
+        for base in texts.clone() {
+            assert_eq!(read_fast(&base), read_lines(&base, p).ok());
+            for _ in 0..300 {
+                let mut t = base.clone();
+                for _ in 0..1 + rng.below(3) {
+                    let at = rng.below(t.len() as u64) as usize;
+                    match rng.below(3) {
+                        0 => t[at] = alphabet[rng.below(alphabet.len() as u64) as usize],
+                        1 => {
+                            t.remove(at);
+                        }
+                        _ => t.insert(at, alphabet[rng.below(alphabet.len() as u64) as usize]),
+                    }
+                }
+                if let Some(m) = read_fast(&t) {
+                    assert_eq!(Some(m), read_lines(&t, p).ok(), "{}", String::from_utf8_lossy(&t));
+                }
+            }
+        }
+    }
 }

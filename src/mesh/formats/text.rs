@@ -105,3 +105,130 @@ pub(crate) fn write_vertices_and_faces(
     }
     Ok(())
 }
+
+/// The fast path of the text readers: the same grammar as [`Lines`] + [`parse_coord`] /
+/// [`parse_index`] on plain ASCII, a byte at a time, without allocating. Anything it is not
+/// sure of (a non-ASCII byte, a token it cannot parse) makes it give up (`None`), and the
+/// reader runs its line-by-line path, which accepts the same files and words the errors.
+pub(crate) mod fast {
+    /// ASCII whitespace as `str::split_whitespace` and `str::trim` see it.
+    #[inline]
+    fn is_space(b: u8) -> bool {
+        b == b' ' || (9..=13).contains(&b)
+    }
+
+    /// The content lines of `bytes` (comment after `#` removed, trimmed, non-empty), or
+    /// `None` as soon as a non-ASCII byte shows up.
+    pub struct ContentLines<'a> {
+        rest: &'a [u8],
+        /// A non-ASCII byte was seen: the caller must use the slow path.
+        pub failed: bool,
+    }
+
+    impl<'a> ContentLines<'a> {
+        pub fn new(bytes: &'a [u8]) -> ContentLines<'a> {
+            ContentLines { rest: bytes, failed: false }
+        }
+    }
+
+    impl<'a> Iterator for ContentLines<'a> {
+        type Item = &'a [u8];
+        #[inline]
+        fn next(&mut self) -> Option<&'a [u8]> {
+            while !self.rest.is_empty() {
+                let end = self.rest.iter().position(|&b| b == b'\n').unwrap_or(self.rest.len());
+                let line = &self.rest[..end];
+                self.rest = &self.rest[(end + 1).min(self.rest.len())..];
+                if !line.is_ascii() {
+                    self.failed = true;
+                    self.rest = &[];
+                    return None;
+                }
+                let line = match line.iter().position(|&b| b == b'#') {
+                    Some(c) => &line[..c],
+                    None => line,
+                };
+                let start = line.iter().position(|&b| !is_space(b)).unwrap_or(line.len());
+                let end = line.iter().rposition(|&b| !is_space(b)).map_or(start, |e| e + 1);
+                let line = &line[start..end.max(start)];
+                if !line.is_empty() {
+                    return Some(line);
+                }
+            }
+            None
+        }
+    }
+
+    /// The whitespace-separated tokens of an ASCII line.
+    #[inline]
+    pub fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+        line.split(|&b| is_space(b)).filter(|t| !t.is_empty())
+    }
+
+    /// A finite f64, parsed exactly as `str::parse` would (correctly rounded); `None` for
+    /// anything else (the slow path then explains).
+    #[inline]
+    pub fn coord(token: &[u8]) -> Option<f64> {
+        // Only the characters of decimal numbers: `str::parse` also takes "inf", "nan" and
+        // friends, which are refused anyway, and leaves nothing else for fast-float to differ on.
+        if !token.iter().all(|&b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E')) {
+            return None;
+        }
+        let v: f64 = fast_float2::parse(token).ok()?;
+        v.is_finite().then_some(v)
+    }
+
+    /// A non-negative integer (`str::parse::<u64>` grammar: an optional `+`, then digits).
+    #[inline]
+    pub fn index(token: &[u8]) -> Option<u64> {
+        let digits = token.strip_prefix(b"+").unwrap_or(token);
+        if digits.is_empty() || digits.len() > 19 {
+            return None;
+        }
+        let mut v = 0u64;
+        for &b in digits {
+            if !b.is_ascii_digit() {
+                return None;
+            }
+            v = v * 10 + (b - b'0') as u64;
+        }
+        Some(v)
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+        use crate::random::Rng;
+
+        #[test]
+        fn numbers_parse_like_the_standard_library() {
+            let mut rng = Rng::new(11);
+            let alphabet = b"0123456789.-+eE";
+            let mut tried = 0;
+            for len in 1..12 {
+                for _ in 0..4000 {
+                    let t: Vec<u8> =
+                        (0..len).map(|_| alphabet[rng.below(alphabet.len() as u64) as usize]).collect();
+                    let s = std::str::from_utf8(&t).unwrap();
+                    let std = s.parse::<f64>().ok().filter(|v| v.is_finite());
+                    assert_eq!(coord(&t).map(f64::to_bits), std.map(f64::to_bits), "{s}");
+                    assert_eq!(index(&t), s.parse::<u64>().ok(), "{s}");
+                    tried += 1;
+                }
+            }
+            for s in ["1.5e300", "-0", "0.1", "4.9406564584124654e-324", "1e400", "123456789012345678901"] {
+                let std = s.parse::<f64>().ok().filter(|v| v.is_finite());
+                assert_eq!(coord(s.as_bytes()).map(f64::to_bits), std.map(f64::to_bits), "{s}");
+                assert_eq!(index(s.as_bytes()), s.parse::<u64>().ok(), "{s}");
+            }
+            assert!(tried > 40_000);
+            assert_eq!(coord(b"inf"), None);
+            let lines: Vec<&[u8]> = ContentLines::new(b"  a b # c\n\n# x\r\n d\r\n").collect();
+            assert_eq!(lines, vec![&b"a b"[..], &b"d"[..]]);
+            let mut l = ContentLines::new("1 2\n\u{e9}\n".as_bytes());
+            assert_eq!(l.next(), Some(&b"1 2"[..]));
+            assert_eq!(l.next(), None);
+            assert!(l.failed);
+        }
+    }
+}

@@ -312,7 +312,14 @@ pub fn measure(
     progress: &mut dyn Progress,
 ) -> Result<Vec<Measured>, InclusionError> {
     progress.total(steps(models.len(), cfg));
-    models.iter().map(|model| measure_model(ctx, model, cfg, progress)).collect()
+    // The thesis' CPU columns are one thread: the tables run in a one-thread pool (the
+    // classifiers use every core of the current pool otherwise; `texgeo bench scale`
+    // measures that).
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| InclusionError::Options(format!("a one-thread pool: {e}")))?;
+    one.install(|| models.iter().map(|model| measure_model(ctx, model, cfg, progress)).collect())
 }
 
 /// `texgeo bench inclusion`: [`measure`] and [`report`].

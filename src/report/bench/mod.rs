@@ -3,6 +3,7 @@
 pub mod boolean;
 pub mod inclusion;
 pub mod reduce;
+pub mod scale;
 pub mod subdiv;
 pub mod voxelize;
 pub mod xor;

@@ -1,0 +1,431 @@
+//! Inclusion by voxel space (§4.2.1.1, "algoritmo de inclusión basado en espacio de
+//! voxels", made exact): a uniform grid over the solid's bounding cube whose cells are
+//! labelled once — *surface* where some face may come within ε of the cell, else *inside*
+//! or *outside* — so a point in a labelled cell is answered in O(1), and only points in
+//! surface cells run an exact test on their cell's list of covering triangles. The thesis
+//! lists the method among the inexact ones because the labels of "partially included"
+//! cells are approximate; here no partial cell gets a label, so every answer is exact.
+//!
+//! ## Building
+//!
+//! 1. **Surface cells** by conservative rasterization of the covering triangles (in
+//!    parallel): a cell lists triangle t when t's box grown by ε + slack reaches it and t's
+//!    plane passes within (the cell's half extent along the normal) + ε + slack of its
+//!    centre. Every cell holding a point within ε of a face lists that face's triangles.
+//! 2. **Labels** of the other cells: the class of the cell's centre, from the project's
+//!    exact scanline voxelizer ([`crate::voxel::scanline`]) over the same grid (its voxel
+//!    centres are these cells' centres). No face comes within ε of such a cell, so all its
+//!    points share its centre's class. A cell whose computed centre rounds out of the cell
+//!    (coordinates so far from the origin that the cell is a few ulps wide) stays a surface
+//!    cell.
+//!
+//! ## A point in a surface cell
+//!
+//! First the boundary: the exact "within ε of a face" predicate ([`Surface::on_face`]) for
+//! the faces of the cell's triangles (the same predicate, so the same OnBoundary answers,
+//! as every other method). Otherwise P is off the surface (in the plane of a non-convex
+//! face it is first moved ε/2 off that plane, as [`Surface::off_polygon_planes`] says
+//! why), and its class is the parity of
+//! the crossings of a ray from P along +x (the exact predicates and tie rule of
+//! [`crate::voxel::exact`]): the ray walks along P's row of cells to the first labelled
+//! cell (or out of the grid); with R the point of that cell's centre abscissa on P's line,
+//! class(P) = class(R) (its label; outside beyond the grid) XOR the parity of the crossings
+//! between P and R. Those crossings lie in the surface cells walked, so only their lists
+//! are tested, each triangle once.
+//! This is Feito-Torres' sum with the apex at infinity along −x (its tetras become prisms
+//! along x) taken between P and R.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::{InclusionError, Result};
+use super::surface::Surface;
+use crate::mesh::Mesh;
+use crate::tetragrid::Cells;
+use crate::voxel::exact::{crossing_ahead, inside_yz, orient2d};
+
+/// Resolutions the method accepts (n³ cells).
+pub const RESOLUTIONS: std::ops::RangeInclusive<usize> = 2..=512;
+
+const OUTSIDE: u32 = 0;
+const INSIDE: u32 = 1;
+/// `state` values from here on are surface cells: `state − FIRST_SURFACE` indexes their lists.
+const FIRST_SURFACE: u32 = 2;
+
+/// The grid size for `triangles` covering triangles and about `points` query points: the
+/// cost model of [`super::auto`] (see there for the measurements behind it).
+pub fn resolution_for(triangles: usize, points: usize) -> usize {
+    super::auto::voxel_space_resolution(triangles, points)
+}
+
+/// The exact voxel-space classifier.
+#[derive(Clone, Debug)]
+pub struct VoxelSpace {
+    surface: Surface,
+    cells: Cells,
+    /// Per cell: [`OUTSIDE`], [`INSIDE`], or [`FIRST_SURFACE`] + the index of its list.
+    state: Vec<u32>,
+    /// Per cell, one byte: 0 outside, 1 inside, 2 surface — what most points read (a
+    /// quarter of `state`'s memory, so it stays in cache).
+    labels: Vec<u8>,
+    /// Box of every covering triangle: x, y, z ranges (`[xlo, xhi, ylo, yhi, zlo, zhi]`).
+    boxes: Vec<[f64; 6]>,
+    /// Per column i: the abscissa of its centre, when it rounds into the column.
+    column_x: Vec<Option<f64>>,
+    /// Lists of the surface cells (CSR, covering triangle ids in increasing order).
+    start: Vec<u32>,
+    ids: Vec<u32>,
+    stats: BuildStats,
+    surface_cells: usize,
+}
+
+impl VoxelSpace {
+    /// Labels an n³ grid over `mesh` (closed and consistently oriented; under `allow_open`
+    /// the factory sends open surfaces to the winding number instead).
+    pub fn new(mesh: &Mesh, n: usize, allow_open: bool) -> Result<VoxelSpace> {
+        let start_time = Instant::now();
+        let surface = Surface::with_policy(mesh, allow_open)?;
+        VoxelSpace::with_surface(surface, n, start_time)
+    }
+
+    fn with_surface(surface: Surface, n: usize, start_time: Instant) -> Result<VoxelSpace> {
+        if !RESOLUTIONS.contains(&n) {
+            return Err(InclusionError::Options(format!(
+                "voxel-space resolution {n} is outside {}..={}",
+                RESOLUTIONS.start(),
+                RESOLUTIONS.end()
+            )));
+        }
+        let num_cells = n * n * n;
+        crate::host::check_available(num_cells as u64 * 5).map_err(|(need, have)| {
+            InclusionError::TooLarge(format!(
+                "a {n}³ voxel space needs {need} MiB, only {have} MiB are available"
+            ))
+        })?;
+        let (lo, hi) = surface.bounds();
+        let eps = surface.eps();
+        let cells = Cells::around(lo, hi, 4.0 * eps, n);
+        let covering = surface.covering();
+        let dbg = std::env::var_os("TEXGEO_DBG").is_some();
+        let t0 = Instant::now();
+        if dbg {
+            eprintln!("surface {:?}", start_time.elapsed());
+        }
+        // 1. Surface cells: (cell << 32 | triangle) for every listing, sorted.
+        let h = cells.cell;
+        let slack = 1e-9 * h + 8.0 * f64::EPSILON * (cells.lo.abs().max_element() + h * n as f64);
+        let grow = eps + slack;
+        let mut entries: Vec<u64> = (0..covering.triangles.len())
+            .into_par_iter()
+            .with_min_len(2048)
+            .fold(Vec::new, |mut out: Vec<u64>, t| {
+                let [a, b, c] = covering.triangle(t);
+                let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                let reach = 0.5 * h * normal.abs().element_sum() + grow;
+                let base = cells.lo - a;
+                let [rx, ry, rz] = cells.ranges(tlo, thi);
+                for k in rz {
+                    for j in ry.clone() {
+                        for i in rx.clone() {
+                            let centre =
+                                base + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
+                            if normal != DVec3::ZERO && normal.dot(centre).abs() > reach {
+                                continue;
+                            }
+                            out.push((cells.index([i, j, k]) as u64) << 32 | t as u64);
+                        }
+                    }
+                }
+                out
+            })
+            .reduce(Vec::new, |mut x, mut y| {
+                if x.len() < y.len() {
+                    std::mem::swap(&mut x, &mut y);
+                }
+                x.extend(y);
+                x
+            });
+        entries.par_sort_unstable();
+        let mut state = vec![u32::MAX; num_cells];
+        let mut start = Vec::new();
+        let mut ids = Vec::with_capacity(entries.len());
+        for run in entries.chunk_by(|x, y| x >> 32 == y >> 32) {
+            state[(run[0] >> 32) as usize] = FIRST_SURFACE + start.len() as u32;
+            start.push(ids.len() as u32);
+            ids.extend(run.iter().map(|&e| e as u32));
+        }
+        start.push(ids.len() as u32);
+        drop(entries);
+        if dbg {
+            eprintln!("raster {:?}", t0.elapsed());
+        }
+        // 2. Labels: the exact class of every cell centre, from the scanline voxelizer.
+        let grid = crate::voxel::Grid::new(n, cells.lo, h * n as f64)
+            .map_err(|e| InclusionError::Options(format!("voxel space: {e}")))?;
+        let solid = crate::voxel::Solid {
+            triangles: (0..covering.triangles.len()).map(|t| covering.triangle(t)).collect(),
+            apex: (lo + hi) * 0.5,
+        };
+        let volume = crate::voxel::scanline::voxelize(&solid, &grid)
+            .map_err(|e| InclusionError::Options(format!("voxel space: {e}")))?;
+        if dbg {
+            eprintln!("scanline {:?}", t0.elapsed());
+        }
+        let mut surface_cells = start.len() - 1;
+        // The centre the scanline classified must lie in its own cell: per axis, the
+        // indices whose centre coordinate maps back to them.
+        let fits = |axis: usize, min: f64| -> Vec<bool> {
+            (0..n).map(|i| cells.coords_axis(grid.centre_coord(min, i), axis) == Some(i)).collect()
+        };
+        let (fx, fy, fz) = (fits(0, grid.min.x), fits(1, grid.min.y), fits(2, grid.min.z));
+        state.par_chunks_mut(n * n).enumerate().for_each(|(k, slice)| {
+            for j in 0..n {
+                let row = volume.row(j, k);
+                for (i, s) in slice[j * n..(j + 1) * n].iter_mut().enumerate() {
+                    if *s == u32::MAX && fx[i] && fy[j] && fz[k] {
+                        *s = if row[i / 64] >> (i % 64) & 1 == 1 { INSIDE } else { OUTSIDE };
+                    }
+                }
+            }
+        });
+        // Cells whose centre rounded away are surface cells with empty lists (their points
+        // walk to a labelled cell).
+        for s in state.iter_mut().filter(|s| **s == u32::MAX) {
+            *s = FIRST_SURFACE + surface_cells as u32;
+            surface_cells += 1;
+            start.push(ids.len() as u32);
+        }
+        if dbg {
+            eprintln!("labels {:?}", t0.elapsed());
+        }
+        let labels = state.par_iter().with_min_len(1 << 16).map(|&s| s.min(FIRST_SURFACE) as u8).collect();
+        let boxes = solid
+            .triangles
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&[a, b, c]| {
+                let (l, h) = (a.min(b).min(c), a.max(b).max(c));
+                [l.x, h.x, l.y, h.y, l.z, h.z]
+            })
+            .collect();
+        let column_x = (0..n)
+            .map(|i| {
+                let x = cells.lo.x + (i as f64 + 0.5) * cells.cell;
+                (cells.coords_axis(x, 0) == Some(i)).then_some(x)
+            })
+            .collect();
+        let mut vs = VoxelSpace {
+            surface,
+            cells,
+            state,
+            labels,
+            boxes,
+            column_x,
+            start,
+            ids,
+            stats: BuildStats::default(),
+            surface_cells,
+        };
+        vs.stats = BuildStats {
+            build_time: start_time.elapsed(),
+            bytes: vs.surface.bytes()
+                + vec_bytes(&vs.state)
+                + vec_bytes(&vs.labels)
+                + vec_bytes(&vs.boxes)
+                + vec_bytes(&vs.start)
+                + vec_bytes(&vs.ids),
+        };
+        Ok(vs)
+    }
+
+    pub fn resolution(&self) -> usize {
+        self.cells.n
+    }
+
+    /// Cells that are surface cells (hold a list) out of n³.
+    pub fn surface_cells(&self) -> usize {
+        self.surface_cells
+    }
+
+    /// Total entries of the lists.
+    pub fn entries(&self) -> usize {
+        self.ids.len()
+    }
+
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    #[inline]
+    fn list(&self, s: u32) -> &[u32] {
+        let k = (s - FIRST_SURFACE) as usize;
+        &self.ids[self.start[k] as usize..self.start[k + 1] as usize]
+    }
+
+    /// The label of cell `c` if it has one, `None` for a surface cell.
+    pub fn label(&self, c: usize) -> Option<Class> {
+        match self.state[c] {
+            OUTSIDE => Some(Class::Outside),
+            INSIDE => Some(Class::Inside),
+            _ => None,
+        }
+    }
+
+    /// The exact test for a point in surface cell `[i, j, k]` (see the module docs).
+    fn classify_near(&self, p: DVec3, [i, j, k]: [usize; 3], s: u32) -> Class {
+        let list = self.list(s);
+        let eps = self.surface.eps();
+        let covering = self.surface.covering();
+        let near = |b: &[f64; 6]| {
+            p.x >= b[0] - eps
+                && p.x <= b[1] + eps
+                && p.y >= b[2] - eps
+                && p.y <= b[3] + eps
+                && p.z >= b[4] - eps
+                && p.z <= b[5] + eps
+        };
+        if list.iter().any(|&t| {
+            near(&self.boxes[t as usize]) && self.surface.on_face(covering.face_of[t as usize] as usize, p)
+        }) {
+            return Class::OnBoundary;
+        }
+        // In the plane of a non-convex face over its cancelled part, the overlapping fan
+        // triangles would see P on sides decided by rounding: classify P moved ε/2 off
+        // that plane (same class, P being > ε from every face), from the moved point's cell.
+        let moved = self.surface.off_polygon_planes(p, list.iter().map(|&t| t as usize));
+        if moved != p {
+            let n = self.cells.n;
+            return match self.lookup(moved) {
+                (_, 0) => Class::Outside,
+                (_, 1) => Class::Inside,
+                (c, _) => self.parity(moved, [c % n, c / n % n, c / (n * n)]),
+            };
+        }
+        self.parity(p, [i, j, k])
+    }
+
+    /// The class of a point `p` in surface cell `[i, j, k]`, off the boundary: the parity
+    /// walk of the module docs.
+    fn parity(&self, p: DVec3, [i, j, k]: [usize; 3]) -> Class {
+        let covering = self.surface.covering();
+        let n = self.cells.n;
+        let row = |m: usize| self.cells.index([m, j, k]);
+        // The walk: the first labelled cell along +x whose centre abscissa lies in it.
+        let mut end = i + 1;
+        let mut reference: Option<(f64, bool)> = None;
+        while end < n {
+            let c = row(end);
+            if self.labels[c] < 2 {
+                if let Some(x) = self.column_x[end] {
+                    reference = Some((x, self.labels[c] == 1));
+                    break;
+                }
+            }
+            end += 1;
+        }
+        let r = reference.map(|(x, _)| DVec3::new(x, p.y, p.z));
+        let r_x = r.map_or(f64::INFINITY, |r| r.x);
+        let mut parity = reference.is_some_and(|(_, inside)| inside);
+        // The triangles that may cross P's line between P and R, each once: a triangle is
+        // listed in several cells of the row (sorted and deduplicated here rather than
+        // trusting its cells to be consecutive, which rounding need not keep).
+        let mut candidates: Vec<u32> = Vec::new();
+        for m in i..end {
+            let c = row(m);
+            if self.labels[c] != 2 {
+                continue;
+            }
+            for &t in self.list(self.state[c]) {
+                // Exact comparisons first: a triangle whose yz box misses P's line, whose x
+                // range ends before P or starts beyond R, cannot flip the parity.
+                let b = &self.boxes[t as usize];
+                if p.y < b[2] || p.y > b[3] || p.z < b[4] || p.z > b[5] || b[1] < p.x || b[0] > r_x {
+                    continue;
+                }
+                candidates.push(t);
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        for t in candidates {
+            let [a, b, c] = covering.triangle(t as usize);
+            let nx = orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
+            if nx == 0 || !inside_yz(a, b, c, p, nx) {
+                continue;
+            }
+            if crossing_ahead(a, b, c, p, nx) && !r.is_some_and(|r| crossing_ahead(a, b, c, r, nx)) {
+                parity = !parity;
+            }
+        }
+        if parity { Class::Inside } else { Class::Outside }
+    }
+}
+
+impl VoxelSpace {
+    /// The cell of `p` and its label byte (0 outside, 1 inside, 2 surface); points outside
+    /// the bounding box grown by ε get (0, 0). The arithmetic of [`Cells::coords`]: after
+    /// the box test every quotient is ≥ 0, where truncation is the floor.
+    #[inline]
+    fn lookup(&self, p: DVec3) -> (usize, u8) {
+        if !self.surface.in_bounds(p) {
+            return (0, 0);
+        }
+        let t = (p - self.cells.lo) / self.cells.cell;
+        let n = self.cells.n as f64;
+        if !(t.cmpge(DVec3::ZERO).all() && t.cmplt(DVec3::splat(n)).all()) {
+            return (0, 0);
+        }
+        let c = self.cells.index([t.x as usize, t.y as usize, t.z as usize]);
+        (c, self.labels[c])
+    }
+
+    #[inline]
+    fn near(&self, p: DVec3, c: usize) -> Class {
+        let n = self.cells.n;
+        self.classify_near(p, [c % n, c / n % n, c / (n * n)], self.state[c])
+    }
+}
+
+impl Classifier for VoxelSpace {
+    fn name(&self) -> &str {
+        "voxel-space"
+    }
+
+    #[inline]
+    fn classify(&self, p: DVec3) -> Class {
+        match self.lookup(p) {
+            (_, 0) => Class::Outside,
+            (_, 1) => Class::Inside,
+            (c, _) => self.near(p, c),
+        }
+    }
+
+    /// In chunks: first every point's label byte, with no branch on the loaded bytes (so
+    /// the memory reads of many points overlap), then the exact test for the points in
+    /// surface cells.
+    fn classify_all(&self, ps: &[DVec3]) -> Vec<Class> {
+        let mut out = vec![Class::Outside; ps.len()];
+        out.par_chunks_mut(2048).zip(ps.par_chunks(2048)).for_each(|(out, ps)| {
+            let mut cells = [(0usize, 0u8); 2048];
+            for (slot, &p) in cells.iter_mut().zip(ps) {
+                *slot = self.lookup(p);
+            }
+            for ((o, &p), &(c, label)) in out.iter_mut().zip(ps).zip(cells.iter()) {
+                *o = match label {
+                    0 => Class::Outside,
+                    1 => Class::Inside,
+                    _ => self.near(p, c),
+                };
+            }
+        });
+        out
+    }
+
+    fn build_stats(&self) -> BuildStats {
+        self.stats
+    }
+}

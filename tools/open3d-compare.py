@@ -1,0 +1,134 @@
+"""texgeo inclusion vs open3d's occupancy query; run through tools/open3d-compare.
+
+--open3d MESH POINTS [-o LABELS]: one open3d run (read, RaycastingScene build, compute_occupancy,
+write), its phase times on stderr. Otherwise: for each points file, `texgeo inclusion MESH
+--points P -o L` and the open3d run alternate --runs times as separate processes; the table
+gives median wall time and peak RSS (wait4) of each whole process, open3d's own build+query
+time (RaycastingScene + compute_occupancy, timed inside its process), and how many labels
+agree (open3d has no boundary class: texgeo's boundary points are left out).
+"""
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def read_points(path):
+    import numpy as np
+
+    if path.endswith(".npy"):
+        return np.load(path).astype(np.float32).reshape(-1, 3)
+    with open(path, "rb") as f:
+        text = f.read()
+    # Comments (`#` to the end of the line) are allowed in texgeo's format.
+    if b"#" in text:
+        text = b"\n".join(line.split(b"#", 1)[0] for line in text.splitlines())
+    return np.array(text.split(), dtype=np.float32).reshape(-1, 3)
+
+
+def run_open3d(mesh_path, points_path, out):
+    import numpy as np
+    import open3d as o3d
+
+    t0 = time.perf_counter()
+    mesh = o3d.io.read_triangle_mesh(mesh_path)
+    if len(mesh.triangles) == 0:
+        sys.exit(f"open3d read no triangles from {mesh_path}")
+    pts = read_points(points_path)
+    t1 = time.perf_counter()
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    occ = scene.compute_occupancy(o3d.core.Tensor(pts, dtype=o3d.core.Dtype.Float32))
+    t2 = time.perf_counter()
+    labels = occ.numpy().astype(np.uint8)
+    t3 = time.perf_counter()
+    if out:
+        lines = np.empty((len(labels), 2), dtype=np.uint8)
+        lines[:, 0] = labels + ord("0")
+        lines[:, 1] = ord("\n")
+        with open(out, "wb") as f:
+            f.write(lines.tobytes())
+    t4 = time.perf_counter()
+    print(
+        f"open3d: read {1e3 * (t1 - t0):.1f} ms, build+query {1e3 * (t2 - t1):.1f} ms, "
+        f"write {1e3 * (t4 - t3):.1f} ms, {len(labels)} points, {int(labels.sum())} inside",
+        file=sys.stderr,
+    )
+
+
+def measured(cmd):
+    """(wall seconds, peak RSS MiB) of one process."""
+    t = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.exit(f"{' '.join(cmd)} failed:\n{err}")
+    return wall, usage.ru_maxrss / 1024.0, err
+
+
+def compare(args):
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    texgeo = args.texgeo or os.path.join(root, "target", "release", "texgeo")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for points in args.points:
+            ours, theirs = os.path.join(tmp, "texgeo.txt"), os.path.join(tmp, "open3d.txt")
+            t_cmd = [texgeo, *args.texgeo_args.split(), "inclusion", args.mesh, "--points", points, "-o", ours]
+            o_cmd = [sys.executable, os.path.abspath(__file__), "--open3d", args.mesh, points, "-o", theirs]
+            t_runs, o_runs = [], []
+            for _ in range(args.runs):
+                t_runs.append(measured(t_cmd))
+                o_runs.append(measured(o_cmd))
+            with open(ours, "rb") as f:
+                a = f.read().split()
+            with open(theirs, "rb") as f:
+                b = f.read().split()
+            decided = [(x, y) for x, y in zip(a, b) if x != b"2"]
+            agree = sum(x == y for x, y in decided)
+            med = lambda runs, i: statistics.median(r[i] for r in runs)
+            inner = statistics.median(float(r[2].split("build+query ")[1].split(" ms")[0]) / 1e3 for r in o_runs)
+            out_mib = os.path.getsize(ours) / 2**20
+            rows.append((points, len(a), med(t_runs, 0), med(o_runs, 0), inner, med(t_runs, 1), med(o_runs, 1), out_mib, agree, len(decided)))
+            print(f"texgeo: {t_runs[-1][2].strip()}", file=sys.stderr)
+            print(o_runs[-1][2].strip(), file=sys.stderr)
+    print(f"\n{args.mesh}, {args.runs} runs each, alternating; whole processes\n")
+    print(
+        "| points file | points | texgeo s | open3d s | open3d build+query s | texgeo / open3d build+query "
+        "| texgeo peak MiB | open3d peak MiB | labels MiB | agree (off the boundary) |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    for p, n, tt, ot, inner, tm, om, out, agree, decided in rows:
+        print(
+            f"| {os.path.basename(p)} | {n} | {tt:.3f} | {ot:.3f} | {inner:.3f} | {tt / inner:.2f} "
+            f"| {tm:.0f} | {om:.0f} | {out:.1f} | {agree}/{decided} |"
+        )
+
+
+def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--open3d":
+        p = argparse.ArgumentParser(prog="tools/open3d-compare --open3d")
+        p.add_argument("--open3d", action="store_true")
+        p.add_argument("mesh")
+        p.add_argument("points")
+        p.add_argument("-o", "--output")
+        a = p.parse_args()
+        run_open3d(a.mesh, a.points, a.output)
+        return
+    p = argparse.ArgumentParser(prog="tools/open3d-compare")
+    p.add_argument("mesh")
+    p.add_argument("points", nargs="+")
+    p.add_argument("--runs", type=int, default=5)
+    p.add_argument("--texgeo", help="texgeo binary (default target/release/texgeo)")
+    p.add_argument("--texgeo-args", default="", help="global texgeo options, e.g. '--threads 1'")
+    compare(p.parse_args())
+
+
+if __name__ == "__main__":
+    main()
