@@ -137,10 +137,30 @@ fn voxelize_writes_binvox_slices_and_aspect() {
         (vec!["voxelize", "builtin:cube", "--res", "5000", "-o", &x], "1024"),
         (
             vec!["voxelize", "builtin:cube", "--res", "8", "--method", "magic", "-o", &x],
-            "[possible values: cpu, fgpu",
+            "no method 'magic' (auto, cpu, fgpu",
         ),
     ] {
         assert_refused(&texgeo(&args), &[expect]);
+    }
+}
+
+#[test]
+fn voxelize_defaults_to_auto_which_names_its_pick_and_gives_the_exact_voxels() {
+    let dir = TempDir::new("cli-voxelize-auto");
+    let auto = dir.arg("auto.binvox");
+    let o = texgeo(&["voxelize", "builtin:knot", "--res", "40", "-o", &auto]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let line = err.lines().find(|l| l.contains("--method auto: ")).unwrap_or_else(|| panic!("{err}"));
+    let picked = line.split("--method auto: ").nth(1).unwrap().split(' ').next().unwrap();
+    assert!(texgeo::voxel::Method::parse(picked).is_some(), "{line}");
+    assert!(stdout(&o).contains(&format!("method {picked} in")), "{}", stdout(&o));
+    let auto = std::fs::read(&auto).unwrap();
+    for method in ["scanline", "cpu", "fang", "auto"] {
+        let out = dir.arg(&format!("{method}.binvox"));
+        let o = texgeo(&["voxelize", "builtin:knot", "--res", "40", "--method", method, "-o", &out]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert!(std::fs::read(&out).unwrap() == auto, "{method} differs from auto");
     }
 }
 
