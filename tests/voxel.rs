@@ -9,7 +9,9 @@ use texgeo::gpu::Context;
 use texgeo::inclusion::{Class, Classifier, FeitoTorres};
 use texgeo::mesh::{Mesh, procedural};
 use texgeo::random::Rng;
-use texgeo::voxel::{Grid, Method, Solid, Volume, VoxelError, Voxelizer, binvox, cpu, exact, scanline, voxelize};
+use texgeo::voxel::{
+    Grid, Method, Solid, Volume, VoxelError, Voxelizer, binvox, cpu, exact, scanline, voxelize,
+};
 
 fn gpu() -> Context {
     Context::from_env().expect("a Vulkan device (run tools/setup)")

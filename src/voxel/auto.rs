@@ -140,8 +140,10 @@ impl Plan {
     /// caller that has no device open can first ask with [`Device::Gpu`] (draws free): if
     /// a CPU method still wins, no device is needed at all.
     pub fn choose(counts: Counts, device: Device, threads: usize) -> Plan {
-        let mut estimates: Vec<(Method, f64)> =
-            Method::ALL.iter().filter_map(|&m| estimate(m, &counts, device, threads).map(|t| (m, t))).collect();
+        let mut estimates: Vec<(Method, f64)> = Method::ALL
+            .iter()
+            .filter_map(|&m| estimate(m, &counts, device, threads).map(|t| (m, t)))
+            .collect();
         // Ties (equal estimates) go to the earlier method of `Method::ALL`: a stable sort.
         estimates.sort_by(|a, b| a.1.total_cmp(&b.1));
         let method = estimates.first().map_or(Method::Scanline, |e| e.0);

@@ -190,9 +190,10 @@ pub fn voxelize(solid: &Solid, grid: &Grid) -> Result<Volume> {
     let lists = slab_lists(
         n,
         slab,
-        solid.triangles.iter().map(|[a, b, c]| {
-            index_range(grid.min.y, h, n, a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y))
-        }),
+        solid
+            .triangles
+            .iter()
+            .map(|[a, b, c]| index_range(grid.min.y, h, n, a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y))),
     );
     volume.par_slabs(slab, |mut s| {
         let slices = s.slices();

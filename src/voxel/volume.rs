@@ -239,9 +239,10 @@ impl Volume {
         use rayon::prelude::*;
         let (n, wpr) = (self.n, self.words_per_row);
         let slab = slab.max(1);
-        self.words.par_chunks_mut(slab * n * wpr).enumerate().for_each(|(s, words)| {
-            work(Slab { n, words_per_row: wpr, j0: s * slab, words })
-        });
+        self.words
+            .par_chunks_mut(slab * n * wpr)
+            .enumerate()
+            .for_each(|(s, words)| work(Slab { n, words_per_row: wpr, j0: s * slab, words }));
     }
 }
 
