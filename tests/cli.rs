@@ -137,11 +137,64 @@ fn voxelize_writes_binvox_slices_and_aspect() {
         (vec!["voxelize", "builtin:cube", "--res", "5000", "-o", &x], "1024"),
         (
             vec!["voxelize", "builtin:cube", "--res", "8", "--method", "magic", "-o", &x],
-            "[possible values: cpu, fgpu",
+            "no method 'magic' (auto, cpu, fgpu",
         ),
     ] {
         assert_refused(&texgeo(&args), &[expect]);
     }
+}
+
+#[test]
+fn voxelize_defaults_to_auto_which_names_its_pick_and_gives_the_exact_voxels() {
+    let dir = TempDir::new("cli-voxelize-auto");
+    let auto = dir.arg("auto.binvox");
+    let o = texgeo(&["voxelize", "builtin:knot", "--res", "40", "-o", &auto]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let line = err.lines().find(|l| l.contains("--method auto: ")).unwrap_or_else(|| panic!("{err}"));
+    let picked = line.split("--method auto: ").nth(1).unwrap().split(' ').next().unwrap();
+    assert!(texgeo::voxel::Method::parse(picked).is_some(), "{line}");
+    assert!(stdout(&o).contains(&format!("method {picked} in")), "{}", stdout(&o));
+    let auto = std::fs::read(&auto).unwrap();
+    for method in ["scanline", "cpu", "fang", "auto"] {
+        let out = dir.arg(&format!("{method}.binvox"));
+        let o = texgeo(&["voxelize", "builtin:knot", "--res", "40", "--method", method, "-o", &out]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert!(std::fs::read(&out).unwrap() == auto, "{method} differs from auto");
+    }
+}
+
+#[test]
+fn the_pipeline_cache_is_kept_in_the_cache_folder_and_survives_a_corrupt_file() {
+    let dir = TempDir::new("cli-pipeline-cache");
+    let out = dir.arg("x.binvox");
+    let run = |cache: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(["voxelize", "builtin:cube", "--res", "8", "--method", "zoned", "-o", &out])
+            .env("TEXGEO_CACHE_DIR", dir.join("cache"))
+            .env("TEXGEO_CACHE", cache)
+            .output()
+            .unwrap()
+    };
+    let folder = dir.join("cache").join("pipelines-v1");
+    let o = run("off");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!folder.exists(), "TEXGEO_CACHE=off wrote {}", folder.display());
+    let o = run("on");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let files: Vec<_> = std::fs::read_dir(&folder).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let good = std::fs::read(&files[0]).unwrap();
+    assert!(good.starts_with(b"texgeo pipeline cache 1\n") && good.len() >= 24 + 32, "{good:?}");
+    // Torn or overwritten with garbage: ignored, and replaced by a whole file.
+    for bad in [&good[..good.len() - 3], b"garbage".as_slice()] {
+        std::fs::write(&files[0], bad).unwrap();
+        let o = run("on");
+        assert!(o.status.success(), "{}", stderr(&o));
+        let again = std::fs::read(&files[0]).unwrap();
+        assert!(again.starts_with(b"texgeo pipeline cache 1\n") && again.len() >= 24 + 32, "{again:?}");
+    }
+    assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 1, "temporary files left");
 }
 
 #[test]

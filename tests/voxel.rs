@@ -9,7 +9,9 @@ use texgeo::gpu::Context;
 use texgeo::inclusion::{Class, Classifier, FeitoTorres};
 use texgeo::mesh::{Mesh, procedural};
 use texgeo::random::Rng;
-use texgeo::voxel::{Grid, Method, Solid, Volume, VoxelError, Voxelizer, exact, voxelize};
+use texgeo::voxel::{
+    Grid, Method, Solid, Volume, VoxelError, Voxelizer, binvox, cpu, exact, scanline, voxelize,
+};
 
 fn gpu() -> Context {
     Context::from_env().expect("a Vulkan device (run tools/setup)")
@@ -151,6 +153,34 @@ fn every_method_matches_the_exact_test_on_builtin_solids() {
         for n in [64, 128] {
             let expected = voxelize(None, mesh, n, Method::Scanline).unwrap().volume;
             all_methods_equal(&mut v, name, mesh, n, &expected);
+        }
+    }
+}
+
+#[test]
+fn parallel_rasterizers_and_encoder_give_the_same_bits_for_any_thread_count() {
+    let in_pool = |threads: usize, work: &(dyn Fn() -> (Volume, Volume, Vec<u8>) + Sync)| {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(work)
+    };
+    for (name, mesh) in [("knot", procedural::torus_knot()), ("cavity", procedural::cube_with_cavity())] {
+        // Sizes below, at and above one slab per slice, and rows of 1, 2 and 3 words.
+        for n in [1, 7, 64, 130, 150] {
+            let grid = Grid::for_mesh(&mesh, n).unwrap();
+            let solid = Solid::new(&mesh).unwrap();
+            let run = || {
+                let s = scanline::voxelize(&solid, &grid).unwrap();
+                let c = cpu::voxelize(&solid, &grid).unwrap().0;
+                let bytes = binvox::to_bytes(&grid, &s).unwrap();
+                (s, c, bytes)
+            };
+            let one = in_pool(1, &run);
+            assert_eq!(one.0, one.1, "{name} {n}³: cpu and scanline differ");
+            for threads in [2, 3, 5] {
+                let many = in_pool(threads, &run);
+                assert_eq!(many.0, one.0, "{name} {n}³ scanline, {threads} threads");
+                assert_eq!(many.1, one.1, "{name} {n}³ cpu, {threads} threads");
+                assert!(many.2 == one.2, "{name} {n}³ binvox bytes, {threads} threads");
+            }
         }
     }
 }

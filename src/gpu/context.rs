@@ -146,6 +146,8 @@ pub(crate) struct Device {
     problems: Mutex<Vec<String>>,
     /// NEAREST, clamp-to-edge: the texture era reads texels with `texelFetch` only.
     pub sampler: vk::Sampler,
+    /// Kept between runs in the user's cache folder ([`super::pipeline_cache`]).
+    pub pipeline_cache: Mutex<super::pipeline_cache::PipelineCache>,
     pub info: DeviceInfo,
 }
 
@@ -156,6 +158,9 @@ impl Drop for Device {
         let leaks = self.leaks();
         unsafe {
             let _ = self.raw.device_wait_idle();
+            if let Ok(cache) = self.pipeline_cache.get_mut() {
+                cache.save_and_destroy(&self.raw);
+            }
             self.raw.destroy_sampler(self.sampler, None);
             if let Ok(pool) = self.command_pool.get_mut() {
                 self.raw.destroy_command_pool(*pool, None);
@@ -617,6 +622,10 @@ impl Context {
             }
         };
         let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.instance, &raw);
+        // SAFETY: valid physical device.
+        let props = unsafe { inst.instance.get_physical_device_properties(physical) };
+        let pipeline_cache =
+            super::pipeline_cache::PipelineCache::open(&raw, super::pipeline_cache::Identity::of(&props));
         // The surface now outlives this function in the caller's `Surface`.
         let surface = pending.as_mut().map(|p| (p.loader.clone(), std::mem::take(&mut p.raw)));
         drop(pending);
@@ -644,6 +653,7 @@ impl Context {
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             problems: Mutex::new(Vec::new()),
             sampler,
+            pipeline_cache: Mutex::new(pipeline_cache),
             info,
         };
         let ctx = Context { dev: Arc::new(dev) };

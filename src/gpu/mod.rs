@@ -1,6 +1,7 @@
 //! The texture-era GPU machinery, written once (SPEC §0): device and validation,
 //! memory, textures and render targets, pipelines from reflected SPIR-V, draw passes
-//! (full-target quad, points, triangles, logic-op XOR), ping-pong, reduction, readback.
+//! (full-target quad, points, triangles, logic-op XOR), ping-pong, reduction, readback;
+//! the pipeline cache kept between runs.
 //! Every `vk::` call of texgeo lives under this module; algorithms only see the types
 //! re-exported here.
 
@@ -9,6 +10,7 @@ mod error;
 mod memory;
 mod pass;
 mod pipeline;
+pub mod pipeline_cache;
 mod present;
 mod reduce;
 mod scatter;

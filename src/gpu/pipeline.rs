@@ -465,7 +465,14 @@ impl Pipeline {
             .layout(pipeline.layout)
             .push_next(&mut rendering);
         // SAFETY: every pointer in `info` outlives the call; modules are alive until after it.
-        let created = unsafe { dev.raw.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+        // The device's cache (kept between runs); locked, as Vulkan wants a cache used by
+        // one thread at a time.
+        let cache = dev
+            .pipeline_cache
+            .lock()
+            .map_err(|_| GpuError::Unsupported("pipeline cache lock poisoned".into()))?;
+        let created = unsafe { dev.raw.create_graphics_pipelines(cache.raw, &[info], None) };
+        drop(cache);
         pipeline.raw =
             created.map_err(|(_, e)| GpuError::Vk { call: "vkCreateGraphicsPipelines", result: e })?[0];
         Ok(pipeline)

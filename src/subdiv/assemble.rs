@@ -15,8 +15,8 @@
 //!
 //! Each position is gathered from the fragment that owns it (points shared by two or four
 //! owned regions are taken from one of them; at a non-manifold vertex or edge, from one
-//! of its fans). Faces and positions are filled in parallel over blocks of coarse faces
-//! and edges.
+//! of its fans). Faces and positions are filled in parallel (rayon's global pool) over
+//! blocks of coarse faces and edges.
 //!
 //! Faces come out in OpenSubdiv's order: coarse face by coarse face, and inside one, the
 //! quadtree of its refinement (each quad's four children in corner order), each quad
@@ -222,21 +222,17 @@ impl Grid<'_> {
     }
 }
 
-/// Runs `work(first_item, block)` over `out` cut into about one block per core, each
-/// block a whole number of `item_len`-long items.
+/// Runs `work(first_item, block)` over `out` cut into blocks of whole `item_len`-long
+/// items, a few per thread of rayon's global pool; each item is written by one call, so
+/// the result does not depend on the number of threads.
 fn for_each_block<T: Send>(out: &mut [T], item_len: usize, work: impl Fn(usize, &mut [T]) + Sync) {
+    use rayon::prelude::*;
     if item_len == 0 || out.is_empty() {
         return;
     }
     let items = out.len() / item_len;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(items.max(1));
-    let per_block = items.div_ceil(threads);
-    std::thread::scope(|scope| {
-        for (b, block) in out.chunks_mut(per_block * item_len).enumerate() {
-            let work = &work;
-            scope.spawn(move || work(b * per_block, block));
-        }
-    });
+    let per_block = items.div_ceil(4 * rayon::current_num_threads().max(1)).max(1);
+    out.par_chunks_mut(per_block * item_len).enumerate().for_each(|(b, block)| work(b * per_block, block));
 }
 
 /// The whole fragment-mesh algorithm on the CPU in f64 (base level, [`FragmentMesh::refine_stream`] per level, assembly): the GPU path's arithmetic without a GPU, to

@@ -36,9 +36,11 @@ pub fn write(path: impl AsRef<Path>, grid: &Grid, volume: &Volume) -> Result<()>
 /// Streams the binvox encoding of `volume` to `out`.
 ///
 /// binvox runs go along y (index x·N² + z·N + y) while the volume stores rows along x, so
-/// the encoder works on blocks of 64 x values: for each z it gathers 64 rows' words of
-/// the block and transposes those 64×64 bits, which gives 64 y-columns at once; the runs
-/// of each column are then found a word at a time (trailing zeros), not a voxel at a time.
+/// the encoder works on groups of 64-x-value blocks: for each z it gathers the rows'
+/// words of the group and transposes each 64×64 bit block, which gives 64 y-columns at
+/// once; the runs of each column are then found a word at a time (trailing zeros), not a
+/// voxel at a time. Groups are encoded in parallel (rayon's global pool) into lists of
+/// runs, which are joined in x order, so the bytes do not depend on the number of threads.
 pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::Result<()> {
     let n = volume.n();
     if grid.n != n {
@@ -54,62 +56,121 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
         m.x, m.y, m.z, grid.side
     )?;
     let mut runs = Runs { out, buf: Vec::with_capacity(1 << 16), value: 0, count: 0 };
+    let wpr = volume.words_per_row();
+    // Words of a row read together: a cache line's worth (8) reads the volume once, but a
+    // group holds the columns of all its x values (8·64·N² bits, 64 MiB at 1024³), so with
+    // more threads each group gets fewer words and at most 8 groups are in memory at once:
+    // the encoder never needs more than half the volume's size besides the volume.
+    let threads = rayon::current_num_threads().clamp(1, 8);
+    let g = (8 / threads).max(1);
+    let groups: Vec<usize> = (0..wpr).step_by(g).collect();
+    for batch in groups.chunks(threads) {
+        use rayon::prelude::*;
+        let lists: Vec<RunList> = batch
+            .par_iter()
+            .map(|&w0| {
+                let mut list = RunList::default();
+                encode_group(volume, w0, g.min(wpr - w0), &mut list);
+                list
+            })
+            .collect();
+        for list in lists {
+            for (value, count) in list.runs {
+                runs.add(value, count as usize)?;
+            }
+        }
+    }
+    runs.finish()
+}
+
+/// The runs of the voxels with x in 64·w0 .. 64·(w0 + gw), in binvox order.
+fn encode_group(volume: &Volume, w0: usize, gw: usize, runs: &mut RunList) {
+    let n = volume.n();
     let ybs = n.div_ceil(64);
     let (words, wpr) = (volume.words(), volume.words_per_row());
-    // Words of a row read in one pass: a cache line's worth, so the volume is read about
-    // once (wpr / G passes), while the columns of G·64 x values wait for their turn.
-    const G: usize = 8;
     // Rows of consecutive z are adjacent in memory: Z_CHUNK of them are gathered together.
     const Z_CHUNK: usize = 16;
-    let g_max = G.min(wpr);
     // columns[((g·64 + xl)·N + z)·ybs + yb]: bit r = voxel (64·(w0 + g) + xl, 64·yb + r, z).
-    let mut columns = vec![0u64; g_max * 64 * n * ybs];
-    let mut stage = vec![[0u64; 64]; g_max * Z_CHUNK * ybs];
-    for w0 in (0..wpr).step_by(G) {
-        let gw = G.min(wpr - w0);
-        let xs = |g: usize| (n - 64 * (w0 + g)).min(64);
-        for z0 in (0..n).step_by(Z_CHUNK) {
-            let zs = (n - z0).min(Z_CHUNK);
-            let slot = |g: usize, dz: usize, yb: usize| (g * Z_CHUNK + dz) * ybs + yb;
-            for y in 0..ybs * 64 {
-                let (yb, r) = (y / 64, y % 64);
-                for dz in 0..zs {
-                    let row = (y * n + z0 + dz) * wpr + w0;
-                    for g in 0..gw {
-                        stage[slot(g, dz, yb)][r] = if y < n { words[row + g] } else { 0 };
-                    }
-                }
-            }
-            for g in 0..gw {
-                for dz in 0..zs {
-                    for yb in 0..ybs {
-                        transpose64(&mut stage[slot(g, dz, yb)]);
-                    }
-                }
-                // xl outermost, so each column's ybs words are written together.
-                #[allow(clippy::needless_range_loop)]
-                for xl in 0..xs(g) {
-                    for dz in 0..zs {
-                        let at = ((g * 64 + xl) * n + z0 + dz) * ybs;
-                        for (yb, c) in columns[at..at + ybs].iter_mut().enumerate() {
-                            *c = stage[slot(g, dz, yb)][xl];
-                        }
-                    }
+    let mut columns = vec![0u64; gw * 64 * n * ybs];
+    let mut stage = vec![[0u64; 64]; gw * Z_CHUNK * ybs];
+    let xs = |g: usize| (n - 64 * (w0 + g)).min(64);
+    for z0 in (0..n).step_by(Z_CHUNK) {
+        let zs = (n - z0).min(Z_CHUNK);
+        let slot = |g: usize, dz: usize, yb: usize| (g * Z_CHUNK + dz) * ybs + yb;
+        for y in 0..ybs * 64 {
+            let (yb, r) = (y / 64, y % 64);
+            for dz in 0..zs {
+                let row = (y * n + z0 + dz) * wpr + w0;
+                for g in 0..gw {
+                    stage[slot(g, dz, yb)][r] = if y < n { words[row + g] } else { 0 };
                 }
             }
         }
         for g in 0..gw {
+            for dz in 0..zs {
+                for yb in 0..ybs {
+                    transpose64(&mut stage[slot(g, dz, yb)]);
+                }
+            }
+            // xl outermost, so each column's ybs words are written together.
+            #[allow(clippy::needless_range_loop)]
             for xl in 0..xs(g) {
-                for z in 0..n {
-                    let at = ((g * 64 + xl) * n + z) * ybs;
-                    for (yb, &c) in columns[at..at + ybs].iter().enumerate() {
-                        runs.bits(c, (n - 64 * yb).min(64))?;
+                for dz in 0..zs {
+                    let at = ((g * 64 + xl) * n + z0 + dz) * ybs;
+                    for (yb, c) in columns[at..at + ybs].iter_mut().enumerate() {
+                        *c = stage[slot(g, dz, yb)][xl];
                     }
                 }
             }
         }
     }
-    runs.finish()
+    for g in 0..gw {
+        for xl in 0..xs(g) {
+            for z in 0..n {
+                let at = ((g * 64 + xl) * n + z) * ybs;
+                for (yb, &c) in columns[at..at + ybs].iter().enumerate() {
+                    runs.bits(c, (n - 64 * yb).min(64));
+                }
+            }
+        }
+    }
+}
+
+/// Maximal runs (value, length) of a stretch of voxels, in order.
+#[derive(Default)]
+struct RunList {
+    runs: Vec<(u8, u64)>,
+}
+
+impl RunList {
+    fn add(&mut self, value: u8, count: u64) {
+        match self.runs.last_mut() {
+            Some((v, c)) if *v == value => *c += count,
+            _ if count > 0 => self.runs.push((value, count)),
+            _ => {}
+        }
+    }
+
+    /// Appends the first `len` bits of `bits` (bit 0 first).
+    fn bits(&mut self, bits: u64, len: usize) {
+        // Most words of a solid are all empty or all full.
+        let full = if len == 64 { u64::MAX } else { (1u64 << len) - 1 };
+        if bits & full == 0 {
+            return self.add(0, len as u64);
+        }
+        if bits & full == full {
+            return self.add(1, len as u64);
+        }
+        let mut i = 0;
+        while i < len {
+            let v = (bits >> i & 1) as u8;
+            // The run of v starting at bit i: up to the first bit that differs.
+            let differ = if v == 1 { !bits } else { bits } >> i;
+            let run = (differ.trailing_zeros() as usize).min(len - i);
+            self.add(v, run as u64);
+            i += run;
+        }
+    }
 }
 
 /// Run-length pairs (value, count ≤ 255), buffered.
@@ -121,28 +182,13 @@ struct Runs<'a, W: Write> {
 }
 
 impl<W: Write> Runs<'_, W> {
-    /// Appends the first `len` bits of `bits` (bit 0 first).
-    fn bits(&mut self, bits: u64, len: usize) -> std::io::Result<()> {
-        // Most words of a solid are all empty or all full.
-        let full = if len == 64 { u64::MAX } else { (1u64 << len) - 1 };
-        let same = if self.value == 1 { full } else { 0 };
-        if bits & full == same {
-            self.count += len;
-            return Ok(());
+    /// Appends `count` voxels of `value`.
+    fn add(&mut self, value: u8, count: usize) -> std::io::Result<()> {
+        if value != self.value {
+            self.flush_run()?;
+            self.value = value;
         }
-        let mut i = 0;
-        while i < len {
-            let v = (bits >> i & 1) as u8;
-            // The run of v starting at bit i: up to the first bit that differs.
-            let differ = if v == 1 { !bits } else { bits } >> i;
-            let run = (differ.trailing_zeros() as usize).min(len - i);
-            if v != self.value {
-                self.flush_run()?;
-                self.value = v;
-            }
-            self.count += run;
-            i += run;
-        }
+        self.count += count;
         Ok(())
     }
 

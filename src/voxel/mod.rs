@@ -23,8 +23,12 @@
 //! | `zoned` | PGPU-MP: tetras grouped by y-zone, each slice draws only its zone |
 //! | `fang` | Fang & Chen: surface triangles sliced into slabs, XOR along y (§5.2.6) |
 //! | `scanline` | exact ray parity along x rows (§5.2.1) |
+//!
+//! `auto` ([`Choice::Auto`], the command's default) picks the fastest of them for the
+//! device, solid and resolution from measured cost models ([`auto`]).
 
 pub mod aspect;
+pub mod auto;
 pub mod band;
 pub mod binvox;
 pub mod cpu;
@@ -93,6 +97,36 @@ impl Method {
     /// Whether the method needs a Vulkan device.
     pub fn uses_gpu(self) -> bool {
         matches!(self, Method::Fgpu | Method::Pgpu | Method::Zoned | Method::Fang)
+    }
+}
+
+/// `--method`: one method, or `auto`, the fastest one by the cost models of [`auto`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Choice {
+    #[default]
+    Auto,
+    Method(Method),
+}
+
+impl std::str::FromStr for Choice {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Choice, String> {
+        if s == "auto" {
+            return Ok(Choice::Auto);
+        }
+        Method::parse(s).map(Choice::Method).ok_or_else(|| {
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!("no method '{s}' (auto, {})", names.join(", "))
+        })
+    }
+}
+
+impl std::fmt::Display for Choice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Choice::Auto => f.write_str("auto"),
+            Choice::Method(m) => f.write_str(m.name()),
+        }
     }
 }
 

@@ -12,7 +12,7 @@ use super::error::Result;
 use super::exact::{self, Sign};
 use super::grid::Grid;
 use super::solid::Solid;
-use super::volume::{Volume, xor_bits};
+use super::volume::{Volume, slab_height, slab_lists, xor_bits};
 
 /// A row of voxel centres, id j·N + k.
 pub type RowId = u32;
@@ -31,18 +31,35 @@ pub struct Crossing {
 /// The crossings of every row (or of the rows `filter` accepts), grouped by row and
 /// sorted by x within a row.
 pub fn row_crossings(solid: &Solid, grid: &Grid, filter: Option<&[u64]>) -> Vec<(RowId, Crossing)> {
+    let mut out = Vec::new();
+    crossings_into(solid, grid, 0..solid.triangles.len() as u32, 0..grid.n, filter, &mut out);
+    out
+}
+
+/// The crossings of `triangles` with the rows of slices `slices` (and `filter`), sorted
+/// by row, then x, then triangle (a total order: the same list whatever the order the
+/// triangles come in).
+fn crossings_into(
+    solid: &Solid,
+    grid: &Grid,
+    triangles: impl Iterator<Item = u32>,
+    slices: std::ops::Range<usize>,
+    filter: Option<&[u64]>,
+    out: &mut Vec<(RowId, Crossing)>,
+) {
     let n = grid.n;
     let h = grid.h();
-    let mut out = Vec::new();
     let wanted = |row: usize| filter.is_none_or(|bits| bits[row / 64] >> (row % 64) & 1 == 1);
-    for (t, tri) in solid.triangles.iter().enumerate() {
+    for t in triangles {
+        let tri = &solid.triangles[t as usize];
         let [a, b, c] = *tri;
         let nx = exact::orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
         if nx == 0 {
             continue;
         }
         let (ylo, yhi) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
-        for j in index_range(grid.min.y, h, n, ylo, yhi) {
+        let js = index_range(grid.min.y, h, n, ylo, yhi);
+        for j in js.start.max(slices.start)..js.end.min(slices.end) {
             let y = grid.centre_coord(grid.min.y, j);
             if y < ylo || y > yhi {
                 continue;
@@ -57,13 +74,14 @@ pub fn row_crossings(solid: &Solid, grid: &Grid, filter: Option<&[u64]>) -> Vec<
                 let p = DVec3::new(0.0, y, grid.centre_coord(grid.min.z, k));
                 if exact::inside_yz(a, b, c, p, nx) {
                     let (x, err) = x_crossing(a, b, c, y, p.z);
-                    out.push((row as RowId, Crossing { x, err, triangle: t as u32, nx }));
+                    out.push((row as RowId, Crossing { x, err, triangle: t, nx }));
                 }
             }
         }
     }
-    out.sort_by(|(r0, c0), (r1, c1)| r0.cmp(r1).then(c0.x.total_cmp(&c1.x)));
-    out
+    out.sort_unstable_by(|(r0, c0), (r1, c1)| {
+        r0.cmp(r1).then(c0.x.total_cmp(&c1.x)).then(c0.triangle.cmp(&c1.triangle))
+    });
 }
 
 /// Indices i (clamped to 0..n) whose centres may lie in [lo, hi], with one index of
@@ -161,17 +179,34 @@ pub fn classify_row(solid: &Solid, grid: &Grid, j: usize, k: usize, crossings: &
     }
 }
 
-/// The scanline method: every row classified exactly.
+/// The scanline method: every row classified exactly. Slabs of slices run in parallel
+/// (rayon's global pool), each from the triangles that reach it; a row's crossings and
+/// its words belong to one slab, so the volume is the same for any number of threads.
 pub fn voxelize(solid: &Solid, grid: &Grid) -> Result<Volume> {
-    let mut volume = Volume::new(grid.n)?;
-    let crossings = row_crossings(solid, grid, None);
-    let mut buf: Vec<Crossing> = Vec::new();
-    for group in crossings.chunk_by(|a, b| a.0 == b.0) {
-        let row = group[0].0 as usize;
-        buf.clear();
-        buf.extend(group.iter().map(|(_, c)| *c));
-        let (j, k) = (row / grid.n, row % grid.n);
-        classify_row(solid, grid, j, k, &buf, volume.row_mut(j, k));
-    }
+    let n = grid.n;
+    let mut volume = Volume::new(n)?;
+    let h = grid.h();
+    let slab = slab_height(n);
+    let lists = slab_lists(
+        n,
+        slab,
+        solid
+            .triangles
+            .iter()
+            .map(|[a, b, c]| index_range(grid.min.y, h, n, a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y))),
+    );
+    volume.par_slabs(slab, |mut s| {
+        let slices = s.slices();
+        let mut crossings = Vec::new();
+        crossings_into(solid, grid, lists[s.j0 / slab].iter().copied(), slices, None, &mut crossings);
+        let mut buf: Vec<Crossing> = Vec::new();
+        for group in crossings.chunk_by(|a, b| a.0 == b.0) {
+            let row = group[0].0 as usize;
+            buf.clear();
+            buf.extend(group.iter().map(|(_, c)| *c));
+            let (j, k) = (row / n, row % n);
+            classify_row(solid, grid, j, k, &buf, s.row_mut(j, k));
+        }
+    });
     Ok(volume)
 }

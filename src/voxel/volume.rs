@@ -200,6 +200,77 @@ impl Volume {
     }
 }
 
+/// Slices j0..j1 of a volume, borrowed mutably: what one task of [`Volume::par_slabs`]
+/// writes.
+pub struct Slab<'a> {
+    n: usize,
+    words_per_row: usize,
+    /// First slice (j) of the slab.
+    pub j0: usize,
+    words: &'a mut [u64],
+}
+
+impl Slab<'_> {
+    /// The slices this slab holds.
+    pub fn slices(&self) -> std::ops::Range<usize> {
+        self.j0..self.j0 + self.words.len() / (self.n * self.words_per_row)
+    }
+
+    /// The words of row (j, k), j inside the slab.
+    pub fn row_mut(&mut self, j: usize, k: usize) -> &mut [u64] {
+        let s = ((j - self.j0) * self.n + k) * self.words_per_row;
+        &mut self.words[s..s + self.words_per_row]
+    }
+
+    /// Flips voxels i0..i1 of row (j, k) (`i1` is clamped to N).
+    pub fn xor_span(&mut self, j: usize, k: usize, i0: usize, i1: usize) {
+        let i1 = i1.min(self.n);
+        if i0 < i1 {
+            xor_bits(self.row_mut(j, k), i0, i1);
+        }
+    }
+}
+
+impl Volume {
+    /// Runs `work` on slabs of `slab` consecutive y slices in parallel (rayon's global
+    /// pool). Each slab is written by one task only, so the result does not depend on the
+    /// number of threads as long as `work` on a slab does not.
+    pub fn par_slabs(&mut self, slab: usize, work: impl Fn(Slab<'_>) + Sync + Send) {
+        use rayon::prelude::*;
+        let (n, wpr) = (self.n, self.words_per_row);
+        let slab = slab.max(1);
+        self.words
+            .par_chunks_mut(slab * n * wpr)
+            .enumerate()
+            .for_each(|(s, words)| work(Slab { n, words_per_row: wpr, j0: s * slab, words }));
+    }
+}
+
+/// Slices per task of the parallel rasterizers: about 64 slabs, so two to a few dozen
+/// cores all get work and each task's setup is amortized over many rows.
+pub fn slab_height(n: usize) -> usize {
+    n.div_ceil(64).max(1)
+}
+
+/// Which items fall in which slab: `ranges` gives each item's slices (empty: none), the
+/// result lists, per slab of `slab` slices, the items meeting it, in item order.
+pub fn slab_lists(
+    n: usize,
+    slab: usize,
+    ranges: impl Iterator<Item = std::ops::Range<usize>>,
+) -> Vec<Vec<u32>> {
+    let mut lists = vec![Vec::new(); n.div_ceil(slab).max(1)];
+    for (item, r) in ranges.enumerate() {
+        if r.start >= r.end {
+            continue;
+        }
+        for list in &mut lists[r.start / slab..=(r.end - 1) / slab] {
+            list.push(item as u32);
+        }
+    }
+    lists
+}
+
 /// Flips bits i0..i1 of a row of words.
 pub(crate) fn xor_bits(row: &mut [u64], i0: usize, i1: usize) {
     let (w0, w1) = (i0 / 64, (i1 - 1) / 64);

@@ -274,8 +274,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     };
     say!("level {}: {} vertices, {} faces", args.level, refined.num_vertices(), refined.num_faces());
     if let Some(out) = &args.output {
+        let t = Instant::now();
         formats::write(out, &refined)?;
-        say!("wrote {}", out.display());
+        say!("wrote {} in {:.1} ms", out.display(), ms(t.elapsed()));
     }
     if args.validate && !validate(&surface, &refined, args.level, args.method)? {
         std::process::exit(1);

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use texgeo::mesh::solidity::Policy;
 use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::{Grid, Method, Solid, Voxelizer, Zone, binvox, pictures};
+use texgeo::voxel::auto::{self as plan, Counts, Plan};
+use texgeo::voxel::{Choice, Grid, Solid, Voxelizer, Zone, binvox, pictures};
 
 /// Aspect functions (Fig. 5-9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -21,9 +22,10 @@ pub struct Args {
     /// Voxels per side (N×N×N over the mesh's bounding cube), 1..=1024.
     #[arg(long, short)]
     res: usize,
-    /// All methods give the same voxels.
-    #[arg(long, short, value_enum, default_value_t = Method::Zoned)]
-    method: Method,
+    /// auto (the fastest for this device, mesh and resolution, by measured cost models;
+    /// named on stderr), cpu, fgpu, pgpu, zoned, fang or scanline: all give the same voxels.
+    #[arg(long, short, default_value_t = Choice::Auto)]
+    method: Choice,
     /// Output .binvox file (written atomically).
     #[arg(long, short)]
     output: PathBuf,
@@ -74,9 +76,30 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mesh = solid.mesh;
     let grid = Grid::for_mesh(&mesh, args.res)?;
     let solid = Solid::new(&mesh)?;
-    let needs_gpu = args.method.uses_gpu() || args.aspect.is_some();
-    let ctx = if needs_gpu {
-        let hint = if args.method.uses_gpu() { "cpu or scanline" } else { "cpu, without --aspect" };
+    let mut opened = None;
+    let method = match args.method {
+        Choice::Method(m) => m,
+        Choice::Auto => {
+            // Asked as if the GPU's draws were free: when a CPU method still wins, no
+            // device is opened (the usual case on lavapipe and, by the models, elsewhere).
+            let counts = Counts::new(&solid, &grid);
+            let threads = rayon::current_num_threads();
+            let mut choice = Plan::choose(counts, plan::Device::Gpu, threads);
+            if choice.method.uses_gpu() || args.aspect.is_some() {
+                let ctx = crate::open_context_for(device, "scanline")?;
+                let kind = if ctx.info().kind == "cpu" { plan::Device::Cpu } else { plan::Device::Gpu };
+                choice = Plan::choose(counts, kind, threads);
+                opened = Some(ctx);
+            }
+            eprintln!("texgeo: --method auto: {}", choice.describe());
+            choice.method
+        }
+    };
+    let needs_gpu = method.uses_gpu() || args.aspect.is_some();
+    let ctx = if opened.is_some() {
+        opened
+    } else if needs_gpu {
+        let hint = if method.uses_gpu() { "cpu or scanline" } else { "cpu, without --aspect" };
         Some(crate::open_context_for(device, hint)?)
     } else {
         None
@@ -86,7 +109,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     }
     let mut voxelizer = Voxelizer::new(ctx.clone());
     voxelizer.zone = args.zone;
-    let result = voxelizer.run(&solid, &grid, args.method)?;
+    let result = voxelizer.run(&solid, &grid, method)?;
     let t = result.timings;
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     say!(
@@ -94,7 +117,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         args.mesh,
         args.res,
         result.volume.count(),
-        args.method,
+        method,
         ms(t.total),
         ms(t.prepare),
         ms(t.draw),

@@ -294,15 +294,10 @@ fn resolve(token: &str, count: usize, what: &str) -> std::result::Result<usize, 
 pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
     writeln!(w, "# texgeo: {} vertices, {} faces", mesh.num_vertices(), mesh.num_faces())?;
-    for p in mesh.positions() {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    for f in mesh.faces() {
-        write!(w, "f")?;
-        for i in f {
-            write!(w, " {}", u64::from(*i) + 1)?;
-        }
-        writeln!(w)?;
-    }
+    super::text::write_vertices(&mut w, mesh, "v ")?;
+    super::text::write_faces(&mut w, mesh, |_, out| {
+        out.push(b'f');
+        1
+    })?;
     w.flush()
 }
