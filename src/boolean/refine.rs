@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use super::index::candidate_pairs;
 use super::intersect::{Key, Meeting, Operands, Simplex, meet};
+use super::snap;
 use crate::mesh::intersect::{TriangleSoup, triangle_projection};
 use crate::mesh::triangulate::{self, TriangulateError};
 
@@ -77,6 +78,9 @@ pub struct RefineStats {
     pub coplanar_pairs: usize,
     /// Intersection points that are not input vertices.
     pub new_points: usize,
+    /// Of those, points merged into a cluster of points or onto an input vertex closer
+    /// than rounding ([`super::snap`]).
+    pub merged_points: usize,
     /// Input triangles re-triangulated in A and in B.
     pub cut_a: usize,
     pub cut_b: usize,
@@ -231,6 +235,28 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     points.extend_from_slice(&a.positions);
     points.extend_from_slice(&b.positions);
     points.extend(new_positions);
+    // Points closer than rounding become one (see `snap`), onto an input vertex of a
+    // simplex naming one of them when there is one.
+    let first = na + nb;
+    let (lo, hi) = points[..first as usize]
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let tolerance = snap::tolerance(lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
+    let corners = |s: Simplex, tris: &[[u32; 3]], id: &dyn Fn(u32) -> u32, out: &mut Vec<u32>| match s {
+        Simplex::Vertex(v) => out.push(id(v)),
+        Simplex::Edge(p, q) => out.extend([id(p), id(q)]),
+        Simplex::Face(t) => out.extend(tris[t as usize].map(id)),
+    };
+    let merged = snap::merge(&points, first, tolerance, |k, out| {
+        corners(new_keys[k].a, &a.triangles, &|v| v, out);
+        corners(new_keys[k].b, &b.triangles, &b_id, out);
+    });
+    stats.merged_points = merged.iter().enumerate().filter(|&(k, &m)| m != first + k as u32).count();
+    if stats.merged_points > 0 {
+        for id in ids.iter_mut().filter(|id| **id >= first) {
+            *id = merged[(*id - first) as usize];
+        }
+    }
     let id_of =
         |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
 
@@ -378,7 +404,9 @@ fn refine_side(
                     continue;
                 };
                 for w in chain[x.min(y)..=x.max(y)].windows(2) {
-                    cut_edges.push(edge_key(w[0], w[1]));
+                    if w[0] != w[1] {
+                        cut_edges.push(edge_key(w[0], w[1]));
+                    }
                 }
             }
         }
@@ -482,8 +510,20 @@ fn retriangulate(
             ids.extend_from_slice(chain);
         }
     }
+    // Merged points (`snap`) may repeat a neighbour or a corner: drop the repeats, the
+    // same way on both sides of a shared edge.
+    ids.dedup();
+    while ids.len() > 1 && ids.first() == ids.last() {
+        ids.pop();
+    }
     let outline_len = ids.len();
-    ids.extend_from_slice(inside);
+    let mut outline_sorted = ids.clone();
+    outline_sorted.sort_unstable();
+    let mut interior: Vec<u32> =
+        inside.iter().copied().filter(|g| outline_sorted.binary_search(g).is_err()).collect();
+    interior.sort_unstable();
+    interior.dedup();
+    ids.extend(interior);
     // Local index of each point id.
     let mut lookup: Vec<(u32, u32)> = ids.iter().enumerate().map(|(i, &g)| (g, i as u32)).collect();
     lookup.sort_unstable();
