@@ -78,8 +78,9 @@ pub struct RefineStats {
     pub coplanar_pairs: usize,
     /// Intersection points that are not input vertices.
     pub new_points: usize,
-    /// Of those, points merged into a cluster of points or onto an input vertex closer
-    /// than rounding ([`super::snap`]).
+    /// Points merged because rounding cannot tell them apart ([`super::snap`]): new
+    /// points merged into a cluster or onto an input vertex, and vertices of B merged
+    /// onto vertices of A.
     pub merged_points: usize,
     /// Input triangles re-triangulated in A and in B.
     pub cut_a: usize,
@@ -157,6 +158,8 @@ impl EdgePoints {
             if e.edges.last() != Some(&edge) {
                 e.edges.push(edge);
                 e.starts.push(e.ids.len() as u32);
+            } else if e.ids.last() == Some(&id) {
+                continue;
             }
             e.ids.push(id);
         }
@@ -209,7 +212,31 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     keys.dedup();
     let na = a.positions.len() as u32;
     let nb = b.positions.len() as u32;
+    let (lo, hi) = a
+        .positions
+        .iter()
+        .chain(&b.positions)
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let tolerance = snap::tolerance(lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
     let mut b_alias: Vec<u32> = (0..nb).map(|v| na + v).collect();
+    // A vertex of B closer than rounding to a vertex of A (a copy turned by 90°, whose
+    // cosines are not exactly 0) is that vertex, as if they coincided exactly: otherwise
+    // both, and the points around them, would be distinct points a few ulps apart.
+    {
+        let mut taken = vec![false; na as usize];
+        for (t, u, _) in &meetings {
+            for va in a.triangles[*t as usize] {
+                for vb in b.triangles[*u as usize] {
+                    let (pa, pb) = (a.positions[va as usize], b.positions[vb as usize]);
+                    if b_alias[vb as usize] == na + vb && !taken[va as usize] && pa.distance(pb) <= tolerance {
+                        b_alias[vb as usize] = va;
+                        taken[va as usize] = true;
+                        stats.merged_points += usize::from(pa != pb);
+                    }
+                }
+            }
+        }
+    }
     let mut ids = Vec::with_capacity(keys.len());
     let mut new_keys = Vec::new();
     for k in &keys {
@@ -238,10 +265,6 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     // Points closer than rounding become one (see `snap`), onto an input vertex of a
     // simplex naming one of them when there is one.
     let first = na + nb;
-    let (lo, hi) = points[..first as usize]
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let tolerance = snap::tolerance(lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
     let corners = |s: Simplex, tris: &[[u32; 3]], id: &dyn Fn(u32) -> u32, out: &mut Vec<u32>| match s {
         Simplex::Vertex(v) => out.push(id(v)),
         Simplex::Edge(p, q) => out.extend([id(p), id(q)]),
@@ -251,7 +274,7 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
         corners(new_keys[k].a, &a.triangles, &|v| v, out);
         corners(new_keys[k].b, &b.triangles, &b_id, out);
     });
-    stats.merged_points = merged.iter().enumerate().filter(|&(k, &m)| m != first + k as u32).count();
+    stats.merged_points += merged.iter().enumerate().filter(|&(k, &m)| m != first + k as u32).count();
     if stats.merged_points > 0 {
         for id in ids.iter_mut().filter(|id| **id >= first) {
             *id = merged[(*id - first) as usize];
@@ -262,6 +285,22 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
 
     // Points on edges and inside triangles, per mesh.
     let param = |p: DVec3, q: DVec3, x: DVec3| (x - p).dot(q - p);
+    // A new point inside a triangle but closer than rounding to one of its edges (an
+    // edge of the other mesh running a hair off this one's) goes onto that edge, for
+    // both triangles sharing it: rounded, it may even lie across the edge.
+    let onto_edge = |tri: [u32; 3], pos: &[DVec3], id: u32| -> Option<((u32, u32), f64)> {
+        if id < first {
+            return None;
+        }
+        let x = points[id as usize];
+        (0..3).find_map(|e| {
+            let (p, q) = (tri[e].min(tri[(e + 1) % 3]), tri[e].max(tri[(e + 1) % 3]));
+            let (pp, pq) = (pos[p as usize], pos[q as usize]);
+            let l = param(pp, pq, x);
+            let closest = pp + (pq - pp) * (l / (pq - pp).length_squared()).clamp(0.0, 1.0);
+            (closest.distance(x) <= tolerance).then_some(((p, q), l))
+        })
+    };
     let mut a_edge_entries = Vec::new();
     let mut b_edge_entries = Vec::new();
     let mut a_inside: Vec<(u32, u32)> = Vec::new();
@@ -272,7 +311,10 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
                 let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
                 a_edge_entries.push(((p, q), l, id));
             }
-            Simplex::Face(t) => a_inside.push((t, id)),
+            Simplex::Face(t) => match onto_edge(a.triangles[t as usize], &a.positions, id) {
+                Some((edge, l)) => a_edge_entries.push((edge, l, id)),
+                None => a_inside.push((t, id)),
+            },
             Simplex::Vertex(_) => {}
         }
         match k.b {
@@ -280,7 +322,10 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
                 let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
                 b_edge_entries.push(((p, q), l, id));
             }
-            Simplex::Face(u) => b_inside.push((u, id)),
+            Simplex::Face(u) => match onto_edge(b.triangles[u as usize], &b.positions, id) {
+                Some((edge, l)) => b_edge_entries.push((edge, l, id)),
+                None => b_inside.push((u, id)),
+            },
             Simplex::Vertex(_) => {}
         }
     }
@@ -380,29 +425,26 @@ fn refine_side(
     let mut cut_edges: Vec<u64> = Vec::new();
     for s in &segments {
         let tri = soup.triangles[s.triangle as usize];
-        let [k0, k1] = s.ends.map(|k| (input.simplex)(&k));
         let (i0, i1) = (id_of(&s.ends[0]), id_of(&s.ends[1]));
         if i0 == i1 {
             continue;
         }
-        let along = (0..3).find(|&e| {
+        // A segment with both ends on one edge's chain (its ends, the points on it, and
+        // those snapped onto it) runs along that edge.
+        let along = (0..3).find_map(|e| {
             let (p, q) = (tri[e], tri[(e + 1) % 3]);
-            k0.within_edge(p, q) && k1.within_edge(p, q)
+            let (lo, hi) = (p.min(q), p.max(q));
+            let mut chain = vec![(input.vertex_id)(lo)];
+            chain.extend_from_slice(input.edges.get(lo, hi));
+            chain.push((input.vertex_id)(hi));
+            let x = chain.iter().position(|&c| c == i0)?;
+            let y = chain.iter().position(|&c| c == i1)?;
+            Some((chain, x, y))
         });
         match along {
             None => constraints.push((s.triangle, [i0, i1])),
-            Some(e) => {
+            Some((chain, x, y)) => {
                 // Mark the pieces of the edge's chain between the two ends.
-                let (p, q) = (tri[e], tri[(e + 1) % 3]);
-                let (lo, hi) = (p.min(q), p.max(q));
-                let mut chain = vec![(input.vertex_id)(lo)];
-                chain.extend_from_slice(input.edges.get(lo, hi));
-                chain.push((input.vertex_id)(hi));
-                let (Some(x), Some(y)) =
-                    (chain.iter().position(|&c| c == i0), chain.iter().position(|&c| c == i1))
-                else {
-                    continue;
-                };
                 for w in chain[x.min(y)..=x.max(y)].windows(2) {
                     if w[0] != w[1] {
                         cut_edges.push(edge_key(w[0], w[1]));
@@ -540,7 +582,15 @@ fn retriangulate(
     }
     let p2: Vec<glam::DVec2> = ids.iter().map(|&g| proj.apply(points[g as usize])).collect();
     let outline: Vec<u32> = (0..outline_len as u32).collect();
-    let out = triangulate::cdt(&p2, &outline, &cons).map_err(|e| (e, near))?;
+    let out = triangulate::cdt(&p2, &outline, &cons).map_err(|e| {
+        if std::env::var_os("TEXGEO_DEBUG_REFINE").is_some() {
+            eprintln!("DEBUG ids {ids:?} outline_len {outline_len} cons {cons:?}");
+            for (i, p) in p2.iter().enumerate() {
+                eprintln!("DEBUG p{i} id{} {:?} {:?} 3d {:?}", ids[i], p.x, p.y, points[ids[i] as usize]);
+            }
+        }
+        (e, near)
+    })?;
     Ok(triangulate::Cdt {
         triangles: out.triangles.into_iter().map(|t| t.map(|l| ids[l as usize])).collect(),
         constraint_edges: out.constraint_edges.into_iter().map(|e| e.map(|l| ids[l as usize])).collect(),
