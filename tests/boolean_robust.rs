@@ -27,7 +27,8 @@ fn moved(m: &Mesh, t: DAffine3) -> Mesh {
 /// and the volumes of ∪, ∩, −, ⊖.
 fn check(name: &str, a: &Mesh, b: &Mesh) -> (Evaluation, [f64; 4]) {
     let options = Options { method: Method::Bvh, ..Options::default() };
-    let ev = boolean::evaluate(a, b, Names::default(), &options, None).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let ev =
+        boolean::evaluate(a, b, Names::default(), &options, None).unwrap_or_else(|e| panic!("{name}: {e}"));
     let mut v = [0.0; 4];
     for (k, op) in Operation::ALL.into_iter().enumerate() {
         let r = ev.result(op, true).unwrap_or_else(|e| panic!("{name} {op}: {e}"));
@@ -107,9 +108,14 @@ fn random_placements_of_builtin_solids() {
         let shift = if trial % 4 == 0 {
             DVec3::ZERO
         } else {
-            DVec3::new(rng.range_f64(-0.3, 0.3), rng.range_f64(-0.3, 0.3), rng.range_f64(-0.3, 0.3)) * (hi - lo)
+            DVec3::new(rng.range_f64(-0.3, 0.3), rng.range_f64(-0.3, 0.3), rng.range_f64(-0.3, 0.3))
+                * (hi - lo)
         };
         let t = DAffine3::from_translation(shift) * DAffine3::from_axis_angle(axis, angle);
-        check(&format!("trial {trial}: {na} vs {nb} turned {angle:e} about {axis}, moved {shift}"), a, &moved(b, t));
+        check(
+            &format!("trial {trial}: {na} vs {nb} turned {angle:e} about {axis}, moved {shift}"),
+            a,
+            &moved(b, t),
+        );
     }
 }

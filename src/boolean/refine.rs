@@ -158,7 +158,9 @@ impl EdgePoints {
             if e.edges.last() != Some(&edge) {
                 e.edges.push(edge);
                 e.starts.push(e.ids.len() as u32);
-            } else if e.ids.last() == Some(&id) {
+            } else if e.ids[*e.starts.last().unwrap_or(&0) as usize..].contains(&id) {
+                // A merged point named twice along the edge: its first place only, the
+                // same for both triangles sharing the edge.
                 continue;
             }
             e.ids.push(id);
@@ -228,7 +230,8 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
             for va in a.triangles[*t as usize] {
                 for vb in b.triangles[*u as usize] {
                     let (pa, pb) = (a.positions[va as usize], b.positions[vb as usize]);
-                    if b_alias[vb as usize] == na + vb && !taken[va as usize] && pa.distance(pb) <= tolerance {
+                    if b_alias[vb as usize] == na + vb && !taken[va as usize] && pa.distance(pb) <= tolerance
+                    {
                         b_alias[vb as usize] = va;
                         taken[va as usize] = true;
                         stats.merged_points += usize::from(pa != pb);
@@ -280,8 +283,6 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
             *id = merged[(*id - first) as usize];
         }
     }
-    let id_of =
-        |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
 
     // Points on edges and inside triangles, per mesh.
     let param = |p: DVec3, q: DVec3, x: DVec3| (x - p).dot(q - p);
@@ -301,38 +302,96 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
             (closest.distance(x) <= tolerance).then_some(((p, q), l))
         })
     };
-    let mut a_edge_entries = Vec::new();
-    let mut b_edge_entries = Vec::new();
-    let mut a_inside: Vec<(u32, u32)> = Vec::new();
-    let mut b_inside: Vec<(u32, u32)> = Vec::new();
-    for (k, &id) in keys.iter().zip(&ids) {
-        match k.a {
-            Simplex::Edge(p, q) => {
-                let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
-                a_edge_entries.push(((p, q), l, id));
+    let mut rounds = 0;
+    let (a_edges, b_edges, a_inside, b_inside) = loop {
+        let mut snapped = 0;
+        let mut a_edge_entries = Vec::new();
+        let mut b_edge_entries = Vec::new();
+        let mut a_inside: Vec<(u32, u32)> = Vec::new();
+        let mut b_inside: Vec<(u32, u32)> = Vec::new();
+        for (k, &id) in keys.iter().zip(&ids) {
+            match k.a {
+                Simplex::Edge(p, q) => {
+                    let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
+                    a_edge_entries.push(((p, q), l, id));
+                }
+                Simplex::Face(t) => match onto_edge(a.triangles[t as usize], &a.positions, id) {
+                    Some((edge, l)) => {
+                        a_edge_entries.push((edge, l, id));
+                        snapped += 1;
+                    }
+                    None => a_inside.push((t, id)),
+                },
+                Simplex::Vertex(_) => {}
             }
-            Simplex::Face(t) => match onto_edge(a.triangles[t as usize], &a.positions, id) {
-                Some((edge, l)) => a_edge_entries.push((edge, l, id)),
-                None => a_inside.push((t, id)),
-            },
-            Simplex::Vertex(_) => {}
-        }
-        match k.b {
-            Simplex::Edge(p, q) => {
-                let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
-                b_edge_entries.push(((p, q), l, id));
+            match k.b {
+                Simplex::Edge(p, q) => {
+                    let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
+                    b_edge_entries.push(((p, q), l, id));
+                }
+                Simplex::Face(u) => match onto_edge(b.triangles[u as usize], &b.positions, id) {
+                    Some((edge, l)) => {
+                        b_edge_entries.push((edge, l, id));
+                        snapped += 1;
+                    }
+                    None => b_inside.push((u, id)),
+                },
+                Simplex::Vertex(_) => {}
             }
-            Simplex::Face(u) => match onto_edge(b.triangles[u as usize], &b.positions, id) {
-                Some((edge, l)) => b_edge_entries.push((edge, l, id)),
-                None => b_inside.push((u, id)),
-            },
-            Simplex::Vertex(_) => {}
         }
-    }
-    let (a_edges, b_edges) =
-        rayon::join(|| EdgePoints::build(a_edge_entries), || EdgePoints::build(b_edge_entries));
-    a_inside.sort_unstable();
-    b_inside.par_sort_unstable();
+        a_inside.sort_unstable();
+        b_inside.par_sort_unstable();
+        let (a_edges, b_edges) =
+            rayon::join(|| EdgePoints::build(a_edge_entries), || EdgePoints::build(b_edge_entries));
+        // A merged point on two edges of one triangle is its corner there (it was a
+        // cluster around that corner not quite within the tolerance of it): merge it onto
+        // the corner everywhere, and sort the points again.
+        rounds += 1;
+        if rounds == 1 {
+            stats.merged_points += snapped;
+        }
+        if stats.merged_points == 0 || rounds > 3 {
+            break (a_edges, b_edges, a_inside, b_inside);
+        }
+        let mut onto: Vec<(u32, u32)> = Vec::new();
+        for (soup, edges, id) in
+            [(a, &a_edges, &(|v: u32| v) as &dyn Fn(u32) -> u32), (b, &b_edges, &b_id as &dyn Fn(u32) -> u32)]
+        {
+            for tri in &soup.triangles {
+                let chains = [0, 1, 2].map(|e| edges.get(tri[e], tri[(e + 1) % 3]));
+                if chains.iter().all(|c| c.is_empty()) {
+                    continue;
+                }
+                for e in 0..3 {
+                    for &x in chains[e] {
+                        // Edges e and e + 1 share corner e + 1, edges e and e + 2 corner e.
+                        if chains[(e + 1) % 3].contains(&x) {
+                            onto.push((x, id(tri[(e + 1) % 3])));
+                        } else if chains[(e + 2) % 3].contains(&x) {
+                            onto.push((x, id(tri[e])));
+                        } else if x == id(tri[(e + 2) % 3]) {
+                            onto.push((x, x));
+                        }
+                    }
+                }
+            }
+        }
+        onto.retain(|&(x, v)| x != v && x >= first);
+        if onto.is_empty() {
+            break (a_edges, b_edges, a_inside, b_inside);
+        }
+        onto.sort_unstable();
+        onto.dedup_by_key(|o| o.0);
+        stats.merged_points += onto.len();
+        for id in ids.iter_mut() {
+            if let Ok(i) = onto.binary_search_by_key(id, |o| o.0) {
+                *id = onto[i].1;
+            }
+        }
+    };
+
+    let id_of =
+        |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
 
     // Segments per triangle, and the cut curve.
     let mut a_segments = Vec::new();
@@ -366,22 +425,8 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     curve.par_sort_unstable();
     curve.dedup();
 
-    let a_input = SideInput {
-        side: Side::A,
-        soup: a,
-        vertex_id: &|v| v,
-        simplex: &|k: &Key| k.a,
-        edges: &a_edges,
-        inside: &a_inside,
-    };
-    let b_input = SideInput {
-        side: Side::B,
-        soup: b,
-        vertex_id: &b_id,
-        simplex: &|k: &Key| k.b,
-        edges: &b_edges,
-        inside: &b_inside,
-    };
+    let a_input = SideInput { side: Side::A, soup: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
+    let b_input = SideInput { side: Side::B, soup: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
     let ((ra, cut_a), (rb, cut_b)) = rayon::join(
         || refine_side(&a_input, a_segments, &points, &id_of),
         || refine_side(&b_input, b_segments, &points, &id_of),
@@ -402,8 +447,6 @@ struct SideInput<'a> {
     soup: &'a TriangleSoup,
     /// Welded vertex id → point id.
     vertex_id: &'a (dyn Fn(u32) -> u32 + Sync),
-    /// This side's simplex of a key.
-    simplex: &'a (dyn Fn(&Key) -> Simplex + Sync),
     edges: &'a EdgePoints,
     /// (triangle, point id) of points strictly inside triangles, sorted.
     inside: &'a [(u32, u32)],
@@ -582,15 +625,7 @@ fn retriangulate(
     }
     let p2: Vec<glam::DVec2> = ids.iter().map(|&g| proj.apply(points[g as usize])).collect();
     let outline: Vec<u32> = (0..outline_len as u32).collect();
-    let out = triangulate::cdt(&p2, &outline, &cons).map_err(|e| {
-        if std::env::var_os("TEXGEO_DEBUG_REFINE").is_some() {
-            eprintln!("DEBUG ids {ids:?} outline_len {outline_len} cons {cons:?}");
-            for (i, p) in p2.iter().enumerate() {
-                eprintln!("DEBUG p{i} id{} {:?} {:?} 3d {:?}", ids[i], p.x, p.y, points[ids[i] as usize]);
-            }
-        }
-        (e, near)
-    })?;
+    let out = triangulate::cdt(&p2, &outline, &cons).map_err(|e| (e, near))?;
     Ok(triangulate::Cdt {
         triangles: out.triangles.into_iter().map(|t| t.map(|l| ids[l as usize])).collect(),
         constraint_edges: out.constraint_edges.into_iter().map(|e| e.map(|l| ids[l as usize])).collect(),

@@ -109,8 +109,8 @@ mod tests {
     fn clusters_merge_and_snap_to_the_closest_named_vertex() {
         let t = 1e-12;
         let points = [
-            DVec3::ZERO,                  // 0: input vertex
-            DVec3::X,                     // 1: input vertex
+            DVec3::ZERO,                   // 0: input vertex
+            DVec3::X,                      // 1: input vertex
             DVec3::new(0.4e-12, 0.0, 0.0), // 2: new, near 0
             DVec3::new(1.2e-12, 0.0, 0.0), // 3: new, near 2 (not 0): joins its cluster
             DVec3::new(0.5, 0.0, 0.0),     // 4: new, alone
