@@ -13,6 +13,7 @@ fn main() {
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     let glsl = root.join("glsl");
     println!("cargo:rerun-if-changed=glsl");
+    git_commit(&root);
 
     let mut sources = Vec::new();
     collect(&glsl, &mut sources);
@@ -114,5 +115,34 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
         } else if matches!(path.extension().and_then(|e| e.to_str()), Some("vert" | "frag")) {
             out.push(path);
         }
+    }
+}
+
+/// Sets `TEXGEO_GIT_COMMIT` for reports: the commit texgeo is built from, or "unknown"
+/// (no git, not a checkout). Never fails the build. Re-runs when HEAD moves.
+fn git_commit(root: &Path) {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(root)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .and_then(|o| String::from_utf8(o.stdout).ok())
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+    };
+    let commit = git(&["rev-parse", "--short=12", "HEAD"]).unwrap_or_else(|| "unknown".to_string());
+    println!("cargo:rustc-env=TEXGEO_GIT_COMMIT={commit}");
+    // HEAD, the branch it points to and packed refs: where a new commit shows up.
+    if let Some(dir) = git(&["rev-parse", "--absolute-git-dir"]) {
+        println!("cargo:rerun-if-changed={dir}/HEAD");
+    }
+    if let (Some(common), Some(branch)) = (
+        git(&["rev-parse", "--path-format=absolute", "--git-common-dir"]),
+        git(&["symbolic-ref", "-q", "HEAD"]),
+    ) {
+        println!("cargo:rerun-if-changed={common}/{branch}");
+        println!("cargo:rerun-if-changed={common}/packed-refs");
     }
 }

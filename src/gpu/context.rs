@@ -81,9 +81,49 @@ pub struct DeviceInfo {
     /// (bit n set: 2^n samples per pixel).
     pub colour_samples: u32,
     pub depth_samples: u32,
+    /// Features turned off by `TEXGEO_MASK_FEATURES` although the device has them.
+    pub masked: Vec<String>,
+}
+
+/// Features `TEXGEO_MASK_FEATURES` (comma-separated) can hide from texgeo, so a run shows
+/// what a device without them gets: the commands that need one refuse with a clear error,
+/// reports mark the rows that need one as not measurable.
+pub const MASKABLE_FEATURES: [&str; 3] = ["logic_op", "timestamps", "float64"];
+
+/// The features `TEXGEO_MASK_FEATURES` asks to hide; an unknown name is an error.
+fn masked_features() -> Result<Vec<String>> {
+    let Ok(list) = std::env::var("TEXGEO_MASK_FEATURES") else { return Ok(Vec::new()) };
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        if !MASKABLE_FEATURES.contains(&name) {
+            return Err(GpuError::Usage(format!(
+                "TEXGEO_MASK_FEATURES: unknown feature '{name}' (known: {})",
+                MASKABLE_FEATURES.join(", ")
+            )));
+        }
+        if !out.iter().any(|m| m == name) {
+            out.push(name.to_string());
+        }
+    }
+    Ok(out)
 }
 
 impl DeviceInfo {
+    /// Turns off the features in `masked` (names from [`MASKABLE_FEATURES`]).
+    fn mask(&mut self, masked: &[String]) {
+        for name in masked {
+            let flag = match name.as_str() {
+                "logic_op" => &mut self.logic_op,
+                "timestamps" => &mut self.timestamps,
+                "float64" => &mut self.float64,
+                _ => continue,
+            };
+            if std::mem::replace(flag, false) {
+                self.masked.push(name.clone());
+            }
+        }
+    }
+
     /// "llvmpipe (LLVM 15.0.6, 256 bits) [llvmpipe, Mesa 22.3.6]".
     pub fn label(&self) -> String {
         format!("{} [{} {}]", self.name, self.driver, self.driver_info)
@@ -348,6 +388,7 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
             && f13.synchronization2 == vk::TRUE,
         colour_samples: limits.framebuffer_color_sample_counts.as_raw(),
         depth_samples: limits.framebuffer_depth_sample_counts.as_raw(),
+        masked: Vec::new(),
     }
 }
 
@@ -360,7 +401,16 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>> {
     let inst = Instance::new(false, &[])?;
     // SAFETY: plain enumeration on a live instance.
     let physicals = unsafe { inst.instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
-    Ok(physicals.iter().enumerate().map(|(i, &p)| describe(&inst.instance, i, p)).collect())
+    let masked = masked_features()?;
+    Ok(physicals
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let mut info = describe(&inst.instance, i, p);
+            info.mask(&masked);
+            info
+        })
+        .collect())
 }
 
 fn choose(instance: &ash::Instance, choice: &DeviceChoice) -> Result<(vk::PhysicalDevice, DeviceInfo)> {
@@ -403,7 +453,8 @@ fn choose(instance: &ash::Instance, choice: &DeviceChoice) -> Result<(vk::Physic
                 .unwrap_or(&all[0])
         }
     };
-    let (p, info) = picked.clone();
+    let (p, mut info) = picked.clone();
+    info.mask(&masked_features()?);
     if !info.vulkan13 {
         return Err(GpuError::Unsupported(format!(
             "device '{}' lacks Vulkan 1.3 dynamic rendering / synchronization2 (API {})",

@@ -17,7 +17,7 @@ mod timer;
 mod validation;
 mod xor;
 
-pub use context::{Context, ContextOptions, DeviceChoice, DeviceInfo, list_devices};
+pub use context::{Context, ContextOptions, DeviceChoice, DeviceInfo, MASKABLE_FEATURES, list_devices};
 pub use error::{GpuError, Result};
 pub use memory::Buffer;
 pub use memory::{Pod, as_bytes, from_bytes};

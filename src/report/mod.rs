@@ -2,11 +2,32 @@
 //! and CSV, and the description of the machine and device that produced them.
 
 pub mod bench;
+pub mod plot;
+pub mod reproduce;
 mod table;
 mod timing;
 
 pub use table::{Report, Table};
 pub use timing::{Samples, time_runs, timed};
+
+/// Where a long measurement says what it is doing: `texgeo bench` prints a line per
+/// step, `texgeo reproduce` advances a progress bar.
+pub trait Progress {
+    /// How many more steps follow (called before them; a run of several parts calls it
+    /// once per part).
+    fn total(&mut self, _steps: u64) {}
+    /// A step starts.
+    fn step(&mut self, what: &str);
+}
+
+/// Prints every step on standard error after a prefix (`bench inclusion: …`).
+pub struct Log(pub &'static str);
+
+impl Progress for Log {
+    fn step(&mut self, what: &str) {
+        eprintln!("{}: {what}", self.0);
+    }
+}
 
 /// Where and on what a measurement was made; printed at the top of every report.
 #[derive(Clone, Debug)]

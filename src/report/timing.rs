@@ -25,6 +25,17 @@ impl Samples {
         self.0.iter().copied().min().unwrap_or_default()
     }
 
+    pub fn max(&self) -> Duration {
+        self.0.iter().copied().max().unwrap_or_default()
+    }
+
+    pub fn mean(&self) -> Duration {
+        match self.0.len() {
+            0 => Duration::ZERO,
+            n => self.0.iter().sum::<Duration>() / n as u32,
+        }
+    }
+
     pub fn median_ms(&self) -> f64 {
         self.median().as_secs_f64() * 1e3
     }

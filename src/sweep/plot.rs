@@ -42,6 +42,8 @@ pub fn time_vs_size(merged: &Merged) -> Result<String> {
     let (y0, y1) = range(&mut points.iter().map(|p| p.2));
     let mut svg = String::new();
     let err = |e: &dyn std::fmt::Display| SweepError::Plot(e.to_string());
+    // Text is measured with a real font (the same one the reports use).
+    crate::report::plot::ensure_font().map_err(|e| err(&e))?;
     {
         let root = SVGBackend::with_string(&mut svg, (800, 520)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;

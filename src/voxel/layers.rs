@@ -105,7 +105,10 @@ pub(crate) fn check_device(ctx: &Context, n: usize) -> Result<()> {
         });
     }
     if !info.logic_op {
-        return Err(VoxelError::Usage(format!("device {} has no logic op XOR", info.name)));
+        return Err(VoxelError::Gpu(crate::gpu::GpuError::Unsupported(format!(
+            "device {} has no logic op XOR",
+            info.name
+        ))));
     }
     Ok(())
 }

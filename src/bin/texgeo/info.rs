@@ -33,6 +33,9 @@ fn print(d: &DeviceInfo) {
         yes(d.vulkan13),
         yes(d.push_descriptor)
     );
+    if !d.masked.is_empty() {
+        println!("masked by TEXGEO_MASK_FEATURES: {}", d.masked.join(", "));
+    }
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {

@@ -20,6 +20,7 @@ mod inclusion;
 mod info;
 mod mesh;
 mod render;
+mod reproduce;
 mod subdivide;
 mod sweep;
 mod view;
@@ -67,6 +68,9 @@ enum Command {
     Render(render::Args),
     /// An interactive window: orbit a mesh, step through subdivision levels live, voxels.
     View(view::Args),
+    /// Every experiment of both theses in one report: tables beside the thesis', plots,
+    /// pictures and a verdict on every claim (`--compare OLD NEW` compares two runs).
+    Reproduce(reproduce::Args),
     /// Boolean operations on two closed solids: union, intersection, difference, symmetric difference.
     Boolean(boolean::Args),
 }
@@ -124,6 +128,7 @@ fn main() {
         Command::Sweep(a) => sweep::run(device, a),
         Command::Render(a) => render::run(device, a),
         Command::View(a) => view::run(device, a),
+        Command::Reproduce(a) => reproduce::run(device, a),
         Command::Boolean(a) => boolean::run(device, a),
     };
     if let Err(e) = result {

@@ -18,7 +18,7 @@ use crate::inclusion::tetragrid::{GridClassifier, RESOLUTIONS};
 use crate::inclusion::{Class, Classifier, EdgeRule, FeitoTorres, InclusionError, Method, Options};
 use crate::mesh::Mesh;
 use crate::random::Rng;
-use crate::report::{Environment, Report, Table};
+use crate::report::{Environment, Log, Progress, Report, Samples, Table};
 
 /// A model of the experiment and the thesis model it stands in for.
 pub struct Model {
@@ -63,9 +63,13 @@ const THESIS: [(&str, &str); 6] = [
     ("4-9", include_str!("../../../reference/inclusion/table4-9.csv")),
 ];
 
+/// The thesis' table `id` ("4-4" … "4-9") as transcribed: header, then rows.
+pub fn thesis_csv(id: &str) -> &'static str {
+    THESIS.iter().find(|(t, _)| *t == id).map(|(_, c)| *c).unwrap_or("")
+}
+
 fn thesis_table(id: &str) -> Table {
-    let csv = THESIS.iter().find(|(t, _)| *t == id).map(|(_, c)| *c).unwrap_or("");
-    let mut lines = csv.lines();
+    let mut lines = thesis_csv(id).lines();
     let columns: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     let mut t = Table::new(
         format!("Table {id} as printed in the thesis (Pentium 4E 3.4 GHz, GeForce 7800 GTX)"),
@@ -95,52 +99,72 @@ fn point_sets(mesh: &Mesh, cfg: &Config) -> Vec<Vec<DVec3>> {
 /// Something that classifies a set of points (a CPU classifier or a GPU solver).
 type Classify<'a> = dyn FnMut(&[DVec3]) -> Result<Vec<Class>, InclusionError> + 'a;
 
-/// Mean time per set and whether every answer equals `want`.
-fn mean_time(
+/// The time of every set and whether every answer equals `want`.
+fn set_times(
     solver: &mut Classify,
     sets: &[Vec<DVec3>],
     want: &[Vec<Class>],
-) -> Result<(Duration, bool), InclusionError> {
+) -> Result<(Samples, bool), InclusionError> {
     // One untimed warm-up (lavapipe compiles shaders at the first draw).
     solver(&sets[0])?;
-    let mut total = Duration::ZERO;
+    let mut times = Samples::default();
     let mut agree = true;
     for (set, w) in sets.iter().zip(want) {
         let t = Instant::now();
         let got = solver(set)?;
-        total += t.elapsed();
+        times.push(t.elapsed());
         agree &= got == *w;
     }
-    Ok((total / sets.len().max(1) as u32, agree))
+    Ok((times, agree))
 }
 
-struct Measured {
-    name: String,
-    thesis: &'static str,
-    vertices: usize,
-    faces: usize,
-    triangles: usize,
-    grid_builds: Vec<(Duration, usize)>,
-    /// Method name → mean time per set.
-    times: Vec<(String, Duration)>,
-    grid_times: Vec<Duration>,
-    gpu_split: Vec<String>,
-    disagreements: Vec<String>,
+/// Everything measured on one model.
+pub struct Measured {
+    pub name: String,
+    pub thesis: &'static str,
+    pub vertices: usize,
+    pub faces: usize,
+    /// Covering triangles = tetrahedra.
+    pub triangles: usize,
+    /// TetraGrid build (time, bytes) at each of `Config::resolutions`.
+    pub grid_builds: Vec<(Duration, usize)>,
+    /// Method name → the time of every set (`gpu-batch-1`: the thesis' one tetrahedron
+    /// per point-vertex).
+    pub times: Vec<(String, Samples)>,
+    /// Methods that could not run on this device, with the reason.
+    pub failed: Vec<(String, String)>,
+    /// TetraGrid at each resolution: the time of every set.
+    pub grid_times: Vec<Samples>,
+    /// TetraGrid at each resolution: the mean share of all tetrahedra a query point is
+    /// tested against (the tetrahedra listed in its cell).
+    pub grid_tested: Vec<f64>,
+    pub gpu_split: Vec<String>,
+    pub disagreements: Vec<String>,
     /// Index-only build stats of the methods with preprocessing (Tables 4-7, 4-8).
-    index: Vec<(&'static str, crate::inclusion::BuildStats)>,
+    pub index: Vec<(&'static str, crate::inclusion::BuildStats)>,
 }
 
 impl Measured {
-    fn time(&self, method: &str) -> String {
-        self.times.iter().find(|t| t.0 == method).map(|t| secs(t.1)).unwrap_or_else(|| "–".into())
+    /// Mean time per set of `method`, if it ran.
+    pub fn mean(&self, method: &str) -> Option<Duration> {
+        self.samples(method).map(Samples::mean)
     }
 
-    fn index(&self, method: &str) -> Option<(Duration, usize)> {
+    pub fn samples(&self, method: &str) -> Option<&Samples> {
+        self.times.iter().find(|t| t.0 == method).map(|t| &t.1)
+    }
+
+    fn time(&self, method: &str) -> String {
+        self.mean(method).map(secs).unwrap_or_else(|| "–".into())
+    }
+
+    /// Build time and bytes of an index (`octants`, `tetragrid`, `bvh`, `jordan-octree`).
+    pub fn index(&self, method: &str) -> Option<(Duration, usize)> {
         self.index.iter().find(|t| t.0 == method).map(|t| (t.1.build_time, t.1.bytes))
     }
 
     fn ratio(&self, method: &str) -> String {
-        let get = |m: &str| self.times.iter().find(|t| t.0 == m).map(|t| t.1.as_secs_f64());
+        let get = |m: &str| self.mean(m).map(|d| d.as_secs_f64());
         match (get("cpu"), get(method)) {
             (Some(c), Some(m)) if m > 0.0 => format!("{:.1}×", c / m),
             _ => "–".into(),
@@ -148,8 +172,33 @@ impl Measured {
     }
 }
 
-fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, InclusionError> {
+/// Steps [`measure`] reports per model: the reference, each TetraGrid resolution, each
+/// method, the indexes, the thesis' GPU layout.
+pub fn steps(models: usize, cfg: &Config) -> u64 {
+    (models * (cfg.resolutions.len() + METHODS.len() + 3)) as u64
+}
+
+/// The methods of Tables 4-6 to 4-9, at their default settings (TetraGrid 32³, octree 6).
+const METHODS: [Method; 9] = [
+    Method::Cpu,
+    Method::CpuGpu,
+    Method::Gpu,
+    Method::Octants,
+    Method::Bvh,
+    Method::TetraGrid,
+    Method::GpuTetraGrid,
+    Method::Jordan,
+    Method::JordanOctree,
+];
+
+fn measure_model(
+    ctx: &Context,
+    model: &Model,
+    cfg: &Config,
+    progress: &mut dyn Progress,
+) -> Result<Measured, InclusionError> {
     let mesh = &model.mesh;
+    progress.step(&format!("{}: reference answers", model.name));
     let sets = point_sets(mesh, cfg);
     let covering = crate::mesh::covering::Covering::new(mesh);
     let mut m = Measured {
@@ -160,7 +209,9 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
         triangles: covering.triangles.len(),
         grid_builds: Vec::new(),
         times: Vec::new(),
+        failed: Vec::new(),
         grid_times: Vec::new(),
+        grid_tested: Vec::new(),
         gpu_split: Vec::new(),
         disagreements: Vec::new(),
         index: Vec::new(),
@@ -175,32 +226,32 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
         if !RESOLUTIONS.contains(&n) {
             return Err(InclusionError::Resolution(n));
         }
+        progress.step(&format!("{}: TetraGrid {n}³", model.name));
         let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
         let grid = GridClassifier::new(ft, n)?;
         let s = grid.index_stats();
         m.grid_builds.push((s.build_time, s.bytes));
-        let (t, ok) = mean_time(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
+        let (t, ok) = set_times(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
         if !ok {
             m.disagreements.push(format!("tetragrid-{n}"));
         }
         m.grid_times.push(t);
+        m.grid_tested.push(tested_share(&grid, &sets, m.triangles));
     }
 
     // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6).
-    let methods = [
-        Method::Cpu,
-        Method::CpuGpu,
-        Method::Gpu,
-        Method::Octants,
-        Method::Bvh,
-        Method::TetraGrid,
-        Method::GpuTetraGrid,
-        Method::Jordan,
-        Method::JordanOctree,
-    ];
-    for method in methods {
-        let mut solver = Solver::new(method, mesh, &Options::default(), Some(ctx), None)?;
-        let (time, ok) = mean_time(&mut |p| solver.classify_all(p), &sets, &want)?;
+    for method in METHODS {
+        progress.step(&format!("{}: {method}", model.name));
+        let mut solver = match Solver::new(method, mesh, &Options::default(), Some(ctx), None) {
+            Ok(s) => s,
+            Err(e) if method.is_cpu() => return Err(e),
+            Err(e) => {
+                // A GPU method this device cannot run marks its cells, not the whole run.
+                m.failed.push((method.name().to_string(), e.to_string()));
+                continue;
+            }
+        };
+        let (time, ok) = set_times(&mut |p| solver.classify_all(p), &sets, &want)?;
         if !ok {
             m.disagreements.push(method.name().to_string());
         }
@@ -228,21 +279,50 @@ fn measure(ctx: &Context, model: &Model, cfg: &Config) -> Result<Measured, Inclu
         ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
     ];
     // The thesis' layout: one point-vertex per tetrahedron.
-    let mut thesis_gpu = Solver::new(Method::Gpu, mesh, &Options::default(), Some(ctx), Some(1))?;
-    let (time, ok) = mean_time(&mut |p| thesis_gpu.classify_all(p), &sets, &want)?;
-    if !ok {
-        m.disagreements.push("gpu (batch 1)".into());
+    progress.step(&format!("{}: gpu, one tetrahedron per point-vertex", model.name));
+    match Solver::new(Method::Gpu, mesh, &Options::default(), Some(ctx), Some(1)) {
+        Ok(mut thesis_gpu) => {
+            let (time, ok) = set_times(&mut |p| thesis_gpu.classify_all(p), &sets, &want)?;
+            if !ok {
+                m.disagreements.push("gpu (batch 1)".into());
+            }
+            m.times.push(("gpu-batch-1".into(), time));
+        }
+        Err(e) => m.failed.push(("gpu-batch-1".into(), e.to_string())),
     }
-    m.times.push(("gpu-batch-1".into(), time));
     Ok(m)
 }
 
-pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, InclusionError> {
-    let mut measured = Vec::new();
-    for model in models {
-        eprintln!("bench inclusion: {} ({} faces)…", model.name, model.mesh.num_faces());
-        measured.push(measure(ctx, model, cfg)?);
+/// The mean share of the `tetrahedra` a query point of `sets` is tested against: those
+/// listed in its TetraGrid cell (none outside the grid).
+fn tested_share(grid: &GridClassifier, sets: &[Vec<DVec3>], tetrahedra: usize) -> f64 {
+    let (mut listed, mut points) = (0usize, 0usize);
+    for p in sets.iter().flatten() {
+        listed += grid.cell_of(*p).map_or(0, |c| grid.cell_tetras(c).len());
+        points += 1;
     }
+    listed as f64 / (points.max(1) * tetrahedra.max(1)) as f64
+}
+
+/// Runs every method on every model (Tables 4-4 to 4-9).
+pub fn measure(
+    ctx: &Context,
+    models: &[Model],
+    cfg: &Config,
+    progress: &mut dyn Progress,
+) -> Result<Vec<Measured>, InclusionError> {
+    progress.total(steps(models.len(), cfg));
+    models.iter().map(|model| measure_model(ctx, model, cfg, progress)).collect()
+}
+
+/// `texgeo bench inclusion`: [`measure`] and [`report`].
+pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, InclusionError> {
+    let measured = measure(ctx, models, cfg, &mut Log("bench inclusion"))?;
+    Ok(report(&measured, cfg, Environment::new(ctx.info().label())))
+}
+
+/// The thesis' tables for `measured`, today's beside the thesis'.
+pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> Report {
     let res = &cfg.resolutions;
     let label = |m: &Measured| format!("{} ({})", m.name, m.thesis);
 
@@ -256,7 +336,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
         columns: cols,
         ..Default::default()
     };
-    for m in &measured {
+    for m in measured {
         let mut row = vec![label(m), m.vertices.to_string(), m.triangles.to_string()];
         for &(t, b) in &m.grid_builds {
             row.push(secs(t));
@@ -275,9 +355,9 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
         columns: cols,
         ..Default::default()
     };
-    for m in &measured {
+    for m in measured {
         let mut row = vec![label(m), m.faces.to_string(), m.time("cpu")];
-        row.extend(m.grid_times.iter().map(|&t| secs(t)));
+        row.extend(m.grid_times.iter().map(|t| secs(t.mean())));
         t45.row(row);
     }
 
@@ -295,7 +375,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
             "GPU+TetraGrid 32",
         ],
     );
-    for m in &measured {
+    for m in measured {
         t46.row(vec![
             label(m),
             m.faces.to_string(),
@@ -332,7 +412,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
             "Jordan (octree 6)",
         ],
     );
-    for m in &measured {
+    for m in measured {
         let mut mem = vec![label(m), m.triangles.to_string()];
         let mut time = mem.clone();
         for p in pre {
@@ -357,7 +437,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
             "Jordan octree 6",
         ],
     );
-    for m in &measured {
+    for m in measured {
         t49.row(vec![
             label(m),
             m.faces.to_string(),
@@ -383,7 +463,7 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
             "jordan-octree",
         ],
     );
-    for m in &measured {
+    for m in measured {
         speed.row(vec![
             label(m),
             m.ratio("cpu+gpu"),
@@ -404,9 +484,12 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
     } else {
         format!("DISAGREEMENTS with `cpu`: {}", disagreements.join(", "))
     });
-    for m in &measured {
+    for m in measured {
         for line in &m.gpu_split {
             speed.note(format!("{}: {line}", m.name));
+        }
+        for (method, why) in &m.failed {
+            speed.note(format!("{}: {method} not measured: {why}", m.name));
         }
     }
     speed.note(format!(
@@ -425,5 +508,5 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
         tables.push(thesis_table(id));
     }
     tables.push(speed.named("speedup"));
-    Ok(Report { name: "inclusion".into(), environment: Environment::new(ctx.info().label()), tables })
+    Report { name: "inclusion".into(), environment, tables }
 }

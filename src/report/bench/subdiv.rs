@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use crate::gpu::Context;
 use crate::mesh::{Mesh, formats, procedural};
-use crate::report::{Environment, Report, Samples, Table, time_runs};
+use crate::report::{Environment, Log, Progress, Report, Samples, Table, time_runs};
 use crate::subdiv::compare::Comparison;
 use crate::subdiv::gpu::{Options, Run, Subdivider, Times};
 use crate::subdiv::{Result, cpu, osd};
@@ -71,7 +71,7 @@ fn median_times(all: &[Times]) -> Times {
 }
 
 /// Milliseconds with about three significant digits.
-fn ms(d: Duration) -> String {
+pub fn ms(d: Duration) -> String {
     let v = d.as_secs_f64() * 1e3;
     if v < 1.0 {
         format!("{v:.3}")
@@ -85,7 +85,168 @@ fn ms(d: Duration) -> String {
 /// The issue's speed target: the GPU path at most half of OpenSubdiv's time on knot1.off.
 const SPEED_TARGET: f64 = 0.5;
 
+/// One model refined to `Settings::level`.
+pub struct Measured {
+    pub name: String,
+    pub input_faces: usize,
+    pub fragments: usize,
+    pub faces: usize,
+    pub vertices: usize,
+    /// Fragment passes the GPU ran (one per GPU level) and GPU levels.
+    pub passes: usize,
+    pub gpu_levels: u32,
+    pub texture: [u32; 2],
+    /// Medians of the GPU path's parts, and every run's total.
+    pub gpu: Times,
+    pub gpu_totals: Samples,
+    /// The first run on a fresh pipeline.
+    pub cold: Duration,
+    /// texgeo's f64 CPU reference (TCPU²).
+    pub cpu: Samples,
+    /// OpenSubdiv: the helper's minimum and median of refine + interpolate, seconds.
+    pub osd: (f64, f64),
+    /// "match, …", "MISMATCH" or "not checked".
+    pub verdict: String,
+}
+
+/// Steps [`measure`] reports.
+pub fn steps(models: usize) -> u64 {
+    3 * models as u64
+}
+
+/// Refines every model on the GPU, on the CPU and with OpenSubdiv (Table 5).
+pub fn measure(
+    ctx: &Context,
+    models: &[Model],
+    settings: Settings,
+    progress: &mut dyn Progress,
+) -> Result<Vec<Measured>> {
+    progress.total(steps(models.len()));
+    let level = settings.level;
+    let mut out = Vec::new();
+    for model in models {
+        let mesh = &model.mesh;
+        progress.step(&format!("{}: GPU fragment passes", model.name));
+        // Cold: a fresh pipeline and targets (JIT compilation, first-touch allocation).
+        let start = Instant::now();
+        let mut subdivider = Subdivider::new(ctx)?;
+        let first = subdivider.refine(ctx, mesh, level, &Options::default())?;
+        let cold = start.elapsed();
+        let mut times = Vec::new();
+        let mut last: Option<Run> = None;
+        let gpu_totals = time_runs(settings.runs, || {
+            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
+            let total = run.times.total;
+            times.push(run.times.clone());
+            last = Some(run);
+            Ok::<_, crate::subdiv::SubdivError>(total)
+        })?;
+        times.remove(0); // the warm-up run
+        let gpu = median_times(&times);
+        let run = last.unwrap_or(first);
+        progress.step(&format!("{}: CPU reference", model.name));
+        let cpu = time_runs(settings.runs, || {
+            let start = Instant::now();
+            cpu::refine(mesh, level)?;
+            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
+        })?;
+        progress.step(&format!("{}: OpenSubdiv", model.name));
+        let osd_times = osd_times(mesh, level, settings.runs)?;
+        let verdict = if settings.validate {
+            let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
+            if c.is_match() {
+                format!("match, max {:.1e} × diag", c.max_error / c.diagonal.max(f64::MIN_POSITIVE))
+            } else {
+                "MISMATCH".to_string()
+            }
+        } else {
+            "not checked".to_string()
+        };
+        out.push(Measured {
+            name: model.name.clone(),
+            input_faces: mesh.num_faces(),
+            fragments: run.fragments,
+            faces: run.mesh.num_faces(),
+            vertices: run.mesh.num_vertices(),
+            passes: gpu.passes.len(),
+            gpu_levels: run.gpu_levels,
+            texture: run.texture,
+            gpu,
+            gpu_totals,
+            cold,
+            cpu,
+            osd: osd_times,
+            verdict,
+        });
+    }
+    Ok(out)
+}
+
+/// OpenSubdiv's minimum and median seconds over `runs` timed runs (no output written).
+fn osd_times(mesh: &Mesh, level: u32, runs: usize) -> Result<(f64, f64)> {
+    let options = osd::Options { repeat: Some(runs.max(1) as u32), no_output: true, ..Default::default() };
+    let timed = osd::run(&crate::subdiv::Surface::smooth(mesh.clone()), level, &options)?;
+    match (timed.min_seconds, timed.median_seconds) {
+        (Some(min), Some(median)) => Ok((min, median)),
+        _ => Err(crate::subdiv::SubdivError::Helper {
+            path: "osd-refine".into(),
+            message: "no timing was printed".into(),
+        }),
+    }
+}
+
+/// One level of [`per_level`].
+pub struct LevelTimes {
+    pub level: u32,
+    /// GPU fragment levels in the GPU path at this level (0: the CPU did all of it).
+    pub gpu_levels: u32,
+    pub faces: usize,
+    pub gpu: Samples,
+    pub cpu: Samples,
+    /// OpenSubdiv's minimum and median, seconds.
+    pub osd: (f64, f64),
+}
+
+/// The GPU path, the CPU reference and OpenSubdiv at each level of `levels`: where the
+/// GPU starts to win.
+pub fn per_level(
+    ctx: &Context,
+    mesh: &Mesh,
+    levels: std::ops::RangeInclusive<u32>,
+    runs: usize,
+    progress: &mut dyn Progress,
+) -> Result<Vec<LevelTimes>> {
+    let mut subdivider = Subdivider::new(ctx)?;
+    let mut out = Vec::new();
+    for level in levels {
+        progress.step(&format!("level {level}"));
+        let mut faces = 0;
+        let mut gpu_levels = 0;
+        let gpu = time_runs(runs, || {
+            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
+            faces = run.mesh.num_faces();
+            gpu_levels = run.gpu_levels;
+            Ok::<_, crate::subdiv::SubdivError>(run.times.total)
+        })?;
+        let cpu = time_runs(runs, || {
+            let start = Instant::now();
+            cpu::refine(mesh, level)?;
+            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
+        })?;
+        let osd = osd_times(mesh, level, runs)?;
+        out.push(LevelTimes { level, gpu_levels, faces, gpu, cpu, osd });
+    }
+    Ok(out)
+}
+
+/// `texgeo bench subdivide`: [`measure`] and [`report`].
 pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report> {
+    let measured = measure(ctx, models, settings, &mut Log("bench subdivide"))?;
+    Ok(report(&measured, settings, Environment::new(ctx.info().label())))
+}
+
+/// Table 5 today, where the GPU path's time goes, and the thesis' Table 5.
+pub fn report(measured: &[Measured], settings: Settings, environment: Environment) -> Report {
     let level = settings.level;
     let mut table5 = Table::new(
         format!("Table 5 today: level {level}, medians (ms)"),
@@ -121,48 +282,11 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
         ],
     );
     let mut targets = Vec::new();
-    for model in models {
-        let mesh = &model.mesh;
-        // Cold: a fresh pipeline and targets (JIT compilation, first-touch allocation).
-        let start = Instant::now();
-        let mut subdivider = Subdivider::new(ctx)?;
-        let first = subdivider.refine(ctx, mesh, level, &Options::default())?;
-        let cold = start.elapsed();
-        let mut times = Vec::new();
-        let mut last: Option<Run> = None;
-        time_runs(settings.runs, || {
-            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
-            let total = run.times.total;
-            times.push(run.times.clone());
-            last = Some(run);
-            Ok::<_, crate::subdiv::SubdivError>(total)
-        })?;
-        times.remove(0); // the warm-up run
-        let gpu = median_times(&times);
-        let run = last.unwrap_or(first);
-        let cpu_time = time_runs(settings.runs, || {
-            let start = Instant::now();
-            cpu::refine(mesh, level)?;
-            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
-        })?;
-        let osd_seconds = osd::time_median(
-            &crate::subdiv::Surface::smooth(mesh.clone()),
-            level,
-            settings.runs.max(1) as u32,
-        )?;
-        let verdict = if settings.validate {
-            let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
-            if c.is_match() {
-                format!("match, max {:.1e} × diag", c.max_error / c.diagonal.max(f64::MIN_POSITIVE))
-            } else {
-                "MISMATCH".to_string()
-            }
-        } else {
-            "not checked".to_string()
-        };
-        let osd_time = Duration::from_secs_f64(osd_seconds);
-        let ratio = gpu.total.as_secs_f64() / osd_seconds.max(1e-9);
-        if model.name.ends_with("knot1.off") {
+    for m in measured {
+        let gpu = &m.gpu;
+        let osd_time = Duration::from_secs_f64(m.osd.1);
+        let ratio = gpu.total.as_secs_f64() / m.osd.1.max(1e-9);
+        if m.name.ends_with("knot1.off") {
             targets.push(format!(
                 "Speed target (knot1.off, level {level}): GPU path {} ms = {ratio:.2} × OpenSubdiv's {} ms: {} \
                  (target ≤ {SPEED_TARGET}).",
@@ -172,22 +296,22 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
             ));
         }
         table5.row(vec![
-            model.name.clone(),
-            mesh.num_faces().to_string(),
-            run.fragments.to_string(),
-            run.mesh.num_faces().to_string(),
-            run.mesh.num_vertices().to_string(),
+            m.name.clone(),
+            m.input_faces.to_string(),
+            m.fragments.to_string(),
+            m.faces.to_string(),
+            m.vertices.to_string(),
             ms(gpu.base),
             ms(gpu.passes_total()),
             ms(gpu.total),
-            ms(cpu_time.median()),
+            ms(m.cpu.median()),
             ms(osd_time),
             format!("{ratio:.2}"),
-            verdict,
+            m.verdict.clone(),
         ]);
         let passes: Vec<String> = gpu.passes.iter().map(|&p| ms(p)).collect();
         split.row(vec![
-            model.name.clone(),
+            m.name.clone(),
             ms(gpu.base),
             ms(gpu.fragments),
             ms(gpu.upload),
@@ -196,8 +320,8 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
             ms(gpu.submit),
             ms(gpu.assembly),
             ms(gpu.total),
-            ms(cold),
-            format!("2 × {}×{}", run.texture[0], run.texture[1]),
+            ms(m.cold),
+            format!("2 × {}×{}", m.texture[0], m.texture[1]),
         ]);
     }
     table5.note(format!(
@@ -219,11 +343,7 @@ pub fn run(ctx: &Context, models: &[Model], settings: Settings) -> Result<Report
          writing their texel stream and the pass tables. Assembly: dropping the support rings and welding \
          by coarse element into a Mesh (two threads).",
     );
-    Ok(Report {
-        name: "subdivide".into(),
-        environment: Environment::new(ctx.info().label()),
-        tables: vec![table5, split, thesis_table5()],
-    })
+    Report { name: "subdivide".into(), environment, tables: vec![table5, split, thesis_table5()] }
 }
 
 /// The thesis' Table 5, from `reference/subdiv/table5.csv`.

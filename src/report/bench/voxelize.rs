@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use crate::gpu::Context;
 use crate::mesh::Mesh;
-use crate::report::{Environment, Report, Samples, Table};
+use crate::report::{Environment, Log, Progress, Report, Samples, Table};
 use crate::voxel::{Grid, Method, Result, Solid, Timings, VoxelError, Voxelizer};
 
 /// The thesis' Table 5-2, as transcribed.
@@ -53,15 +53,15 @@ pub fn thesis_seconds(resolution: usize, model: &str, method: Method) -> Option<
     })
 }
 
-/// Medians of the parts of [`Timings`] over several runs.
-#[derive(Default)]
-struct Medians {
-    total: Samples,
-    prepare: Samples,
-    draw: Samples,
-    copy: Samples,
-    readback: Samples,
-    fallback: Samples,
+/// The parts of [`Timings`] over several runs.
+#[derive(Clone, Debug, Default)]
+pub struct Medians {
+    pub total: Samples,
+    pub prepare: Samples,
+    pub draw: Samples,
+    pub copy: Samples,
+    pub readback: Samples,
+    pub fallback: Samples,
 }
 
 impl Medians {
@@ -75,13 +75,121 @@ impl Medians {
     }
 }
 
+/// One method at one resolution on one model.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    pub model: String,
+    /// The model's row name in Table 5-2 ("–" when none).
+    pub thesis: &'static str,
+    pub triangles: usize,
+    pub n: usize,
+    pub method: Method,
+    /// The timed runs, or why the method cannot run on this device.
+    pub result: std::result::Result<MethodResult, String>,
+}
+
+#[derive(Clone, Debug)]
+pub struct MethodResult {
+    pub times: Medians,
+    pub fallback_centres: u64,
+    pub corrected: u64,
+    pub occupied: u64,
+    /// Equal, voxel for voxel, to the exact `scanline` volume.
+    pub identical: bool,
+}
+
+impl Measured {
+    /// Median total time, if measured.
+    pub fn total(&self) -> Option<Duration> {
+        self.result.as_ref().ok().map(|r| r.times.total.median())
+    }
+}
+
 fn ms(d: Duration) -> String {
     format!("{:.1}", d.as_secs_f64() * 1e3)
 }
 
-pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
+/// Steps [`measure`] reports.
+pub fn steps(models: usize, cfg: &Config) -> u64 {
+    (models * cfg.resolutions.len() * (cfg.methods.len() + 1)) as u64
+}
+
+/// Whether an error means "this device cannot run the method" (a row to mark) rather
+/// than a failure of the run.
+fn unsupported(e: &VoxelError) -> bool {
+    matches!(e, VoxelError::Gpu(crate::gpu::GpuError::Unsupported(_)))
+}
+
+/// Every method at every resolution on every model, each compared with `scanline`.
+pub fn measure(
+    ctx: &Context,
+    models: &[Model],
+    cfg: &Config,
+    progress: &mut dyn Progress,
+) -> Result<Vec<Measured>> {
+    progress.total(steps(models.len(), cfg));
     let mut voxelizer = Voxelizer::new(Some(ctx.clone()));
     voxelizer.zone = cfg.zone;
+    let mut out = Vec::new();
+    for model in models {
+        let solid = Solid::new(&model.mesh)?;
+        for &n in &cfg.resolutions {
+            progress.step(&format!("{} {n}³: exact reference", model.name));
+            let grid = Grid::for_mesh(&model.mesh, n)?;
+            let reference = voxelizer.run(&solid, &grid, Method::Scanline)?.volume;
+            for &method in &cfg.methods {
+                progress.step(&format!("{} {n}³: {method}", model.name));
+                let mut times = Medians::default();
+                let mut last = None;
+                let mut failed = None;
+                for run in 0..=cfg.runs.max(1) {
+                    match voxelizer.run(&solid, &grid, method) {
+                        Ok(r) => {
+                            if run > 0 {
+                                times.push(&r.timings);
+                            }
+                            last = Some(r);
+                        }
+                        Err(e) if unsupported(&e) => {
+                            failed = Some(e.to_string());
+                            break;
+                        }
+                        Err(e) => return Err(e),
+                    }
+                }
+                let result = match (failed, last) {
+                    (Some(why), _) => Err(why),
+                    (None, Some(r)) => Ok(MethodResult {
+                        times,
+                        fallback_centres: r.band.candidates as u64,
+                        corrected: r.band.changed as u64,
+                        occupied: r.volume.count(),
+                        identical: r.volume == reference,
+                    }),
+                    (None, None) => return Err(VoxelError::Usage("no run".into())),
+                };
+                out.push(Measured {
+                    model: model.name.clone(),
+                    thesis: model.thesis,
+                    triangles: solid.triangles.len(),
+                    n,
+                    method,
+                    result,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// `texgeo bench voxelize`: [`measure`] and [`report`].
+pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
+    let measured = measure(ctx, models, cfg, &mut Log("bench voxelize"))?;
+    Ok(report(&measured, cfg, Environment::new(ctx.info().label())))
+}
+
+/// Table 5-2 and the CPU/GPU ratios of `measured`.
+pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> Report {
     let mut table = Table::new(
         "Table 5-2: voxelization time per method (ms, medians) and where it goes",
         &[
@@ -118,72 +226,73 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
             "cpu / zoned excl. prepare",
         ],
     );
-    for model in models {
-        let solid = Solid::new(&model.mesh)?;
-        for &n in &cfg.resolutions {
-            let grid = Grid::for_mesh(&model.mesh, n)?;
-            let reference = voxelizer.run(&solid, &grid, Method::Scanline)?.volume;
-            let mut totals = std::collections::HashMap::new();
-            for &method in &cfg.methods {
-                let mut medians = Medians::default();
-                let mut last = None;
-                for run in 0..=cfg.runs.max(1) {
-                    let r = voxelizer.run(&solid, &grid, method)?;
-                    if run > 0 {
-                        medians.push(&r.timings);
-                    }
-                    last = Some(r);
+    let mut failures = Vec::new();
+    for group in measured.chunk_by(|a, b| a.model == b.model && a.n == b.n) {
+        let (model, n) = (&group[0].model, group[0].n);
+        let mut totals = std::collections::HashMap::new();
+        for m in group {
+            let thesis = thesis_seconds(n, m.thesis, m.method).map_or("–".into(), |s| format!("{s}"));
+            let r = match &m.result {
+                Ok(r) => r,
+                Err(why) => {
+                    let mut row =
+                        vec![model.clone(), m.triangles.to_string(), n.to_string(), m.method.to_string()];
+                    row.extend((0..11).map(|_| "–".to_string()));
+                    row.push(thesis);
+                    table.row(row);
+                    failures.push(format!("{model} {n}³ {}: {why}", m.method));
+                    continue;
                 }
-                let r = last.ok_or_else(|| VoxelError::Usage("no run".into()))?;
-                let identical = r.volume == reference;
-                let total = medians.total.median();
-                let prepare = medians.prepare.median();
-                totals.insert(method, (total, total.saturating_sub(prepare)));
-                table.row(vec![
-                    model.name.clone(),
-                    solid.triangles.len().to_string(),
-                    n.to_string(),
-                    method.to_string(),
-                    ms(total),
-                    ms(total.saturating_sub(prepare)),
-                    ms(prepare),
-                    ms(medians.draw.median()),
-                    ms(medians.copy.median()),
-                    ms(medians.readback.median()),
-                    ms(medians.fallback.median()),
-                    r.band.candidates.to_string(),
-                    r.band.changed.to_string(),
-                    r.volume.count().to_string(),
-                    if identical { "yes".into() } else { "NO".into() },
-                    thesis_seconds(n, model.thesis, method).map_or("–".into(), |s| format!("{s}")),
-                ]);
-                eprintln!("{} {n}³ {method}: {} ms", model.name, ms(total));
-            }
-            let get = |m: Method| totals.get(&m).copied();
-            if get(Method::Cpu).is_some() || (get(Method::Pgpu).is_some() && get(Method::Zoned).is_some()) {
-                let time =
-                    |m: Method, excl: bool| get(m).map_or("–".into(), |t| ms(if excl { t.1 } else { t.0 }));
-                let ratio = |a: Method, b: Method, excl: bool| match (get(a), get(b)) {
-                    (Some(x), Some(y)) => {
-                        let y = if excl { y.1 } else { y.0 };
-                        format!("{:.2}", x.0.as_secs_f64() / y.as_secs_f64().max(1e-9))
-                    }
-                    _ => "–".into(),
-                };
-                ratios.row(vec![
-                    model.name.clone(),
-                    n.to_string(),
-                    time(Method::Cpu, false),
-                    time(Method::Pgpu, false),
-                    time(Method::Zoned, false),
-                    ratio(Method::Cpu, Method::Pgpu, false),
-                    ratio(Method::Cpu, Method::Zoned, false),
-                    ratio(Method::Pgpu, Method::Zoned, false),
-                    time(Method::Zoned, true),
-                    ratio(Method::Cpu, Method::Zoned, true),
-                ]);
-            }
+            };
+            let total = r.times.total.median();
+            let prepare = r.times.prepare.median();
+            totals.insert(m.method, (total, total.saturating_sub(prepare)));
+            table.row(vec![
+                model.clone(),
+                m.triangles.to_string(),
+                n.to_string(),
+                m.method.to_string(),
+                ms(total),
+                ms(total.saturating_sub(prepare)),
+                ms(prepare),
+                ms(r.times.draw.median()),
+                ms(r.times.copy.median()),
+                ms(r.times.readback.median()),
+                ms(r.times.fallback.median()),
+                r.fallback_centres.to_string(),
+                r.corrected.to_string(),
+                r.occupied.to_string(),
+                if r.identical { "yes".into() } else { "NO".into() },
+                thesis,
+            ]);
         }
+        let get = |m: Method| totals.get(&m).copied();
+        if get(Method::Cpu).is_some() || (get(Method::Pgpu).is_some() && get(Method::Zoned).is_some()) {
+            let time =
+                |m: Method, excl: bool| get(m).map_or("–".into(), |t| ms(if excl { t.1 } else { t.0 }));
+            let ratio = |a: Method, b: Method, excl: bool| match (get(a), get(b)) {
+                (Some(x), Some(y)) => {
+                    let y = if excl { y.1 } else { y.0 };
+                    format!("{:.2}", x.0.as_secs_f64() / y.as_secs_f64().max(1e-9))
+                }
+                _ => "–".into(),
+            };
+            ratios.row(vec![
+                model.clone(),
+                n.to_string(),
+                time(Method::Cpu, false),
+                time(Method::Pgpu, false),
+                time(Method::Zoned, false),
+                ratio(Method::Cpu, Method::Pgpu, false),
+                ratio(Method::Cpu, Method::Zoned, false),
+                ratio(Method::Pgpu, Method::Zoned, false),
+                time(Method::Zoned, true),
+                ratio(Method::Cpu, Method::Zoned, true),
+            ]);
+        }
+    }
+    for f in failures {
+        table.note(format!("not measured on this device: {f}"));
     }
     table.note(format!(
         "{} timed runs after one warm-up; medians. total = wall time of one voxelization from the \
@@ -202,9 +311,5 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
         "The issue asks pgpu/zoned to be at least 3× faster than cpu on armadillo at 256³ with lavapipe, \
          and zoned never slower than pgpu.",
     );
-    Ok(Report {
-        name: "voxelize".into(),
-        environment: Environment::new(ctx.info().label()),
-        tables: vec![table, ratios],
-    })
+    Report { name: "voxelize".into(), environment, tables: vec![table, ratios] }
 }

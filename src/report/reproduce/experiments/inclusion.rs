@@ -1,0 +1,263 @@
+//! Point in solid (2006 Ch. 4, Tables 4-4 … 4-9) through `texgeo bench inclusion`'s
+//! measuring code.
+
+use super::{Model, Quantity, both, comparison, curve, models_table, quick_models, ratio_curve, stand_ins};
+use crate::report::bench::inclusion::{self, Config, STAND_INS};
+use crate::report::plot::{Chart, Series};
+use crate::report::reproduce::doc::Block;
+use crate::report::reproduce::facts::Stat;
+use crate::report::reproduce::{Result, Run};
+use crate::report::{Environment, Table};
+
+const EXP: &str = "inclusion";
+
+/// Methods in the time curves, with their labels.
+const METHODS: [(&str, &str); 7] = [
+    ("cpu", "Feito-Torres CPU"),
+    ("gpu", "GPU"),
+    ("gpu+tetragrid", "GPU + TetraGrid 32³"),
+    ("tetragrid", "TetraGrid 32³"),
+    ("octants", "octants"),
+    ("jordan", "Jordan"),
+    ("jordan-octree", "Jordan + octree 6"),
+];
+
+pub fn run(r: &mut Run) -> Result<Vec<Block>> {
+    let (models, notes) =
+        if r.quick { (quick_models(), Vec::new()) } else { stand_ins(r.models_dir, STAND_INS)? };
+    let cfg = Config { sets: if r.quick { 4 } else { 10 }, ..Config::default() };
+    let models: Vec<inclusion::Model> = models
+        .into_iter()
+        .map(|Model { thesis, name, mesh }| inclusion::Model { thesis, name, mesh })
+        .collect();
+    let measured = inclusion::measure(r.ctx, &models, &cfg, r.progress)?;
+
+    for m in &measured {
+        let f = &mut *r.facts;
+        f.model(EXP, &m.name, m.triangles as f64, m.thesis);
+        for (method, samples) in &m.times {
+            f.add(EXP, &m.name, &format!("time:{method}"), "s", Stat::mean_of(samples));
+        }
+        for (method, why) in &m.failed {
+            f.missing(EXP, &m.name, &format!("time:{method}"), "s", why);
+        }
+        for (i, &n) in cfg.resolutions.iter().enumerate() {
+            f.add(EXP, &m.name, &format!("time:tetragrid-{n}"), "s", Stat::mean_of(&m.grid_times[i]));
+            let (build, bytes) = m.grid_builds[i];
+            f.add(EXP, &m.name, &format!("build:tetragrid-{n}"), "s", Stat::exact(build.as_secs_f64()));
+            f.add(
+                EXP,
+                &m.name,
+                &format!("memory:tetragrid-{n}"),
+                "KiB",
+                Stat::exact(bytes.div_ceil(1024) as f64),
+            );
+            f.add(EXP, &m.name, &format!("tested:tetragrid-{n}"), "", Stat::exact(m.grid_tested[i]));
+        }
+        for (index, stats) in &m.index {
+            f.add(EXP, &m.name, &format!("build:{index}"), "s", Stat::exact(stats.build_time.as_secs_f64()));
+            f.add(
+                EXP,
+                &m.name,
+                &format!("memory:{index}"),
+                "KiB",
+                Stat::exact(stats.bytes.div_ceil(1024) as f64),
+            );
+        }
+        for d in &m.disagreements {
+            r.disagreement(format!("inclusion: {d} on {}", m.name));
+        }
+    }
+
+    let mut blocks = vec![Block::Para(format!(
+        "{} sets of {} uniform random points in each model's bounding box (fixed seeds); a time is the mean per set \
+         after one untimed warm-up, as in the thesis (§4.4.2). Every method's answer is compared with the exact \
+         `cpu` test on every point.",
+        cfg.sets, cfg.points
+    ))];
+    let list: Vec<(String, &str, usize)> =
+        measured.iter().map(|m| (m.name.clone(), m.thesis, m.triangles)).collect();
+    blocks.push(r.table(models_table(EXP, r, &list), "inclusion-models")?);
+    blocks.extend(notes.into_iter().map(Block::Para));
+    let wrong: Vec<String> = measured
+        .iter()
+        .flat_map(|m| m.disagreements.iter().map(move |d| format!("{d} on {}", m.name)))
+        .collect();
+    blocks.push(Block::Para(if wrong.is_empty() {
+        "**All methods agree on every point** of every set.".to_string()
+    } else {
+        format!("**Methods that disagree with the exact test:** {}.", wrong.join(", "))
+    }));
+    let failed: Vec<String> = measured
+        .iter()
+        .flat_map(|m| m.failed.iter().map(move |(k, why)| format!("{k} on {}: {why}", m.name)))
+        .collect();
+    if !failed.is_empty() {
+        blocks.push(Block::Para(format!("**Not measurable on this device:** {}.", failed.join("; "))));
+    }
+
+    let res = &cfg.resolutions;
+    let mut q44 = Vec::new();
+    for n in res {
+        q44.push(Quantity::same(format!("{n}³ build (s)"), format!("build:tetragrid-{n}")));
+        q44.push(Quantity::same(format!("{n}³ memory (KiB)"), format!("memory:tetragrid-{n}")));
+    }
+    let tables: [(&str, &str, &str, Vec<Quantity>); 6] = [
+        ("4-4", "Table 4-4: TetraGrid build time and memory", "s or KiB", q44),
+        (
+            "4-5",
+            "Table 4-5: Feito-Torres without and with TetraGrid, s per set",
+            "s",
+            std::iter::once(Quantity::same("no optimizer", "time:cpu"))
+                .chain(
+                    res.iter()
+                        .map(|n| Quantity::same(format!("TetraGrid {n}³"), format!("time:tetragrid-{n}"))),
+                )
+                .collect(),
+        ),
+        (
+            "4-6",
+            "Table 4-6: versions of Feito-Torres, s per set",
+            "s",
+            vec![
+                Quantity::same("basic (cpu)", "time:cpu"),
+                Quantity::same("CPU+GPU", "time:cpu+gpu"),
+                Quantity::same("GPU", "time:gpu"),
+                Quantity::new("GPU, one tetrahedron per point-vertex", "time:gpu-batch-1", "time:gpu"),
+                Quantity::same("octants", "time:octants"),
+                Quantity::same("TetraGrid 32³", "time:tetragrid"),
+                Quantity::same("GPU + TetraGrid 32³", "time:gpu+tetragrid"),
+            ],
+        ),
+        (
+            "4-7",
+            "Table 4-7: memory of each method's index (KiB; a BVH stands where the thesis had a BSP)",
+            "KiB",
+            vec![
+                Quantity::same("Feito (octants)", "memory:octants"),
+                Quantity::same("Feito (TetraGrid 32³)", "memory:tetragrid"),
+                Quantity::new("BVH (thesis: BSP)", "memory:bvh", "memory:bsp"),
+                Quantity::same("Jordan (octree 6)", "memory:jordan-octree"),
+            ],
+        ),
+        (
+            "4-8",
+            "Table 4-8: time to build each method's index (s)",
+            "s",
+            vec![
+                Quantity::same("Feito (octants)", "build:octants"),
+                Quantity::same("Feito (TetraGrid 32³)", "build:tetragrid"),
+                Quantity::new("BVH (thesis: BSP)", "build:bvh", "build:bsp"),
+                Quantity::same("Jordan (octree 6)", "build:jordan-octree"),
+            ],
+        ),
+        (
+            "4-9",
+            "Table 4-9: inclusion tests, s per set",
+            "s",
+            vec![
+                Quantity::same("Feito CPU", "time:cpu"),
+                Quantity::same("Feito GPU", "time:gpu"),
+                Quantity::same("Feito GPU + TetraGrid 32³", "time:gpu+tetragrid"),
+                Quantity::new("Feito BVH (thesis: BSP)", "time:bvh", "time:bsp"),
+                Quantity::same("Jordan", "time:jordan"),
+                Quantity::same("Jordan + octree 6", "time:jordan-octree"),
+            ],
+        ),
+    ];
+    for (id, title, unit, quantities) in tables {
+        let t = comparison(r, EXP, title, unit, &quantities);
+        blocks.push(r.table(t, &format!("inclusion-table{id}"))?);
+    }
+
+    // Plots: the thesis' Figs. 4-5 … 4-10 as curves, today's beside the thesis'.
+    let mut series = Vec::new();
+    for (i, (key, label)) in METHODS.iter().enumerate() {
+        let k = format!("time:{key}");
+        series.extend(both(label, i, curve(r.facts, EXP, &k), curve(r.thesis, EXP, &k)));
+    }
+    let chart = Chart {
+        title: "Point in solid: time per set of points against triangles (Figs. 4-7, 4-10)".into(),
+        x_label: "triangles".into(),
+        y_label: format!("s per set of {} points", cfg.points),
+        x_log: true,
+        y_log: true,
+        series,
+    };
+    blocks.push(r.plot(&chart, "inclusion-time-vs-triangles")?);
+
+    let mut series = Vec::new();
+    for (i, (key, label)) in
+        [("gpu", "GPU"), ("gpu+tetragrid", "GPU + TetraGrid"), ("tetragrid", "TetraGrid")].iter().enumerate()
+    {
+        let k = format!("time:{key}");
+        series.extend(both(
+            &format!("cpu / {label}"),
+            i,
+            ratio_curve(r.facts, EXP, "time:cpu", &k),
+            ratio_curve(r.thesis, EXP, "time:cpu", &k),
+        ));
+    }
+    let chart = Chart {
+        title: "Point in solid: speed-up over the CPU test against triangles".into(),
+        x_label: "triangles".into(),
+        y_label: "speed-up (×)".into(),
+        x_log: true,
+        y_log: true,
+        series,
+    };
+    blocks.push(r.plot(&chart, "inclusion-speedup")?);
+
+    for (key, what, unit, stem, fig) in [
+        ("time", "test time", "s per set", "inclusion-tetragrid-time", "Fig. 4-6"),
+        ("memory", "memory", "KiB", "inclusion-tetragrid-memory", "Fig. 4-5"),
+    ] {
+        let mut series = Vec::new();
+        for (i, (model, _)) in r.facts.models_of(EXP).iter().enumerate() {
+            let thesis_model = r.facts.thesis_name(EXP, model);
+            let pts = |f: &crate::report::reproduce::Facts, m: &str| -> Vec<(f64, f64)> {
+                res.iter()
+                    .filter_map(|&n| {
+                        f.get(EXP, m, &format!("{key}:tetragrid-{n}")).ok().map(|s| (n as f64, s.value))
+                    })
+                    .collect()
+            };
+            series.push(Series {
+                label: model.clone(),
+                points: pts(r.facts, model),
+                thesis: false,
+                colour: i,
+            });
+            let then = pts(r.thesis, &thesis_model);
+            if !then.is_empty() {
+                series.push(Series {
+                    label: format!("{thesis_model} (thesis)"),
+                    points: then,
+                    thesis: true,
+                    colour: i,
+                });
+            }
+        }
+        let chart = Chart {
+            title: format!("TetraGrid {what} against resolution ({fig})"),
+            x_label: "grid resolution n (n³ cells)".into(),
+            y_label: unit.into(),
+            x_log: true,
+            y_log: true,
+            series,
+        };
+        blocks.push(r.plot(&chart, stem)?);
+    }
+
+    blocks.push(Block::Heading(3, "Details (as `texgeo bench inclusion` prints them)".into()));
+    let details = inclusion::report(&measured, &cfg, Environment::new(r.ctx.info().label()));
+    for (k, t) in details.tables.into_iter().enumerate() {
+        let stem = if t.stem.is_empty() {
+            format!("inclusion-bench-{}", k + 1)
+        } else {
+            format!("inclusion-bench-{}", t.stem)
+        };
+        blocks.push(r.table(Table { stem: String::new(), ..t }, &stem)?);
+    }
+    Ok(blocks)
+}

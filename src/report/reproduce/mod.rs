@@ -1,0 +1,437 @@
+//! `texgeo reproduce`: every experiment of both theses in one run, and one report a
+//! reader can open, diff against another machine's and paste from (SPEC §7).
+//!
+//! The experiments are a list of entries ([`EXPERIMENTS`]): a name, the thesis tables it
+//! reproduces, the function that runs it (the `texgeo bench …` suites' own measuring
+//! code), the thesis' claims about it (`claims.rs`) and its pictures. An experiment
+//! whose command does not exist yet is an entry without a runner: its section says so
+//! and its claims are "not measurable". Adding one is adding an entry.
+//!
+//! A run writes into its folder: `report.md` and `report.html` (the same blocks, the HTML
+//! with every figure inline), `csv/` (every table, plus `measurements.csv` — each
+//! measured value with the range of its repeated runs, which `--compare` uses as its
+//! noise — and `claims.csv`), `plots/` (SVG + PNG), `figures/` (PNG pictures rendered by
+//! texgeo's own Vulkan pipeline, described in `figures.json`) and `run.json` (machine,
+//! device, version). Every file is written atomically.
+
+mod claims;
+mod compare;
+mod doc;
+mod experiments;
+mod facts;
+mod figures;
+mod files;
+mod header;
+mod thesis;
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+pub use claims::{Claim, Verdict};
+pub use compare::compare;
+pub use experiments::{EXPERIMENTS, Experiment, Figure};
+pub use facts::{Facts, Stat};
+pub use figures::{FigureRecord, valence_model};
+pub use files::{check_writable, write_atomic};
+
+use crate::gpu::Context;
+use crate::report::{Progress, Table};
+use doc::Block;
+use files::Layout;
+
+pub type Result<T, E = ReproduceError> = std::result::Result<T, E>;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ReproduceError {
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{0}")]
+    Usage(String),
+    #[error("{0}")]
+    Plot(String),
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::GpuError),
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    #[error(transparent)]
+    Inclusion(#[from] crate::inclusion::InclusionError),
+    #[error(transparent)]
+    Voxel(#[from] crate::voxel::VoxelError),
+    #[error(transparent)]
+    Subdiv(#[from] crate::subdiv::SubdivError),
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error(transparent)]
+    Boolean(#[from] crate::boolean::BooleanError),
+}
+
+impl ReproduceError {
+    /// The device feature missing, when that is why the error happened: such an
+    /// experiment is not measurable on this device rather than failed.
+    pub fn unsupported(&self) -> Option<&str> {
+        use crate::gpu::GpuError::Unsupported;
+        let gpu = match self {
+            ReproduceError::Gpu(g) => g,
+            ReproduceError::Inclusion(crate::inclusion::InclusionError::Gpu(g)) => g,
+            ReproduceError::Voxel(crate::voxel::VoxelError::Gpu(g)) => g,
+            ReproduceError::Subdiv(crate::subdiv::SubdivError::Gpu(g)) => g,
+            ReproduceError::Render(crate::render::RenderError::Gpu(g)) => g,
+            ReproduceError::Boolean(crate::boolean::BooleanError::Inclusion {
+                source: crate::inclusion::InclusionError::Gpu(g),
+                ..
+            }) => g,
+            _ => return None,
+        };
+        match gpu {
+            Unsupported(m) => Some(m),
+            _ => None,
+        }
+    }
+}
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Built-in models and small sizes (about two minutes on two cores).
+    pub quick: bool,
+    /// Where `tools/fetch-models` put the thesis stand-ins.
+    pub models_dir: PathBuf,
+    /// Experiment names to run (empty: all).
+    pub only: Vec<String>,
+    pub out: PathBuf,
+}
+
+impl Config {
+    /// Checks `--only` names and the output folder before anything runs.
+    pub fn check(&self) -> Result<()> {
+        for name in &self.only {
+            if !EXPERIMENTS.iter().any(|e| e.key == name) {
+                return Err(ReproduceError::Usage(format!(
+                    "--only: unknown experiment '{name}' (known: {})",
+                    EXPERIMENTS.iter().map(|e| e.key).collect::<Vec<_>>().join(", ")
+                )));
+            }
+        }
+        check_writable(&self.out)
+    }
+
+    fn selected(&self, key: &str) -> bool {
+        self.only.is_empty() || self.only.iter().any(|o| o == key)
+    }
+}
+
+/// Shows a run's progress: one progress per experiment.
+pub trait Monitor {
+    /// `name` starts; its steps go to the returned progress.
+    fn begin(&mut self, name: &str) -> Box<dyn Progress>;
+    /// `name` ended, after `elapsed`.
+    fn end(&mut self, name: &str, elapsed: Duration);
+}
+
+/// A monitor that shows nothing.
+pub struct Quiet;
+
+struct NoProgress;
+
+impl Progress for NoProgress {
+    fn step(&mut self, _what: &str) {}
+}
+
+impl Monitor for Quiet {
+    fn begin(&mut self, _name: &str) -> Box<dyn Progress> {
+        Box::new(NoProgress)
+    }
+    fn end(&mut self, _name: &str, _elapsed: Duration) {}
+}
+
+/// What a run produced.
+#[derive(Debug)]
+pub struct Outcome {
+    pub report: PathBuf,
+    pub html: PathBuf,
+    /// Experiments that failed, with the error (their sections say so too).
+    pub failures: Vec<(String, String)>,
+    /// Methods whose answers differed from the reference, per experiment.
+    pub disagreements: Vec<String>,
+    /// Claims per verdict: holds, does not hold, not measurable.
+    pub verdicts: [usize; 3],
+    pub elapsed: Duration,
+}
+
+/// The state an experiment runs with: the device, the settings, where its tables,
+/// plots and pictures go, and the facts it adds for the claims.
+pub struct Run<'a> {
+    pub ctx: &'a Context,
+    pub quick: bool,
+    pub models_dir: &'a Path,
+    pub progress: &'a mut dyn Progress,
+    pub facts: &'a mut Facts,
+    pub thesis: &'a Facts,
+    layout: &'a Layout,
+    names: &'a mut HashSet<String>,
+    figures: &'a mut Vec<FigureRecord>,
+    disagreements: &'a mut Vec<String>,
+}
+
+impl Run<'_> {
+    fn unique(&mut self, stem: &str) -> Result<()> {
+        if !self.names.insert(stem.to_string()) {
+            return Err(ReproduceError::Usage(format!("two outputs are named {stem}")));
+        }
+        Ok(())
+    }
+
+    /// `table` as a block, its cells written to `csv/STEM.csv`. An empty cell (a number
+    /// a thesis table does not have) shows as "–".
+    pub fn table(&mut self, mut table: Table, stem: &str) -> Result<Block> {
+        self.unique(&format!("csv/{stem}"))?;
+        for cell in table.rows.iter_mut().flatten().filter(|c| c.trim().is_empty()) {
+            *cell = "–".to_string();
+        }
+        let csv = format!("{}/{stem}.csv", Layout::CSV);
+        self.layout.write(&csv, table.to_csv().as_bytes())?;
+        Ok(Block::Table { table, csv })
+    }
+
+    /// `chart` as `plots/STEM.svg` and `.png`.
+    pub fn plot(&mut self, chart: &crate::report::plot::Chart, stem: &str) -> Result<Block> {
+        self.unique(&format!("plots/{stem}"))?;
+        let (svg, png) = (format!("{}/{stem}.svg", Layout::PLOTS), format!("{}/{stem}.png", Layout::PLOTS));
+        self.layout.write(&svg, chart.svg().map_err(ReproduceError::Plot)?.as_bytes())?;
+        self.layout.write(&png, &chart.png().map_err(ReproduceError::Plot)?)?;
+        Ok(Block::Plot { svg, png, caption: chart.title.clone() })
+    }
+
+    /// A rendered picture as `figures/STEM.png`, described in `figures.json`.
+    pub fn picture(
+        &mut self,
+        picture: &crate::render::Picture,
+        stem: &str,
+        caption: &str,
+        mut record: FigureRecord,
+    ) -> Result<Block> {
+        self.unique(&format!("figures/{stem}"))?;
+        let path = format!("{}/{stem}.png", Layout::FIGURES);
+        picture.save_png(self.layout.root.join(&path))?;
+        record.file = path.clone();
+        record.width = picture.width;
+        record.height = picture.height;
+        self.figures.push(record);
+        Ok(Block::Image { path, caption: caption.to_string(), width: picture.width, height: picture.height })
+    }
+
+    /// Records that `what` gave answers different from the reference.
+    pub fn disagreement(&mut self, what: String) {
+        self.disagreements.push(what);
+    }
+}
+
+/// Runs the selected experiments and writes the report into `config.out`.
+pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<Outcome> {
+    config.check()?;
+    let start = Instant::now();
+    let layout = Layout::create(&config.out)?;
+    let header = header::Header::new(ctx, config);
+    let thesis = thesis::facts();
+    let mut today = facts::Facts::new(facts::Source::Today);
+    let mut names = HashSet::new();
+    let mut figures = Vec::new();
+    let mut disagreements = Vec::new();
+    let mut failures = Vec::new();
+    let mut sections: Vec<(usize, Vec<Block>, String, Duration)> = Vec::new();
+
+    for (i, e) in EXPERIMENTS.iter().enumerate() {
+        if !config.selected(e.key) {
+            today.skipped(e.key, "not run: left out by --only");
+            continue;
+        }
+        let t = Instant::now();
+        let mut progress = monitor.begin(e.title);
+        let mut blocks = Vec::new();
+        let status = match e.runner {
+            Err(why) => {
+                today.skipped(e.key, why);
+                blocks.push(Block::Para(format!("**Not run:** {why}.")));
+                format!("not run: {why}")
+            }
+            Ok(runner) => {
+                let mut r = Run {
+                    ctx,
+                    quick: config.quick,
+                    models_dir: &config.models_dir,
+                    progress: progress.as_mut(),
+                    facts: &mut today,
+                    thesis: &thesis,
+                    layout: &layout,
+                    names: &mut names,
+                    figures: &mut figures,
+                    disagreements: &mut disagreements,
+                };
+                let mut result = runner(&mut r);
+                if let Ok(b) = &mut result {
+                    let drawn: Vec<&Figure> = e.figures.iter().collect();
+                    r.progress.total(drawn.len() as u64);
+                    for f in drawn {
+                        r.progress.step(f.title);
+                        b.push(Block::Heading(4, format!("Figure: {} ({})", f.title, f.thesis)));
+                        match f.draw {
+                            Err(why) => b.push(Block::Para(format!("Not drawn: {why}."))),
+                            Ok(draw) => match draw(&mut r) {
+                                Ok(pics) => b.extend(pics),
+                                Err(err) => match err.unsupported() {
+                                    Some(why) => {
+                                        b.push(Block::Para(format!("**Not drawn on this device:** {why}.")))
+                                    }
+                                    None => {
+                                        failures.push((format!("{}: figure {}", e.key, f.key), err.to_string()));
+                                        b.push(Block::Para(format!("**Figure failed:** {err}")));
+                                    }
+                                },
+                            },
+                        }
+                    }
+                }
+                match result {
+                    Ok(b) => {
+                        blocks.extend(b);
+                        "ran".to_string()
+                    }
+                    Err(err) => match err.unsupported() {
+                        Some(why) => {
+                            today.skipped(e.key, &format!("not measurable on this device: {why}"));
+                            blocks.push(Block::Para(format!("**Not measurable on this device:** {why}.")));
+                            format!("not measurable on this device: {why}")
+                        }
+                        None => {
+                            today.skipped(e.key, &format!("the experiment failed: {err}"));
+                            failures.push((e.key.to_string(), err.to_string()));
+                            blocks.push(Block::Para(format!("**Failed:** {err}")));
+                            format!("FAILED: {err}")
+                        }
+                    },
+                }
+            }
+        };
+        let elapsed = t.elapsed();
+        monitor.end(e.title, elapsed);
+        sections.push((i, blocks, status, elapsed));
+    }
+
+    // The claims, computed from the thesis' numbers and from today's.
+    let mut claims_table = Table::new(
+        "Claims of the theses, checked against today's measurements",
+        &[
+            "id",
+            "source",
+            "claim (the thesis' words)",
+            "decided by",
+            "thesis' own numbers",
+            "measured here",
+            "verdict",
+        ],
+    );
+    let mut verdicts = [0usize; 3];
+    for e in EXPERIMENTS {
+        for c in e.claims {
+            let then = (c.measure)(&thesis);
+            let now = (c.measure)(&today);
+            let verdict = Verdict::of(&now);
+            verdicts[match verdict {
+                Verdict::Holds => 0,
+                Verdict::DoesNotHold => 1,
+                Verdict::NotMeasurable(_) => 2,
+            }] += 1;
+            let thesis_cell = match &then {
+                Ok((shown, holds)) => format!("{shown} ({})", if *holds { "holds" } else { "does not hold" }),
+                Err(why) => format!("– ({why})"),
+            };
+            let measured = match &now {
+                Ok((shown, _)) => shown.clone(),
+                Err(why) => why.clone(),
+            };
+            claims_table.row(vec![
+                c.id.to_string(),
+                c.source.to_string(),
+                format!("{} («{}»)", c.claim, c.quote),
+                c.rule.to_string(),
+                thesis_cell,
+                measured,
+                verdict.word().to_string(),
+            ]);
+        }
+    }
+    claims_table.note(
+        "Verdicts are computed from the numbers by the rule in \"decided by\"; the same rule applied to the thesis' \
+         own tables gives \"thesis' own numbers\". Words of degree are read the same way everywhere: faster or better \
+         — a ratio above 1; much, considerably, greatly — at least 2×; drastically, enormously, the vast majority — \
+         at least 10× (90 %); linear — a log–log slope within 0.8–1.2; close — within a factor of 2; equal or better \
+         — not slower beyond the range of the repeated runs (within 5 % for single numbers, such as the thesis'). \
+         \"not measurable\" says why in \"measured here\".",
+    );
+
+    let elapsed = start.elapsed();
+    let longest = sections.iter().max_by_key(|s| s.3).map(|s| (EXPERIMENTS[s.0].title, s.3));
+    let write_table = |t: Table, stem: &str| -> Result<Block> {
+        let csv = format!("{}/{stem}.csv", Layout::CSV);
+        layout.write(&csv, t.to_csv().as_bytes())?;
+        Ok(Block::Table { table: t, csv })
+    };
+    let mut blocks = vec![write_table(header.table(elapsed, longest), "run")?, header::Header::note()];
+    let mut summary =
+        Table::new("Experiments", &["experiment", "thesis tables", "command", "status", "time (s)"]);
+    for (i, _, status, t) in &sections {
+        let e = &EXPERIMENTS[*i];
+        summary.row(vec![
+            format!("[{}](#{})", e.title, doc::anchor(e.title)),
+            e.tables.to_string(),
+            format!("`{}`", e.command),
+            status.clone(),
+            format!("{:.1}", t.as_secs_f64()),
+        ]);
+    }
+    blocks.push(Block::Heading(2, "Summary".into()));
+    blocks.push(write_table(summary, "experiments")?);
+    blocks.push(Block::Para(format!(
+        "Claims: **{}** hold, **{}** do not hold, **{}** are not measurable here (details in [Claims](#claims)). {}",
+        verdicts[0],
+        verdicts[1],
+        verdicts[2],
+        if disagreements.is_empty() {
+            "Every method gave the reference's answer on every point, voxel and vertex checked.".to_string()
+        } else {
+            format!("**Answers that differ from the reference:** {}.", disagreements.join("; "))
+        }
+    )));
+    blocks.push(Block::Heading(2, "Claims".into()));
+    blocks.push(write_table(claims_table, "claims")?);
+    for (i, body, _, _) in sections {
+        let e = &EXPERIMENTS[i];
+        blocks.push(Block::Heading(2, e.title.to_string()));
+        blocks.push(Block::Para(format!("Reproduces {}; the same code as `{}`.", e.tables, e.command)));
+        blocks.extend(body);
+    }
+    blocks.push(Block::Heading(2, "Files".into()));
+    blocks.push(Block::List(vec![
+        "`report.md`, `report.html` (the same report, figures inline)".into(),
+        "`csv/` every table above as CSV; `csv/measurements.csv` every measured value with the range of its runs; \
+         `csv/claims.csv` the claims"
+            .into(),
+        "`plots/` SVG and PNG of every plot; `figures/` the pictures, described in `figures.json`".into(),
+        "`run.json` machine, device and version; `texgeo reproduce --compare OLD NEW` compares two runs".into(),
+    ]));
+
+    let measurements = compare::measurements_csv(&today);
+    layout.write("csv/measurements.csv", measurements.as_bytes())?;
+    layout.write("run.json", header.json().as_bytes())?;
+    let figures_json = serde_json::to_string_pretty(&figures)
+        .map_err(|e| ReproduceError::Usage(format!("figures.json: {e}")))?;
+    layout.write("figures.json", figures_json.as_bytes())?;
+    let markdown = format!("# texgeo reproduction report\n\n{}", doc::to_markdown(&blocks));
+    let report = layout.write("report.md", markdown.as_bytes())?;
+    let mut html_blocks = vec![Block::Heading(1, "texgeo reproduction report".into())];
+    html_blocks.extend(blocks);
+    let html = doc::to_html("texgeo reproduction report", &html_blocks, &layout.root)?;
+    let html = layout.write("report.html", html.as_bytes())?;
+    Ok(Outcome { report, html, failures, disagreements, verdicts, elapsed })
+}

@@ -1,0 +1,159 @@
+//! The thesis' numbers (`reference/`) as facts, under the same names as today's, so a
+//! claim is computed the same way from both.
+
+use super::facts::{Facts, Source, Stat};
+use crate::report::bench::{inclusion, subdiv, voxelize};
+
+/// (column of the thesis CSV, fact key, unit, scale to texgeo's unit).
+type Columns<'a> = &'a [(&'a str, &'a str, &'static str)];
+
+/// Reads one transcribed table: every row of `model` + `columns`.
+fn table(facts: &mut Facts, experiment: &'static str, csv: &str, size_column: &str, columns: Columns) {
+    let mut lines = csv.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let model = cells[0].to_string();
+        let size = col(size_column).and_then(|c| cells.get(c)).and_then(|v| v.parse::<f64>().ok());
+        if let Some(size) = size {
+            facts.model(experiment, &model, size, &model);
+        }
+        for &(column, key, unit) in columns {
+            let Some(cell) = col(column).and_then(|c| cells.get(c)) else { continue };
+            match cell.trim().parse::<f64>() {
+                Ok(v) => facts.add(experiment, &model, key, unit, Stat::exact(v)),
+                Err(_) if cell.trim().is_empty() => {}
+                // "stack overflow" and the like: the thesis says why there is no number.
+                Err(_) => facts.missing(experiment, &model, key, unit, cell.trim()),
+            }
+        }
+    }
+}
+
+/// Every transcribed table of both theses.
+pub fn facts() -> Facts {
+    let mut f = Facts::new(Source::Thesis);
+    let inc = "inclusion";
+    table(
+        &mut f,
+        inc,
+        inclusion::thesis_csv("4-9"),
+        "faces",
+        &[
+            ("feito_cpu", "time:cpu", "s"),
+            ("feito_gpu", "time:gpu", "s"),
+            ("feito_gpu_tetragrid_32", "time:gpu+tetragrid", "s"),
+            ("bsp", "time:bsp", "s"),
+            ("jordan", "time:jordan", "s"),
+            ("jordan_octree_6", "time:jordan-octree", "s"),
+        ],
+    );
+    table(
+        &mut f,
+        inc,
+        inclusion::thesis_csv("4-6"),
+        "faces",
+        &[
+            ("cpu_gpu", "time:cpu+gpu", "s"),
+            ("octants", "time:octants", "s"),
+            ("tetragrid_32", "time:tetragrid", "s"),
+        ],
+    );
+    let grid_times: Vec<(String, String)> = [2, 4, 8, 16, 32, 64]
+        .iter()
+        .map(|n| (format!("tetragrid_{n}"), format!("time:tetragrid-{n}")))
+        .collect();
+    let cols: Vec<(&str, &str, &str)> =
+        grid_times.iter().map(|(c, k)| (c.as_str(), k.as_str(), "s")).collect();
+    table(&mut f, inc, inclusion::thesis_csv("4-5"), "faces", &cols);
+    let builds: Vec<(String, String, String, String)> = [2, 4, 8, 16, 32, 64]
+        .iter()
+        .map(|n| {
+            (
+                format!("time_{n}"),
+                format!("build:tetragrid-{n}"),
+                format!("kb_{n}"),
+                format!("memory:tetragrid-{n}"),
+            )
+        })
+        .collect();
+    let mut cols: Vec<(&str, &str, &str)> = Vec::new();
+    for (tc, tk, mc, mk) in &builds {
+        cols.push((tc, tk, "s"));
+        cols.push((mc, mk, "KiB"));
+    }
+    table(&mut f, inc, inclusion::thesis_csv("4-4"), "triangles", &cols);
+    table(
+        &mut f,
+        inc,
+        inclusion::thesis_csv("4-7"),
+        "triangles",
+        &[
+            ("feito_octants_kb", "memory:octants", "KiB"),
+            ("feito_tetragrid_32_kb", "memory:tetragrid", "KiB"),
+            ("bsp_kb", "memory:bsp", "KiB"),
+            ("jordan_octree_6_kb", "memory:jordan-octree", "KiB"),
+        ],
+    );
+    table(
+        &mut f,
+        inc,
+        inclusion::thesis_csv("4-8"),
+        "triangles",
+        &[
+            ("feito_octants_s", "build:octants", "s"),
+            ("feito_tetragrid_32_s", "build:tetragrid", "s"),
+            ("bsp_s", "build:bsp", "s"),
+            ("jordan_octree_6_s", "build:jordan-octree", "s"),
+        ],
+    );
+
+    // Table 5-2: one row per (resolution, model).
+    for line in voxelize::THESIS_TABLE.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+        let c: Vec<&str> = line.split(',').collect();
+        let (Some(n), Some(model), Some(faces)) =
+            (c.first(), c.get(1), c.get(2).and_then(|v| v.parse::<f64>().ok()))
+        else {
+            continue;
+        };
+        f.model("voxelize", model, faces, model);
+        for (i, method) in ["cpu", "fgpu", "pgpu", "zoned", "fang", "sramek"].iter().enumerate() {
+            if let Some(v) = c.get(3 + i).and_then(|v| v.parse::<f64>().ok()) {
+                f.add("voxelize", model, &format!("time:{method}@{n}"), "s", Stat::exact(v));
+            }
+        }
+    }
+
+    // Table 5 of the 2010 thesis: models unnamed; rows numbered, the first is the cube.
+    for (i, line) in subdiv::THESIS_TABLE5.lines().skip(1).filter(|l| !l.trim().is_empty()).enumerate() {
+        let c: Vec<f64> = line.split(',').filter_map(|v| v.trim().parse().ok()).collect();
+        let [fragments, faces, _vertices, tcpu1, tgpu, tcpu2] = c[..] else { continue };
+        let model = if i == 0 { "row 1: cube".to_string() } else { format!("row {}", i + 1) };
+        f.model("subdivide", &model, faces, &model);
+        let sub = |f: &mut Facts, key: &str, v: f64| f.add("subdivide", &model, key, "s", Stat::exact(v));
+        sub(&mut f, "time:tcpu1", tcpu1);
+        sub(&mut f, "time:tgpu", tgpu);
+        sub(&mut f, "time:gpu-path", tcpu1 + tgpu);
+        sub(&mut f, "time:tcpu2", tcpu2);
+        f.add("subdivide", &model, "faces", "", Stat::exact(faces));
+        f.add("subdivide", &model, "fragments", "", Stat::exact(fragments));
+    }
+    f.skipped("boolean", "Table 6-1 is not transcribed in reference/ yet");
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_thesis_table_is_read() {
+        let f = super::facts();
+        assert_eq!(f.get("inclusion", "Armadillo", "time:cpu").unwrap().value, 20.785783);
+        assert_eq!(f.get("inclusion", "Torusknot", "time:tetragrid-64").unwrap().value, 0.001527);
+        assert_eq!(f.get("inclusion", "Torusknot", "memory:tetragrid-32").unwrap().value, 953.0);
+        assert_eq!(f.get("inclusion", "Chinese Dragon", "memory:bsp").unwrap_err(), "stack overflow");
+        assert_eq!(f.get("voxelize", "Armadillo", "time:zoned@256").unwrap().value, 0.008743);
+        assert_eq!(f.get("subdivide", "row 1: cube", "time:gpu-path").unwrap().value, 0.015 + 0.031);
+        assert_eq!(f.models_of("inclusion").len(), 9);
+    }
+}

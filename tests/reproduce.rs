@@ -1,0 +1,363 @@
+//! `texgeo reproduce`: one `--quick` run checked the way a reader would use it — every
+//! table there and filled, the CSVs holding the Markdown's numbers, every picture a real
+//! PNG of its stated size, valence colours where the mesh's valences say, a verdict on
+//! every claim, a self-contained HTML page — and a run on a device without logic-op
+//! XOR, which marks the rows that need it and nothing else.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+use glam::DVec3;
+use texgeo::render::{Camera, Picture, colour};
+use texgeo::report::reproduce::{EXPERIMENTS, FigureRecord, valence_model};
+
+fn texgeo(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_texgeo"));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("run texgeo")
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("texgeo-reproduce-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// The `--quick` report, made once for all tests of this file.
+fn quick() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = temp("quick");
+        let o = texgeo(&["reproduce", "--quick", "-o", dir.to_str().unwrap()], &[]);
+        assert!(
+            o.status.success(),
+            "reproduce --quick failed:\n{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        dir
+    })
+}
+
+/// A Markdown table of the report: title, columns, rows, and the CSV it links to.
+struct MdTable {
+    title: String,
+    columns: Vec<String>,
+    rows: Vec<Vec<String>>,
+    csv: String,
+}
+
+fn cells(line: &str) -> Vec<String> {
+    let inner = line.trim().trim_start_matches('|').trim_end_matches('|');
+    inner.split(" | ").map(|c| c.trim().to_string()).collect()
+}
+
+fn tables(md: &str) -> Vec<MdTable> {
+    let lines: Vec<&str> = md.lines().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i + 1 < lines.len() {
+        if lines[i].starts_with("| ") && lines[i + 1].starts_with("|---") {
+            let title = lines[..i]
+                .iter()
+                .rev()
+                .find(|l| l.starts_with("**"))
+                .map(|l| l.trim_matches('*').to_string())
+                .unwrap_or_default();
+            let columns = cells(lines[i]);
+            let mut j = i + 2;
+            let mut rows = Vec::new();
+            while j < lines.len() && lines[j].starts_with('|') {
+                rows.push(cells(lines[j]));
+                j += 1;
+            }
+            let csv = lines[j..]
+                .iter()
+                .find_map(|l| l.strip_prefix("CSV: ["))
+                .and_then(|l| l.split(']').next())
+                .unwrap_or_default()
+                .to_string();
+            out.push(MdTable { title, columns, rows, csv });
+            i = j;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+fn report(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("report.md")).expect("report.md")
+}
+
+#[test]
+fn every_table_is_present_with_every_row_filled() {
+    let md = report(quick());
+    let all = tables(&md);
+    for wanted in [
+        "Where this ran",
+        "Experiments",
+        "Claims of the theses",
+        "Table 4-4",
+        "Table 4-5",
+        "Table 4-6",
+        "Table 4-7",
+        "Table 4-8",
+        "Table 4-9",
+        "Table 5-2",
+        "Table 5: level 5",
+        "The GPU against the CPU level by level",
+    ] {
+        let t = all.iter().find(|t| t.title.starts_with(wanted)).unwrap_or_else(|| panic!("no table {wanted}"));
+        assert!(!t.rows.is_empty(), "{wanted} has no rows");
+    }
+    for t in &all {
+        for row in &t.rows {
+            assert_eq!(row.len(), t.columns.len(), "{}: {row:?}", t.title);
+            assert!(row.iter().all(|c| !c.is_empty()), "{}: empty cell in {row:?}", t.title);
+        }
+    }
+    assert!(md.contains("**All methods agree on every point**"), "inclusion answers checked");
+    assert!(md.contains("**All methods agree on every voxel**"), "voxel answers checked");
+    assert!(md.contains("equals OpenSubdiv's on every vertex"), "subdivision answers checked");
+    assert!(md.contains("`texgeo bench boolean` does not exist yet"), "the Boolean section says why it is empty");
+    for h in ["texgeo", "device", "driver", "Vulkan", "CPU", "machine", "longest experiment"] {
+        assert!(md.contains(&format!("| {h} |")), "header names {h}");
+    }
+    assert!(md.contains(" (commit "), "header names the commit");
+}
+
+#[test]
+fn csvs_hold_the_numbers_of_the_markdown() {
+    let dir = quick();
+    let all = tables(&report(dir));
+    assert!(all.len() > 20);
+    for t in &all {
+        assert!(!t.csv.is_empty(), "{} links no CSV", t.title);
+        let mut r = csv::Reader::from_path(dir.join(&t.csv)).unwrap_or_else(|e| panic!("{}: {e}", t.csv));
+        let header: Vec<String> = r.headers().unwrap().iter().map(|c| c.replace('|', "/")).collect();
+        assert_eq!(header, t.columns, "{}", t.csv);
+        let rows: Vec<Vec<String>> =
+            r.records().map(|rec| rec.unwrap().iter().map(|c| c.replace('|', "/").replace('\n', " ")).collect()).collect();
+        assert_eq!(rows, t.rows, "{}: CSV and Markdown differ", t.csv);
+    }
+    // Every measured value is there with the range of its runs.
+    let mut m = csv::Reader::from_path(dir.join("csv/measurements.csv")).unwrap();
+    let mut n = 0;
+    for rec in m.records() {
+        let rec = rec.unwrap();
+        let (v, lo, hi): (f64, f64, f64) = (rec[4].parse().unwrap(), rec[5].parse().unwrap(), rec[6].parse().unwrap());
+        assert!(lo <= v && v <= hi, "{rec:?}");
+        n += 1;
+    }
+    assert!(n > 100, "{n} measurements");
+}
+
+fn not_uniform(p: &Picture) -> bool {
+    p.rgba.chunks_exact(4).any(|px| px != &p.rgba[..4])
+}
+
+#[test]
+fn every_figure_is_a_png_of_its_stated_size_and_not_one_colour() {
+    let dir = quick();
+    let md = report(dir);
+    let mut pictures = 0;
+    for line in md.lines() {
+        // "*caption* (800×600, `figures/x.png`)"
+        if line.starts_with('*')
+            && let Some(start) = line.rfind(" (")
+            && let Some((size, path)) = line[start + 2..].trim_end_matches(')').split_once(", `")
+            && let Some((w, h)) = size.split_once('×')
+        {
+            let path = path.trim_end_matches('`');
+            let p = Picture::load_png(dir.join(path)).unwrap();
+            assert_eq!((p.width, p.height), (w.parse().unwrap(), h.parse().unwrap()), "{path}");
+            assert!(not_uniform(&p), "{path} is one colour");
+            pictures += 1;
+        }
+    }
+    assert!(pictures >= 8, "{pictures} pictures");
+    let mut plots = 0;
+    for line in md.lines() {
+        if let Some(i) = line.find("[PNG](") {
+            let path = line[i + 6..].split(')').next().unwrap();
+            let p = Picture::load_png(dir.join(path)).unwrap();
+            assert_eq!((p.width, p.height), (texgeo::report::plot::WIDTH, texgeo::report::plot::HEIGHT), "{path}");
+            assert!(not_uniform(&p), "{path} is one colour");
+            let svg = std::fs::read_to_string(dir.join(path.replace(".png", ".svg"))).unwrap();
+            assert!(svg.contains("<svg") && svg.contains("</svg>"), "{path}: its SVG");
+            plots += 1;
+        }
+    }
+    assert!(plots >= 9, "{plots} plots");
+    let records: Vec<FigureRecord> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("figures.json")).unwrap()).unwrap();
+    assert_eq!(records.len(), pictures, "figures.json describes every picture");
+}
+
+/// The valence whose colour, scaled by some light in [0.3, 1], is nearest to `px`.
+fn nearest_valence(px: [u8; 4]) -> usize {
+    let c = DVec3::new(f64::from(px[0]), f64::from(px[1]), f64::from(px[2]));
+    (2..=8)
+        .min_by(|&a, &b| {
+            let err = |k: usize| {
+                let q = colour::valence_colour(k);
+                let q = DVec3::new(f64::from(q[0]), f64::from(q[1]), f64::from(q[2]));
+                let s = (c.dot(q) / q.dot(q)).clamp(0.3, 1.0);
+                (c - q * s).length_squared()
+            };
+            err(a).total_cmp(&err(b))
+        })
+        .unwrap()
+}
+
+#[test]
+fn valence_colours_match_the_mesh_at_sampled_vertices() {
+    let dir = quick();
+    let records: Vec<FigureRecord> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("figures.json")).unwrap()).unwrap();
+    let valence: Vec<&FigureRecord> = records.iter().filter(|r| r.kind == "valence").collect();
+    assert_eq!(valence.iter().map(|r| r.level).collect::<Vec<_>>(), vec![0, 1, 2, 3]);
+    for r in valence {
+        let picture = Picture::load_png(dir.join(&r.file)).unwrap();
+        let mesh = texgeo::subdiv::cpu::refine(&valence_model(), r.level).unwrap();
+        let valences = colour::valences(&mesh);
+        let camera = Camera::from(r.camera);
+        let eye = camera.eye();
+        // Per valence: (vertices sampled, matching).
+        let mut seen: HashMap<usize, (usize, usize)> = HashMap::new();
+        for (v, &p) in mesh.positions().iter().enumerate() {
+            // The model is a convex sphere about the origin: a vertex well inside the
+            // visible side is not hidden by anything.
+            if p.normalize().dot((eye - p).normalize()) < 0.5 {
+                continue;
+            }
+            let Some(at) = camera.project(p, picture.width, picture.height) else { continue };
+            let (x, y) = (at.x.floor() as u32, at.y.floor() as u32);
+            if x >= picture.width || y >= picture.height {
+                continue;
+            }
+            let want = valences[v].clamp(2, 8);
+            let e = seen.entry(want).or_default();
+            e.0 += 1;
+            e.1 += usize::from(nearest_valence(picture.pixel(x, y)) == want);
+        }
+        let sampled: usize = seen.values().map(|s| s.0).sum();
+        assert!(sampled >= 6, "{}: {sampled} vertices sampled: too few", r.file);
+        for (k, (n, ok)) in &seen {
+            assert!(*ok * 10 >= *n * 9, "{}: valence {k}: {ok} of {n} vertices show its colour", r.file);
+        }
+    }
+}
+
+#[test]
+fn every_claim_has_a_verdict() {
+    let dir = quick();
+    let mut r = csv::Reader::from_path(dir.join("csv/claims.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    let claims: usize = EXPERIMENTS.iter().map(|e| e.claims.len()).sum();
+    assert_eq!(rows.len(), claims);
+    let mut verdicts = HashMap::new();
+    for row in &rows {
+        let verdict = &row[6];
+        assert!(["holds", "does not hold", "not measurable"].contains(&verdict), "{row:?}");
+        assert!(!row[5].is_empty(), "{row:?}: the measured value or why there is none");
+        *verdicts.entry(verdict.to_string()).or_insert(0) += 1;
+    }
+    // The Booleans are not measurable yet; the rest were measured.
+    for row in rows.iter().filter(|r| r[0].starts_with('B')) {
+        assert_eq!(&row[6], "not measurable");
+    }
+    assert!(verdicts.get("holds").copied().unwrap_or(0) + verdicts.get("does not hold").copied().unwrap_or(0) >= 20);
+}
+
+#[test]
+fn the_html_report_is_self_contained() {
+    let dir = quick();
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let md_tables = tables(&report(dir)).len();
+    assert_eq!(html.matches("<table>").count(), md_tables);
+    let images: Vec<&str> = html.split("<img src=\"").skip(1).collect();
+    assert!(images.len() >= 17, "{} images", images.len());
+    for img in images {
+        assert!(img.starts_with("data:image/png;base64,") || img.starts_with("data:image/svg+xml;base64,"));
+    }
+}
+
+#[test]
+fn a_run_compared_with_itself_moved_nothing() {
+    let dir = quick().to_str().unwrap();
+    let o = texgeo(&["reproduce", "--compare", dir, dir], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("beyond the noise of their runs (0 of"), "{out}");
+    assert!(out.contains("Claims whose verdict changed (0)"), "{out}");
+}
+
+#[test]
+fn a_device_without_logic_op_marks_the_xor_rows_and_nothing_else() {
+    let dir = temp("masked");
+    let o = texgeo(
+        &["reproduce", "--quick", "--only", "voxelize", "-o", dir.to_str().unwrap()],
+        &[("TEXGEO_MASK_FEATURES", "logic_op")],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = report(&dir);
+    assert!(md.contains("| masked features | logic_op"), "the header says what was masked");
+    let all = tables(&md);
+    let t = all.iter().find(|t| t.title.starts_with("Table 5-2")).unwrap();
+    for row in &t.rows {
+        let method = row[2].split(' ').nth(1).unwrap();
+        let today = &row[4];
+        if ["fgpu", "pgpu", "zoned", "fang"].contains(&method) {
+            assert!(today.starts_with("not measurable") && today.contains("logic op"), "{row:?}");
+        } else {
+            assert!(today.parse::<f64>().is_ok(), "{row:?} is measured");
+        }
+    }
+    let claims = all.iter().find(|t| t.title.starts_with("Claims")).unwrap();
+    for row in &claims.rows {
+        let (id, measured, verdict) = (&row[0], &row[5], &row[6]);
+        match id.as_str() {
+            "V3" | "V4" | "V5" | "V6" | "V7" | "V8" | "V9" => {
+                assert!(verdict == "not measurable" && measured.contains("logic op"), "{row:?}")
+            }
+            "V1" | "V2" => assert_ne!(verdict, "not measurable", "{row:?}: the CPU rows still count"),
+            _ => {}
+        }
+    }
+    // The picture is still there, made by the CPU slicer.
+    assert!(md.contains("CPU slicer: this device has no logic-op XOR"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_options_are_refused_before_anything_runs() {
+    let dir = temp("bad");
+    let d = dir.to_str().unwrap();
+    let o = texgeo(&["reproduce", "--quick", "--only", "nope", "-o", d], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown experiment 'nope'"));
+    assert!(!dir.exists(), "nothing is written for a refused run");
+
+    std::fs::write(&dir, b"a file").unwrap();
+    let o = texgeo(&["reproduce", "--quick", "-o", d], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a folder"), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_file(&dir).unwrap();
+
+    let empty = temp("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let e = empty.to_str().unwrap();
+    let o = texgeo(&["reproduce", "--compare", e, e], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("measurements.csv"));
+    let o = texgeo(&["reproduce", "--quick"], &[]);
+    assert_eq!(o.status.code(), Some(2), "-o is required");
+    std::fs::remove_dir_all(empty).unwrap();
+}
