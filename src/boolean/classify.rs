@@ -103,10 +103,13 @@ pub fn classify(
 ) -> Result<Classification, ClassifyError> {
     let mut b_coplanar: Vec<(u32, u32, bool)> = r.coplanar.iter().map(|&(t, u, s)| (u, t, s)).collect();
     b_coplanar.sort_unstable_by_key(|c| (c.0, c.1));
-    let (on_a, on_b) = rayon::join(
+    let (mut on_a, mut on_b) = rayon::join(
         || on_status(&r.a, &r.points, a, b, &r.coplanar),
         || on_status(&r.b, &r.points, b, a, &b_coplanar),
     );
+    if r.stats.merged_points > 0 {
+        coincident(r, &mut on_a, &mut on_b);
+    }
     let ((groups_a, count_a), (groups_b, count_b)) =
         rayon::join(|| groups(&r.a, &on_a, r), || groups(&r.b, &on_b, r));
 
@@ -213,6 +216,43 @@ fn on_status(
             None
         })
         .collect()
+}
+
+/// Pieces of A and B over the same three points are on each other's surface. Without
+/// merged points (`super::snap`) that happens only to coplanar pairs, which
+/// [`on_status`] decides; a merge can collapse a sliver of space between two cut
+/// triangles that are not coplanar, leaving one triangle in both meshes.
+fn coincident(r: &Refinement, on_a: &mut [Option<Class>], on_b: &mut [Option<Class>]) {
+    // (sorted corners, piece, corners rotated to start at the smallest).
+    let pieces = |refined: &Refined| -> Vec<([u32; 3], u32, [u32; 3])> {
+        let mut v: Vec<([u32; 3], u32, [u32; 3])> = (0..refined.triangles.len() as u32)
+            .filter(|&t| refined.cut[refined.parent[t as usize] as usize])
+            .map(|t| {
+                let c = refined.triangles[t as usize];
+                let k = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
+                let mut sorted = c;
+                sorted.sort_unstable();
+                (sorted, t, [c[k], c[(k + 1) % 3], c[(k + 2) % 3]])
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    let (pa, pb) = (pieces(&r.a), pieces(&r.b));
+    let (mut i, mut j) = (0, 0);
+    while i < pa.len() && j < pb.len() {
+        match pa[i].0.cmp(&pb[j].0) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                let class = if pa[i].2 == pb[j].2 { Class::OnSame } else { Class::OnOpposite };
+                on_a[pa[i].1 as usize].get_or_insert(class);
+                on_b[pb[j].1 as usize].get_or_insert(class);
+                i += 1;
+                j += 1;
+            }
+        }
+    }
 }
 
 /// Group id of every refined triangle (on-triangles get their own groups, which are

@@ -37,6 +37,7 @@ pub mod input;
 pub mod intersect;
 pub mod refine;
 pub mod select;
+pub mod snap;
 pub mod transform;
 
 pub use classify::{Class, Classification, ClassifyStats, Grouping};

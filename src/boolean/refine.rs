@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use super::index::candidate_pairs;
 use super::intersect::{Key, Meeting, Operands, Simplex, meet};
+use super::snap;
 use crate::mesh::intersect::{TriangleSoup, triangle_projection};
 use crate::mesh::triangulate::{self, TriangulateError};
 
@@ -77,6 +78,10 @@ pub struct RefineStats {
     pub coplanar_pairs: usize,
     /// Intersection points that are not input vertices.
     pub new_points: usize,
+    /// Points merged because rounding cannot tell them apart ([`super::snap`]): new
+    /// points merged into a cluster or onto an input vertex, and vertices of B merged
+    /// onto vertices of A.
+    pub merged_points: usize,
     /// Input triangles re-triangulated in A and in B.
     pub cut_a: usize,
     pub cut_b: usize,
@@ -153,6 +158,10 @@ impl EdgePoints {
             if e.edges.last() != Some(&edge) {
                 e.edges.push(edge);
                 e.starts.push(e.ids.len() as u32);
+            } else if e.ids[*e.starts.last().unwrap_or(&0) as usize..].contains(&id) {
+                // A merged point named twice along the edge: its first place only, the
+                // same for both triangles sharing the edge.
+                continue;
             }
             e.ids.push(id);
         }
@@ -205,7 +214,32 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     keys.dedup();
     let na = a.positions.len() as u32;
     let nb = b.positions.len() as u32;
+    let (lo, hi) = a
+        .positions
+        .iter()
+        .chain(&b.positions)
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let tolerance = snap::tolerance(lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
     let mut b_alias: Vec<u32> = (0..nb).map(|v| na + v).collect();
+    // A vertex of B closer than rounding to a vertex of A (a copy turned by 90°, whose
+    // cosines are not exactly 0) is that vertex, as if they coincided exactly: otherwise
+    // both, and the points around them, would be distinct points a few ulps apart.
+    {
+        let mut taken = vec![false; na as usize];
+        for (t, u, _) in &meetings {
+            for va in a.triangles[*t as usize] {
+                for vb in b.triangles[*u as usize] {
+                    let (pa, pb) = (a.positions[va as usize], b.positions[vb as usize]);
+                    if b_alias[vb as usize] == na + vb && !taken[va as usize] && pa.distance(pb) <= tolerance
+                    {
+                        b_alias[vb as usize] = va;
+                        taken[va as usize] = true;
+                        stats.merged_points += usize::from(pa != pb);
+                    }
+                }
+            }
+        }
+    }
     let mut ids = Vec::with_capacity(keys.len());
     let mut new_keys = Vec::new();
     for k in &keys {
@@ -231,37 +265,133 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     points.extend_from_slice(&a.positions);
     points.extend_from_slice(&b.positions);
     points.extend(new_positions);
-    let id_of =
-        |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
+    // Points closer than rounding become one (see `snap`), onto an input vertex of a
+    // simplex naming one of them when there is one.
+    let first = na + nb;
+    let corners = |s: Simplex, tris: &[[u32; 3]], id: &dyn Fn(u32) -> u32, out: &mut Vec<u32>| match s {
+        Simplex::Vertex(v) => out.push(id(v)),
+        Simplex::Edge(p, q) => out.extend([id(p), id(q)]),
+        Simplex::Face(t) => out.extend(tris[t as usize].map(id)),
+    };
+    let merged = snap::merge(&points, first, tolerance, |k, out| {
+        corners(new_keys[k].a, &a.triangles, &|v| v, out);
+        corners(new_keys[k].b, &b.triangles, &b_id, out);
+    });
+    stats.merged_points += merged.iter().enumerate().filter(|&(k, &m)| m != first + k as u32).count();
+    if stats.merged_points > 0 {
+        for id in ids.iter_mut().filter(|id| **id >= first) {
+            *id = merged[(*id - first) as usize];
+        }
+    }
 
     // Points on edges and inside triangles, per mesh.
     let param = |p: DVec3, q: DVec3, x: DVec3| (x - p).dot(q - p);
-    let mut a_edge_entries = Vec::new();
-    let mut b_edge_entries = Vec::new();
-    let mut a_inside: Vec<(u32, u32)> = Vec::new();
-    let mut b_inside: Vec<(u32, u32)> = Vec::new();
-    for (k, &id) in keys.iter().zip(&ids) {
-        match k.a {
-            Simplex::Edge(p, q) => {
-                let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
-                a_edge_entries.push(((p, q), l, id));
-            }
-            Simplex::Face(t) => a_inside.push((t, id)),
-            Simplex::Vertex(_) => {}
+    // A new point inside a triangle but closer than rounding to one of its edges (an
+    // edge of the other mesh running a hair off this one's) goes onto that edge, for
+    // both triangles sharing it: rounded, it may even lie across the edge.
+    let onto_edge = |tri: [u32; 3], pos: &[DVec3], id: u32| -> Option<((u32, u32), f64)> {
+        if id < first {
+            return None;
         }
-        match k.b {
-            Simplex::Edge(p, q) => {
-                let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
-                b_edge_entries.push(((p, q), l, id));
+        let x = points[id as usize];
+        (0..3).find_map(|e| {
+            let (p, q) = (tri[e].min(tri[(e + 1) % 3]), tri[e].max(tri[(e + 1) % 3]));
+            let (pp, pq) = (pos[p as usize], pos[q as usize]);
+            let l = param(pp, pq, x);
+            let closest = pp + (pq - pp) * (l / (pq - pp).length_squared()).clamp(0.0, 1.0);
+            (closest.distance(x) <= tolerance).then_some(((p, q), l))
+        })
+    };
+    let mut rounds = 0;
+    let (a_edges, b_edges, a_inside, b_inside) = loop {
+        let mut snapped = 0;
+        let mut a_edge_entries = Vec::new();
+        let mut b_edge_entries = Vec::new();
+        let mut a_inside: Vec<(u32, u32)> = Vec::new();
+        let mut b_inside: Vec<(u32, u32)> = Vec::new();
+        for (k, &id) in keys.iter().zip(&ids) {
+            match k.a {
+                Simplex::Edge(p, q) => {
+                    let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
+                    a_edge_entries.push(((p, q), l, id));
+                }
+                Simplex::Face(t) => match onto_edge(a.triangles[t as usize], &a.positions, id) {
+                    Some((edge, l)) => {
+                        a_edge_entries.push((edge, l, id));
+                        snapped += 1;
+                    }
+                    None => a_inside.push((t, id)),
+                },
+                Simplex::Vertex(_) => {}
             }
-            Simplex::Face(u) => b_inside.push((u, id)),
-            Simplex::Vertex(_) => {}
+            match k.b {
+                Simplex::Edge(p, q) => {
+                    let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
+                    b_edge_entries.push(((p, q), l, id));
+                }
+                Simplex::Face(u) => match onto_edge(b.triangles[u as usize], &b.positions, id) {
+                    Some((edge, l)) => {
+                        b_edge_entries.push((edge, l, id));
+                        snapped += 1;
+                    }
+                    None => b_inside.push((u, id)),
+                },
+                Simplex::Vertex(_) => {}
+            }
         }
-    }
-    let (a_edges, b_edges) =
-        rayon::join(|| EdgePoints::build(a_edge_entries), || EdgePoints::build(b_edge_entries));
-    a_inside.sort_unstable();
-    b_inside.par_sort_unstable();
+        a_inside.sort_unstable();
+        b_inside.par_sort_unstable();
+        let (a_edges, b_edges) =
+            rayon::join(|| EdgePoints::build(a_edge_entries), || EdgePoints::build(b_edge_entries));
+        // A merged point on two edges of one triangle is its corner there (it was a
+        // cluster around that corner not quite within the tolerance of it): merge it onto
+        // the corner everywhere, and sort the points again.
+        rounds += 1;
+        if rounds == 1 {
+            stats.merged_points += snapped;
+        }
+        if stats.merged_points == 0 || rounds > 3 {
+            break (a_edges, b_edges, a_inside, b_inside);
+        }
+        let mut onto: Vec<(u32, u32)> = Vec::new();
+        for (soup, edges, id) in
+            [(a, &a_edges, &(|v: u32| v) as &dyn Fn(u32) -> u32), (b, &b_edges, &b_id as &dyn Fn(u32) -> u32)]
+        {
+            for tri in &soup.triangles {
+                let chains = [0, 1, 2].map(|e| edges.get(tri[e], tri[(e + 1) % 3]));
+                if chains.iter().all(|c| c.is_empty()) {
+                    continue;
+                }
+                for e in 0..3 {
+                    for &x in chains[e] {
+                        // Edges e and e + 1 share corner e + 1, edges e and e + 2 corner e.
+                        if chains[(e + 1) % 3].contains(&x) {
+                            onto.push((x, id(tri[(e + 1) % 3])));
+                        } else if chains[(e + 2) % 3].contains(&x) {
+                            onto.push((x, id(tri[e])));
+                        } else if x == id(tri[(e + 2) % 3]) {
+                            onto.push((x, x));
+                        }
+                    }
+                }
+            }
+        }
+        onto.retain(|&(x, v)| x != v && x >= first);
+        if onto.is_empty() {
+            break (a_edges, b_edges, a_inside, b_inside);
+        }
+        onto.sort_unstable();
+        onto.dedup_by_key(|o| o.0);
+        stats.merged_points += onto.len();
+        for id in ids.iter_mut() {
+            if let Ok(i) = onto.binary_search_by_key(id, |o| o.0) {
+                *id = onto[i].1;
+            }
+        }
+    };
+
+    let id_of =
+        |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
 
     // Segments per triangle, and the cut curve.
     let mut a_segments = Vec::new();
@@ -295,22 +425,8 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     curve.par_sort_unstable();
     curve.dedup();
 
-    let a_input = SideInput {
-        side: Side::A,
-        soup: a,
-        vertex_id: &|v| v,
-        simplex: &|k: &Key| k.a,
-        edges: &a_edges,
-        inside: &a_inside,
-    };
-    let b_input = SideInput {
-        side: Side::B,
-        soup: b,
-        vertex_id: &b_id,
-        simplex: &|k: &Key| k.b,
-        edges: &b_edges,
-        inside: &b_inside,
-    };
+    let a_input = SideInput { side: Side::A, soup: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
+    let b_input = SideInput { side: Side::B, soup: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
     let ((ra, cut_a), (rb, cut_b)) = rayon::join(
         || refine_side(&a_input, a_segments, &points, &id_of),
         || refine_side(&b_input, b_segments, &points, &id_of),
@@ -331,8 +447,6 @@ struct SideInput<'a> {
     soup: &'a TriangleSoup,
     /// Welded vertex id → point id.
     vertex_id: &'a (dyn Fn(u32) -> u32 + Sync),
-    /// This side's simplex of a key.
-    simplex: &'a (dyn Fn(&Key) -> Simplex + Sync),
     edges: &'a EdgePoints,
     /// (triangle, point id) of points strictly inside triangles, sorted.
     inside: &'a [(u32, u32)],
@@ -354,31 +468,30 @@ fn refine_side(
     let mut cut_edges: Vec<u64> = Vec::new();
     for s in &segments {
         let tri = soup.triangles[s.triangle as usize];
-        let [k0, k1] = s.ends.map(|k| (input.simplex)(&k));
         let (i0, i1) = (id_of(&s.ends[0]), id_of(&s.ends[1]));
         if i0 == i1 {
             continue;
         }
-        let along = (0..3).find(|&e| {
+        // A segment with both ends on one edge's chain (its ends, the points on it, and
+        // those snapped onto it) runs along that edge.
+        let along = (0..3).find_map(|e| {
             let (p, q) = (tri[e], tri[(e + 1) % 3]);
-            k0.within_edge(p, q) && k1.within_edge(p, q)
+            let (lo, hi) = (p.min(q), p.max(q));
+            let mut chain = vec![(input.vertex_id)(lo)];
+            chain.extend_from_slice(input.edges.get(lo, hi));
+            chain.push((input.vertex_id)(hi));
+            let x = chain.iter().position(|&c| c == i0)?;
+            let y = chain.iter().position(|&c| c == i1)?;
+            Some((chain, x, y))
         });
         match along {
             None => constraints.push((s.triangle, [i0, i1])),
-            Some(e) => {
+            Some((chain, x, y)) => {
                 // Mark the pieces of the edge's chain between the two ends.
-                let (p, q) = (tri[e], tri[(e + 1) % 3]);
-                let (lo, hi) = (p.min(q), p.max(q));
-                let mut chain = vec![(input.vertex_id)(lo)];
-                chain.extend_from_slice(input.edges.get(lo, hi));
-                chain.push((input.vertex_id)(hi));
-                let (Some(x), Some(y)) =
-                    (chain.iter().position(|&c| c == i0), chain.iter().position(|&c| c == i1))
-                else {
-                    continue;
-                };
                 for w in chain[x.min(y)..=x.max(y)].windows(2) {
-                    cut_edges.push(edge_key(w[0], w[1]));
+                    if w[0] != w[1] {
+                        cut_edges.push(edge_key(w[0], w[1]));
+                    }
                 }
             }
         }
@@ -482,8 +595,20 @@ fn retriangulate(
             ids.extend_from_slice(chain);
         }
     }
+    // Merged points (`snap`) may repeat a neighbour or a corner: drop the repeats, the
+    // same way on both sides of a shared edge.
+    ids.dedup();
+    while ids.len() > 1 && ids.first() == ids.last() {
+        ids.pop();
+    }
     let outline_len = ids.len();
-    ids.extend_from_slice(inside);
+    let mut outline_sorted = ids.clone();
+    outline_sorted.sort_unstable();
+    let mut interior: Vec<u32> =
+        inside.iter().copied().filter(|g| outline_sorted.binary_search(g).is_err()).collect();
+    interior.sort_unstable();
+    interior.dedup();
+    ids.extend(interior);
     // Local index of each point id.
     let mut lookup: Vec<(u32, u32)> = ids.iter().enumerate().map(|(i, &g)| (g, i as u32)).collect();
     lookup.sort_unstable();

@@ -164,11 +164,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             ev.b.triangles.len()
         );
         say!(
-            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points, cut triangles A {} B {}, refined triangles A {} B {}",
+            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points ({} merged), cut triangles A {} B {}, refined triangles A {} B {}",
             r.candidate_pairs,
             r.meeting_pairs,
             r.coplanar_pairs,
             r.new_points,
+            r.merged_points,
             r.cut_a,
             r.cut_b,
             ev.refinement.a.triangles.len(),

@@ -221,9 +221,20 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
     if !cfg.scaling.is_empty() {
         let mut scaling = Table::new(
             "Growth with size: sphere − turned copy (ms)",
-            &["triangles", "cut A+B", "phase 1", "phase 2", "total", "µs per triangle"],
+            &[
+                "triangles",
+                "cut A+B",
+                "phase 1",
+                "phase 2",
+                "total",
+                "µs per triangle",
+                "phase 1 µs/tri",
+                "phase 2 µs/tri",
+            ],
         )
         .named("scaling");
+        // (triangles, phase 1 s, phase 2 s) per size, for the growth exponents.
+        let mut growth: Vec<(f64, f64, f64)> = Vec::new();
         for &n in &cfg.scaling {
             // n triangles for both; a UV sphere with r rings and 2r segments has about 4r².
             let r = ((n as f64 / 8.0).sqrt().round() as usize).max(3);
@@ -233,6 +244,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                 measure(&pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs)?;
             let total = p1.median() + p2.median() + asm[2].median();
             let tris = ev.a.triangles.len() + ev.b.triangles.len();
+            let (s1, s2) = (p1.median().as_secs_f64(), (p2.median() + asm[2].median()).as_secs_f64());
+            growth.push((tris as f64, s1, s2));
             scaling.row(vec![
                 tris.to_string(),
                 (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
@@ -240,9 +253,26 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                 ms(p2.median() + asm[2].median()),
                 ms(total),
                 format!("{:.2}", total.as_secs_f64() * 1e6 / tris as f64),
+                format!("{:.2}", s1 * 1e6 / tris as f64),
+                format!("{:.2}", s2 * 1e6 / tris as f64),
             ]);
         }
-        scaling.note("Difference A − B; phases as above, CPU point tests. Near-constant µs per triangle = linear growth.");
+        scaling.note(
+            "Difference A − B; phases as above, CPU point tests. Near-constant µs per triangle = linear growth.",
+        );
+        // Time ∝ n^k between the first size of at least 10 000 triangles (below, fixed
+        // costs dominate) and the largest.
+        let from = growth.iter().position(|g| g.0 >= 1e4).unwrap_or(0);
+        if let (Some(&(n0, a0, b0)), Some(&(n1, a1, b1))) = (growth.get(from), growth.last())
+            && n1 > n0
+        {
+            let k = |t0: f64, t1: f64| (t1 / t0).ln() / (n1 / n0).ln();
+            scaling.note(format!(
+                "Growth from {n0} to {n1} triangles: phase 1 ∝ n^{:.2}, phase 2 ∝ n^{:.2} (1 = linear).",
+                k(a0, a1),
+                k(b0, b1)
+            ));
+        }
         tables.push(scaling);
     }
     Ok(Report { name: "boolean".into(), environment: Environment::new(ctx.info().label()), tables })
