@@ -3,7 +3,7 @@
 //! driver caches compiled pipelines).
 //!
 //! One file per driver and shader set: `pipelines-v1/VENDOR-DEVICE-DRIVER-UUID-SHADERS.bin`
-//! under [`cache_root`] (vendor and device id, driver version, `pipelineCacheUUID`, and
+//! under [`crate::cache::root`] (vendor and device id, driver version, `pipelineCacheUUID`, and
 //! the hash of every shader texgeo embeds), so another driver, device or texgeo build
 //! never reads it. The file is `texgeo pipeline cache 1\n`, the data's length and FNV-1a
 //! hash (u64 little-endian each), then the data `vkGetPipelineCacheData` gave. A file that
@@ -23,22 +23,6 @@ use ash::vk;
 const MAGIC: &[u8] = b"texgeo pipeline cache 1\n";
 /// Folder of the entries; bumped if the file layout changes.
 const KIND: &str = "pipelines-v1";
-
-/// The user's cache folder: `$TEXGEO_CACHE_DIR`, else `$XDG_CACHE_HOME/texgeo`, else
-/// `$HOME/.cache/texgeo`; `None` when `TEXGEO_CACHE` is `off` or `0`, or no folder is known.
-pub fn cache_root() -> Option<PathBuf> {
-    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
-    if var("TEXGEO_CACHE").is_some_and(|v| v == "off" || v == "0") {
-        return None;
-    }
-    if let Some(d) = var("TEXGEO_CACHE_DIR") {
-        return Some(PathBuf::from(d));
-    }
-    if let Some(d) = var("XDG_CACHE_HOME").map(PathBuf::from).filter(|d| d.is_absolute()) {
-        return Some(d.join("texgeo"));
-    }
-    var("HOME").map(|h| PathBuf::from(h).join(".cache").join("texgeo"))
-}
 
 fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
@@ -123,7 +107,7 @@ impl PipelineCache {
     /// without a usable file (or when even an empty cache cannot be made) pipelines are
     /// built without one.
     pub fn open(raw: &ash::Device, id: Identity) -> PipelineCache {
-        let path = cache_root().map(|r| r.join(KIND).join(id.file_name()));
+        let path = crate::cache::root().map(|r| r.join(KIND).join(id.file_name()));
         PipelineCache::open_at(raw, id, path)
     }
 
