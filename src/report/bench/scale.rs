@@ -223,6 +223,17 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
     Ok(table)
 }
 
+/// One row of the throughput table: bytes moved by `step` in `time`.
+fn throughput_row(table: &mut Table, threads: usize, step: &str, bytes: f64, time: Duration) {
+    table.row(vec![
+        threads.to_string(),
+        step.into(),
+        format!("{:.1}", bytes / 1e6),
+        ms(time),
+        format!("{:.0}", bytes / 1e6 / time.as_secs_f64().max(1e-9)),
+    ]);
+}
+
 /// Point-file reading and label writing throughput at the largest point count.
 fn io_table(model: &Model, cfg: &Config) -> Result<Table, ScaleError> {
     let n = cfg.points.iter().copied().max().unwrap_or(1_000_000);
@@ -257,13 +268,7 @@ fn io_table(model: &Model, cfg: &Config) -> Result<Table, ScaleError> {
                     Ok((t.elapsed(), got.len()))
                 })
             })?;
-            table.row(vec![
-                threads.to_string(),
-                step.into(),
-                format!("{:.1}", bytes / 1e6),
-                ms(m.time),
-                format!("{:.0}", bytes / 1e6 / m.time.as_secs_f64().max(1e-9)),
-            ]);
+            throughput_row(&mut table, threads, step, bytes, m.time);
         }
         for (step, name) in [("write text labels", "labels.txt"), ("write .npy labels", "labels.npy")] {
             let path = dir.0.join(name);
@@ -278,13 +283,7 @@ fn io_table(model: &Model, cfg: &Config) -> Result<Table, ScaleError> {
                 Ok((t.elapsed(), ()))
             })?;
             let bytes = std::fs::metadata(&path).map_err(io)?.len() as f64;
-            table.row(vec![
-                threads.to_string(),
-                step.into(),
-                format!("{:.1}", bytes / 1e6),
-                ms(m.time),
-                format!("{:.0}", bytes / 1e6 / m.time.as_secs_f64().max(1e-9)),
-            ]);
+            throughput_row(&mut table, threads, step, bytes, m.time);
         }
     }
     table.note(
