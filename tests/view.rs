@@ -25,8 +25,9 @@ impl Xvfb {
     fn start() -> Xvfb {
         let mut child = Command::new("Xvfb")
             // -noreset: without it the server resets whenever its last client leaves, and a
-            // client connecting during the reset is refused.
-            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp", "-noreset"])
+            // client connecting during the reset is refused. -r: no auto-repeat, so a key whose
+            // release is late on a loaded machine is still one key press (one level, not two).
+            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp", "-noreset", "-r"])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()

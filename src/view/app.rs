@@ -422,7 +422,11 @@ impl ApplicationHandler for App {
                 Ok(())
             }
             WindowEvent::RedrawRequested => self.on_redraw(event_loop),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // A held key's auto-repeats are ignored: one press is one step (a level change
+            // reruns the fragment passes; a late release must not add a level).
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed && !event.repeat =>
+            {
                 match event.logical_key.as_ref() {
                     Key::Named(NamedKey::Escape) => {
                         event_loop.exit();
