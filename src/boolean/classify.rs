@@ -20,6 +20,7 @@ use rayon::prelude::*;
 
 use super::refine::{Refined, Refinement, Side, edge_key};
 use crate::inclusion;
+use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::intersect::{TriangleSoup, orient2d, orient3d, segment_meets_triangle, triangle_projection};
 
 /// Where a refined triangle lies relative to the other solid.
@@ -417,39 +418,6 @@ pub fn exact_parity(p: DVec3, soup: &TriangleSoup) -> Option<bool> {
         return Some(crossings % 2 == 1);
     }
     None
-}
-
-/// Disjoint sets with path halving and union by size.
-struct UnionFind {
-    parent: Vec<u32>,
-    size: Vec<u32>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind { parent: (0..n as u32).collect(), size: vec![1; n] }
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let grand = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grand;
-            x = grand;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (mut a, mut b) = (self.find(a), self.find(b));
-        if a == b {
-            return;
-        }
-        if self.size[a as usize] < self.size[b as usize] {
-            std::mem::swap(&mut a, &mut b);
-        }
-        self.parent[b as usize] = a;
-        self.size[a as usize] += self.size[b as usize];
-    }
 }
 
 #[cfg(test)]

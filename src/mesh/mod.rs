@@ -5,6 +5,7 @@ use glam::DVec3;
 
 pub mod boxgrid;
 pub mod covering;
+pub mod disjoint_sets;
 pub mod error;
 pub mod formats;
 pub mod intersect;

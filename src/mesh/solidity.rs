@@ -45,6 +45,7 @@
 use glam::DVec3;
 
 use super::covering::{Covering, UnbalancedEdge, signed_tetra_volume};
+use super::disjoint_sets::UnionFind;
 use super::{Mesh, intersect};
 
 /// Vertices sampled per shell to find how deep it is nested.
@@ -221,28 +222,16 @@ pub fn check(mesh: &Mesh) -> Solidity {
 /// The faces of each shell (vertex-connected components), ordered by first face.
 fn shells_of(mesh: &Mesh) -> Vec<Vec<u32>> {
     let n = mesh.num_vertices();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let g = parent[parent[x as usize] as usize];
-            parent[x as usize] = g;
-            x = g;
-        }
-        x
-    }
+    let mut sets = UnionFind::new(n);
     for face in mesh.faces() {
-        let a = find(&mut parent, face[0]);
         for &v in &face[1..] {
-            let b = find(&mut parent, v);
-            if a != b {
-                parent[b as usize] = a;
-            }
+            sets.union(face[0], v);
         }
     }
     let mut shell_of_root = vec![u32::MAX; n];
     let mut shells: Vec<Vec<u32>> = Vec::new();
     for (f, face) in mesh.faces().enumerate() {
-        let r = find(&mut parent, face[0]) as usize;
+        let r = sets.find(face[0]) as usize;
         if shell_of_root[r] == u32::MAX {
             shell_of_root[r] = shells.len() as u32;
             shells.push(Vec::new());

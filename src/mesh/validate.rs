@@ -11,6 +11,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 
 use super::Mesh;
+use super::disjoint_sets::UnionFind;
 
 /// What [`report`] found about a mesh.
 ///
@@ -237,41 +238,6 @@ fn vector_area(face: &[u32], positions: &[glam::DVec3], p0: glam::DVec3, unit: f
         scale += pa.distance_squared(pb);
     }
     (area.length(), scale)
-}
-
-/// Disjoint sets over 0..n with path halving and union by rank.
-struct UnionFind {
-    parent: Vec<u32>,
-    rank: Vec<u8>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind { parent: (0..n as u32).collect(), rank: vec![0; n] }
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let grand = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grand;
-            x = grand;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (mut a, mut b) = (self.find(a), self.find(b));
-        if a == b {
-            return;
-        }
-        if self.rank[a as usize] < self.rank[b as usize] {
-            std::mem::swap(&mut a, &mut b);
-        }
-        self.parent[b as usize] = a;
-        if self.rank[a as usize] == self.rank[b as usize] {
-            self.rank[a as usize] += 1;
-        }
-    }
 }
 
 impl fmt::Display for Report {
