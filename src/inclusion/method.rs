@@ -122,6 +122,10 @@ pub struct Options {
     /// method classifies such a surface (inside iff its generalized winding number is at
     /// least ½); the factory refuses the others on it.
     pub allow_open: bool,
+    /// The caller has already found the surface closed and consistently oriented (the
+    /// command line's [`crate::mesh::solidity::require_solid`], whose verdicts are cached),
+    /// so the default method does not check it again.
+    pub known_closed: bool,
 }
 
 impl Default for Options {
@@ -133,6 +137,7 @@ impl Default for Options {
             points: 0,
             octree_depth: 6,
             allow_open: false,
+            known_closed: false,
         }
     }
 }

@@ -87,7 +87,8 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
             let n = options
                 .voxel_space_resolution
                 .unwrap_or_else(|| super::voxel_space::resolution_for(triangles, options.points));
-            Box::new(VoxelSpace::new(mesh, n, options.allow_open)?)
+            // Without the closure check when the caller made it (the same unbalanced-edge test).
+            Box::new(VoxelSpace::new(mesh, n, options.allow_open || options.known_closed)?)
         }
         Method::Auto => return Err(InclusionError::Options("auto picks a method before building".into())),
         Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => {

@@ -26,7 +26,7 @@ pub struct Surface {
     face_planes: Vec<Option<(DVec3, DVec3)>>,
     /// Axis along which each polygon face (degree > 3) is projected for its winding test
     /// (the dominant axis of its vector area, decided exactly); `None` for triangles and
-    /// faces without area.
+    /// faces without area. Both vectors are empty when every face is a triangle.
     face_axes: Vec<Option<usize>>,
 }
 
@@ -53,7 +53,9 @@ impl Surface {
     fn unchecked(covering: Covering) -> Surface {
         let (lo, hi) = covering.bounds();
         let eps = REL_TOL * (hi - lo).length();
-        let face_planes = (0..covering.num_faces())
+        // Only polygons have planes and axes; a triangle mesh allocates none.
+        let faces = if covering.triangles.len() == covering.num_faces() { 0 } else { covering.num_faces() };
+        let face_planes = (0..faces)
             .map(|f| {
                 let tris = covering.face_triangles(f);
                 if tris.len() < 2 {
@@ -73,7 +75,7 @@ impl Surface {
                 planar.then_some((n, c))
             })
             .collect();
-        let face_axes = (0..covering.num_faces())
+        let face_axes = (0..faces)
             .map(|f| {
                 let poly = covering.polygon(f);
                 if poly.len() > 3 { dominant_axis(poly, &covering.points) } else { None }
@@ -111,12 +113,12 @@ impl Surface {
     /// Unit normal and a point of the plane of face `f` when it is a polygon of degree > 3
     /// that is planar within ε/2; `None` for triangles and non-planar faces.
     pub fn face_plane(&self, f: usize) -> Option<(DVec3, DVec3)> {
-        self.face_planes[f]
+        self.face_planes.get(f).copied().flatten()
     }
 
     /// Signed distance from `p` to the plane of face `f` (0 when it has none, see [`Self::face_plane`]).
     pub fn face_distance(&self, f: usize, p: DVec3) -> f64 {
-        self.face_planes[f].map_or(0.0, |(n, c)| n.dot(p - c))
+        self.face_plane(f).map_or(0.0, |(n, c)| n.dot(p - c))
     }
 
     /// Cheap filter: `p` is inside the bounding box of covering triangle `t` grown by ε.
@@ -160,7 +162,7 @@ impl Surface {
             let (s, e) = (pts[v as usize], pts[poly[(i + 1) % poly.len()] as usize]);
             exact::segment_within(p, s, e, eps)
         });
-        on_edge || self.face_axes[f].is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
+        on_edge || self.face_axes.get(f).copied().flatten().is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
     }
 
     /// `p`, or `p` moved ε/2 away from the plane of the first covering triangle of an n-gon

@@ -12,12 +12,13 @@
 //!    parallel): a cell lists triangle t when t's box grown by ε + slack reaches it and t's
 //!    plane passes within (the cell's half extent along the normal) + ε + slack of its
 //!    centre. Every cell holding a point within ε of a face lists that face's triangles.
-//! 2. **Labels** of the other cells: the class of the cell's centre, from the project's
-//!    exact scanline voxelizer ([`crate::voxel::scanline`]) over the same grid (its voxel
-//!    centres are these cells' centres). No face comes within ε of such a cell, so all its
-//!    points share its centre's class. A cell whose computed centre rounds out of the cell
-//!    (coordinates so far from the origin that the cell is a few ulps wide) stays a surface
-//!    cell.
+//! 2. **Labels** of the other cells: the class of the cell's centre. No face comes within
+//!    ε of such a cell, so all its points share its centre's class. Each row is labelled
+//!    from its far end (outside beyond the grid) towards −x, each centre by the same parity
+//!    walk as a query point (below) to the labelled cell on its right: the crossings tested
+//!    are those of the surface cells in between, so the whole labelling reads each list
+//!    about once per row. A cell whose computed centre rounds out of the cell (coordinates
+//!    so far from the origin that the cell is a few ulps wide) stays a surface cell.
 //!
 //! ## A point in a surface cell
 //!
@@ -52,6 +53,8 @@ pub const RESOLUTIONS: std::ops::RangeInclusive<usize> = 2..=512;
 
 const OUTSIDE: u32 = 0;
 const INSIDE: u32 = 1;
+/// A cell not labelled yet (while building).
+const UNLABELLED: u32 = u32::MAX;
 /// `state` values from here on are surface cells: `state − FIRST_SURFACE` indexes their lists.
 const FIRST_SURFACE: u32 = 2;
 
@@ -71,8 +74,9 @@ pub struct VoxelSpace {
     /// Per cell, one byte: 0 outside, 1 inside, 2 surface — what most points read (a
     /// quarter of `state`'s memory, so it stays in cache).
     labels: Vec<u8>,
-    /// Box of every covering triangle: x, y, z ranges (`[xlo, xhi, ylo, yhi, zlo, zhi]`).
-    boxes: Vec<[f64; 6]>,
+    /// Box of every covering triangle: x, y, z ranges (`[xlo, xhi, ylo, yhi, zlo, zhi]`),
+    /// rounded outwards to f32 (half the memory; only ever a filter before exact tests).
+    boxes: Vec<[f32; 6]>,
     /// Per column i: the abscissa of its centre, when it rounds into the column.
     column_x: Vec<Option<f64>>,
     /// Lists of the surface cells (CSR, covering triangle ids in increasing order).
@@ -83,11 +87,12 @@ pub struct VoxelSpace {
 }
 
 impl VoxelSpace {
-    /// Labels an n³ grid over `mesh` (closed and consistently oriented; under `allow_open`
-    /// the factory sends open surfaces to the winding number instead).
-    pub fn new(mesh: &Mesh, n: usize, allow_open: bool) -> Result<VoxelSpace> {
+    /// Labels an n³ grid over `mesh`, closed and consistently oriented. `unchecked` skips
+    /// checking that (under `allow_open` the factory sends open surfaces to the winding
+    /// number instead; the command line has checked it already).
+    pub fn new(mesh: &Mesh, n: usize, unchecked: bool) -> Result<VoxelSpace> {
         let start_time = Instant::now();
-        let surface = Surface::with_policy(mesh, allow_open)?;
+        let surface = Surface::with_policy(mesh, unchecked)?;
         VoxelSpace::with_surface(surface, n, start_time)
     }
 
@@ -109,107 +114,80 @@ impl VoxelSpace {
         let eps = surface.eps();
         let cells = Cells::around(lo, hi, 4.0 * eps, n);
         let covering = surface.covering();
-        let dbg = std::env::var_os("TEXGEO_DBG").is_some();
-        let t0 = Instant::now();
-        if dbg {
-            eprintln!("surface {:?}", start_time.elapsed());
-        }
-        // 1. Surface cells: (cell << 32 | triangle) for every listing, sorted.
+        // 1. Surface cells: per chunk of triangles (in parallel, in order), every listing
+        // as (cell << 32 | triangle); then bucketed by cell (a counting sort, which keeps
+        // each list in increasing triangle order).
         let h = cells.cell;
         let slack = 1e-9 * h + 8.0 * f64::EPSILON * (cells.lo.abs().max_element() + h * n as f64);
         let grow = eps + slack;
-        let mut entries: Vec<u64> = (0..covering.triangles.len())
+        let chunks: Vec<Vec<u64>> = (0..covering.triangles.len())
             .into_par_iter()
-            .with_min_len(2048)
-            .fold(Vec::new, |mut out: Vec<u64>, t| {
-                let [a, b, c] = covering.triangle(t);
-                let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
-                let normal = (b - a).cross(c - a).normalize_or_zero();
-                let reach = 0.5 * h * normal.abs().element_sum() + grow;
-                let base = cells.lo - a;
-                let [rx, ry, rz] = cells.ranges(tlo, thi);
-                for k in rz {
-                    for j in ry.clone() {
-                        for i in rx.clone() {
-                            let centre =
-                                base + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
-                            if normal != DVec3::ZERO && normal.dot(centre).abs() > reach {
-                                continue;
+            .with_min_len(4096)
+            .chunks(4096)
+            .map(|ts| {
+                let mut out = Vec::with_capacity(ts.len() * 2);
+                for t in ts {
+                    let [a, b, c] = covering.triangle(t);
+                    let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
+                    let normal = (b - a).cross(c - a).normalize_or_zero();
+                    let reach = 0.5 * h * normal.abs().element_sum() + grow;
+                    let base = cells.lo - a;
+                    let [rx, ry, rz] = cells.ranges(tlo, thi);
+                    for k in rz {
+                        for j in ry.clone() {
+                            for i in rx.clone() {
+                                let centre =
+                                    base + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
+                                if normal != DVec3::ZERO && normal.dot(centre).abs() > reach {
+                                    continue;
+                                }
+                                out.push((cells.index([i, j, k]) as u64) << 32 | t as u64);
                             }
-                            out.push((cells.index([i, j, k]) as u64) << 32 | t as u64);
                         }
                     }
                 }
                 out
             })
-            .reduce(Vec::new, |mut x, mut y| {
-                if x.len() < y.len() {
-                    std::mem::swap(&mut x, &mut y);
-                }
-                x.extend(y);
-                x
-            });
-        entries.par_sort_unstable();
-        let mut state = vec![u32::MAX; num_cells];
+            .collect();
+        // `state` counts first, then names each cell's list.
+        let mut state = vec![0u32; num_cells];
+        for &e in chunks.iter().flatten() {
+            state[(e >> 32) as usize] += 1;
+        }
         let mut start = Vec::new();
-        let mut ids = Vec::with_capacity(entries.len());
-        for run in entries.chunk_by(|x, y| x >> 32 == y >> 32) {
-            state[(run[0] >> 32) as usize] = FIRST_SURFACE + start.len() as u32;
-            start.push(ids.len() as u32);
-            ids.extend(run.iter().map(|&e| e as u32));
-        }
-        start.push(ids.len() as u32);
-        drop(entries);
-        if dbg {
-            eprintln!("raster {:?}", t0.elapsed());
-        }
-        // 2. Labels: the exact class of every cell centre, from the scanline voxelizer.
-        let grid = crate::voxel::Grid::new(n, cells.lo, h * n as f64)
-            .map_err(|e| InclusionError::Options(format!("voxel space: {e}")))?;
-        let solid = crate::voxel::Solid {
-            triangles: (0..covering.triangles.len()).map(|t| covering.triangle(t)).collect(),
-            apex: (lo + hi) * 0.5,
-        };
-        let volume = crate::voxel::scanline::voxelize(&solid, &grid)
-            .map_err(|e| InclusionError::Options(format!("voxel space: {e}")))?;
-        if dbg {
-            eprintln!("scanline {:?}", t0.elapsed());
-        }
-        let mut surface_cells = start.len() - 1;
-        // The centre the scanline classified must lie in its own cell: per axis, the
-        // indices whose centre coordinate maps back to them.
-        let fits = |axis: usize, min: f64| -> Vec<bool> {
-            (0..n).map(|i| cells.coords_axis(grid.centre_coord(min, i), axis) == Some(i)).collect()
-        };
-        let (fx, fy, fz) = (fits(0, grid.min.x), fits(1, grid.min.y), fits(2, grid.min.z));
-        state.par_chunks_mut(n * n).enumerate().for_each(|(k, slice)| {
-            for j in 0..n {
-                let row = volume.row(j, k);
-                for (i, s) in slice[j * n..(j + 1) * n].iter_mut().enumerate() {
-                    if *s == u32::MAX && fx[i] && fy[j] && fz[k] {
-                        *s = if row[i / 64] >> (i % 64) & 1 == 1 { INSIDE } else { OUTSIDE };
-                    }
-                }
+        let mut total = 0u32;
+        for s in state.iter_mut() {
+            if *s == 0 {
+                *s = UNLABELLED;
+            } else {
+                let count = *s;
+                *s = FIRST_SURFACE + start.len() as u32;
+                start.push(total);
+                total += count;
             }
-        });
-        // Cells whose centre rounded away are surface cells with empty lists (their points
-        // walk to a labelled cell).
-        for s in state.iter_mut().filter(|s| **s == u32::MAX) {
-            *s = FIRST_SURFACE + surface_cells as u32;
-            surface_cells += 1;
-            start.push(ids.len() as u32);
         }
-        if dbg {
-            eprintln!("labels {:?}", t0.elapsed());
+        let lists = start.len();
+        start.push(total);
+        // One shared empty list for the cells whose centre rounds out of the cell.
+        let empty_list = FIRST_SURFACE + lists as u32;
+        start.push(total);
+        let mut ids = vec![0u32; total as usize];
+        let mut next = start[..lists].to_vec();
+        for &e in chunks.iter().flatten() {
+            let k = (state[(e >> 32) as usize] - FIRST_SURFACE) as usize;
+            ids[next[k] as usize] = e as u32;
+            next[k] += 1;
         }
-        let labels = state.par_iter().with_min_len(1 << 16).map(|&s| s.min(FIRST_SURFACE) as u8).collect();
-        let boxes = solid
-            .triangles
-            .par_iter()
+        drop(chunks);
+        drop(next);
+        let labels = state.par_iter().with_min_len(1 << 16).map(|&s| if s == UNLABELLED { 3 } else { 2 }).collect();
+        let boxes = (0..covering.triangles.len())
+            .into_par_iter()
             .with_min_len(4096)
-            .map(|&[a, b, c]| {
+            .map(|t| {
+                let [a, b, c] = covering.triangle(t);
                 let (l, h) = (a.min(b).min(c), a.max(b).max(c));
-                [l.x, h.x, l.y, h.y, l.z, h.z]
+                [down(l.x), up(h.x), down(l.y), up(h.y), down(l.z), up(h.z)]
             })
             .collect();
         let column_x = (0..n)
@@ -228,8 +206,42 @@ impl VoxelSpace {
             start,
             ids,
             stats: BuildStats::default(),
-            surface_cells,
+            surface_cells: 0,
         };
+        // 2. Labels: every other cell gets its centre's class, row by row from the far end
+        // (outside beyond the grid), each centre by the parity walk of a query point to the
+        // labelled cell on its right. A cell whose centre rounds out of the cell becomes a
+        // surface cell with the empty list (its points walk to a labelled cell).
+        let mut state = std::mem::take(&mut vs.state);
+        let mut labels = std::mem::take(&mut vs.labels);
+        let centre = |axis: usize, j: usize| {
+            let y = cells.lo[axis] + (j as f64 + 0.5) * cells.cell;
+            (cells.coords_axis(y, axis) == Some(j)).then_some(y)
+        };
+        labels.par_chunks_mut(n).zip(state.par_chunks_mut(n)).enumerate().for_each(|(row, (lab, st))| {
+            let (j, k) = (row % n, row / n);
+            let yz = centre(1, j).zip(centre(2, k));
+            let mut scratch = Vec::new();
+            for i in (0..n).rev() {
+                if lab[i] == 2 {
+                    continue;
+                }
+                match (yz, vs.column_x[i]) {
+                    (Some((y, z)), Some(x)) => {
+                        let inside = vs.parity_in_row(lab, st, DVec3::new(x, y, z), i, &mut scratch);
+                        lab[i] = inside as u8;
+                        st[i] = if inside { INSIDE } else { OUTSIDE };
+                    }
+                    _ => {
+                        lab[i] = 2;
+                        st[i] = empty_list;
+                    }
+                }
+            }
+        });
+        vs.surface_cells = labels.par_iter().with_min_len(1 << 16).filter(|&&l| l == 2).count();
+        vs.state = state;
+        vs.labels = labels;
         vs.stats = BuildStats {
             build_time: start_time.elapsed(),
             bytes: vs.surface.bytes()
@@ -280,7 +292,8 @@ impl VoxelSpace {
         let list = self.list(s);
         let eps = self.surface.eps();
         let covering = self.surface.covering();
-        let near = |b: &[f64; 6]| {
+        let near = |b: &[f32; 6]| {
+            let b = b.map(f64::from);
             p.x >= b[0] - eps
                 && p.x <= b[1] + eps
                 && p.y >= b[2] - eps
@@ -311,17 +324,26 @@ impl VoxelSpace {
     /// The class of a point `p` in surface cell `[i, j, k]`, off the boundary: the parity
     /// walk of the module docs.
     fn parity(&self, p: DVec3, [i, j, k]: [usize; 3]) -> Class {
+        let n = self.cells.n;
+        let row = self.cells.index([0, j, k])..self.cells.index([0, j, k]) + n;
+        let inside = self.parity_in_row(&self.labels[row.clone()], &self.state[row], p, i, &mut Vec::new());
+        if inside { Class::Inside } else { Class::Outside }
+    }
+
+    /// Whether `p`, off the boundary in cell `i` of the row whose labels and states are
+    /// `labels` and `state`, is inside: the first labelled cell along +x whose centre
+    /// abscissa lies in it gives R, and the crossings between P and R flip R's class.
+    /// Only that cell and the surface cells before it are read (so the labelling can use
+    /// it while it fills the row from the far end). `scratch` is reused between calls.
+    fn parity_in_row(&self, labels: &[u8], state: &[u32], p: DVec3, i: usize, scratch: &mut Vec<u32>) -> bool {
         let covering = self.surface.covering();
         let n = self.cells.n;
-        let row = |m: usize| self.cells.index([m, j, k]);
-        // The walk: the first labelled cell along +x whose centre abscissa lies in it.
         let mut end = i + 1;
         let mut reference: Option<(f64, bool)> = None;
         while end < n {
-            let c = row(end);
-            if self.labels[c] < 2 {
+            if labels[end] < 2 {
                 if let Some(x) = self.column_x[end] {
-                    reference = Some((x, self.labels[c] == 1));
+                    reference = Some((x, labels[end] == 1));
                     break;
                 }
             }
@@ -333,25 +355,24 @@ impl VoxelSpace {
         // The triangles that may cross P's line between P and R, each once: a triangle is
         // listed in several cells of the row (sorted and deduplicated here rather than
         // trusting its cells to be consecutive, which rounding need not keep).
-        let mut candidates: Vec<u32> = Vec::new();
+        scratch.clear();
         for m in i..end {
-            let c = row(m);
-            if self.labels[c] != 2 {
+            if labels[m] != 2 {
                 continue;
             }
-            for &t in self.list(self.state[c]) {
+            for &t in self.list(state[m]) {
                 // Exact comparisons first: a triangle whose yz box misses P's line, whose x
                 // range ends before P or starts beyond R, cannot flip the parity.
-                let b = &self.boxes[t as usize];
+                let b = self.boxes[t as usize].map(f64::from);
                 if p.y < b[2] || p.y > b[3] || p.z < b[4] || p.z > b[5] || b[1] < p.x || b[0] > r_x {
                     continue;
                 }
-                candidates.push(t);
+                scratch.push(t);
             }
         }
-        candidates.sort_unstable();
-        candidates.dedup();
-        for t in candidates {
+        scratch.sort_unstable();
+        scratch.dedup();
+        for &t in scratch.iter() {
             let [a, b, c] = covering.triangle(t as usize);
             let nx = orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
             if nx == 0 || !inside_yz(a, b, c, p, nx) {
@@ -361,8 +382,20 @@ impl VoxelSpace {
                 parity = !parity;
             }
         }
-        if parity { Class::Inside } else { Class::Outside }
+        parity
     }
+}
+
+/// The largest f32 at most `x`.
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x { f.next_down() } else { f }
+}
+
+/// The smallest f32 at least `x`.
+fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) < x { f.next_up() } else { f }
 }
 
 impl VoxelSpace {

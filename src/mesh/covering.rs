@@ -12,7 +12,6 @@
 //! (the vertex-set rule of Alg. 4-1 and the GPU upload need it).
 
 use glam::DVec3;
-use rayon::slice::ParallelSliceMut;
 
 use super::Mesh;
 
@@ -233,30 +232,47 @@ impl Covering {
     /// surface (a 2-cycle), which is what the covering methods need; non-manifold edges
     /// (used twice each way) are fine.
     pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
-        // Every directed edge as (min, max, direction) packed in a u64, sorted (in
-        // parallel): the uses of an undirected edge are then adjacent, smallest edge first.
-        let mut keys: Vec<u64> = Vec::with_capacity(self.polygon_indices.len());
-        for f in 0..self.num_faces() {
-            let poly = self.polygon(f);
-            for (i, &a) in poly.iter().enumerate() {
-                let b = poly[(i + 1) % poly.len()];
-                if a != b {
-                    let (lo, hi) = (a.min(b) as u64, a.max(b) as u64);
-                    keys.push(lo << 33 | hi << 1 | (a > b) as u64);
-                }
-            }
+        // Every directed edge bucketed by its smaller end (a counting sort), as
+        // (larger end, direction) packed in a u64; each bucket sorted, the uses of an
+        // undirected edge are adjacent, and buckets are read in order: smallest edge first.
+        let nv = self.points.len();
+        let mut start = vec![0u32; nv + 1];
+        self.for_each_edge(|a, b| start[a.min(b) as usize + 1] += 1);
+        for v in 0..nv {
+            start[v + 1] += start[v];
         }
-        keys.par_sort_unstable();
-        keys.chunk_by(|x, y| x >> 1 == y >> 1).find_map(|run| {
-            let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
-            let forward = run.len() as u32 - backward;
-            (forward != backward).then(|| UnbalancedEdge {
-                a: (run[0] >> 33) as u32,
-                b: (run[0] >> 1 & 0xffff_ffff) as u32,
-                forward,
-                backward,
+        let mut next = start.clone();
+        let mut keys = vec![0u64; start[nv] as usize];
+        self.for_each_edge(|a, b| {
+            let lo = a.min(b) as usize;
+            keys[next[lo] as usize] = (a.max(b) as u64) << 1 | (a > b) as u64;
+            next[lo] += 1;
+        });
+        (0..nv).find_map(|v| {
+            let bucket = &mut keys[start[v] as usize..start[v + 1] as usize];
+            bucket.sort_unstable();
+            bucket.chunk_by(|x, y| x >> 1 == y >> 1).find_map(|run| {
+                let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
+                let forward = run.len() as u32 - backward;
+                (forward != backward).then(|| UnbalancedEdge { a: v as u32, b: (run[0] >> 1) as u32, forward, backward })
             })
         })
+    }
+
+    /// Calls `f(a, b)` for every directed edge a→b (a ≠ b) of the mesh faces.
+    #[inline]
+    fn for_each_edge(&self, mut f: impl FnMut(u32, u32)) {
+        for w in self.polygon_offsets.windows(2) {
+            let poly = &self.polygon_indices[w[0]..w[1]];
+            let Some(&last) = poly.last() else { continue };
+            let mut a = last;
+            for &b in poly {
+                if a != b {
+                    f(a, b);
+                }
+                a = b;
+            }
+        }
     }
 }
 
