@@ -50,6 +50,46 @@ fn errors_exit_2_with_one_message() {
     assert_refused(&texgeo(&["inclusion"]), &["--points <FILE>"]);
 }
 
+/// A point file larger than one read block (8 MiB) is read, classified and written a
+/// block at a time: the same labels as the same points read whole from `.npy` by another
+/// method; a bad line late in it is an error with its line number and leaves no file.
+#[test]
+fn inclusion_streams_a_large_point_file() {
+    let dir = TempDir::new("cli-inclusion-blocks");
+    let knot = texgeo::mesh::procedural::by_name("knot").unwrap();
+    let (lo, hi) = knot.bounds();
+    let pts = texgeo::random::Rng::new(21).points_in_box(160_000, lo - (hi - lo) * 0.1, hi + (hi - lo) * 0.1);
+    let mut text = String::from("# many points\n");
+    for (i, p) in pts.iter().enumerate() {
+        text.push_str(&format!("{} {} {}{}\n", p.x, p.y, p.z, if i % 5000 == 0 { " # mark" } else { "" }));
+    }
+    assert!(text.len() > 8 << 20, "{} bytes: not more than one block", text.len());
+    let (txt, npy) = (dir.join("p.txt"), dir.join("p.npy"));
+    std::fs::write(&txt, &text).unwrap();
+    let mut bytes = Vec::new();
+    texgeo::inclusion::points::write_npy(&mut bytes, &pts).unwrap();
+    std::fs::write(&npy, bytes).unwrap();
+    let run = |points: &str, method: &str, out: &str| {
+        let o = texgeo(&["inclusion", "builtin:knot", "--points", points, "--method", method, "-o", out]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        std::fs::read_to_string(out).unwrap()
+    };
+    let streamed = run(&dir.arg("p.txt"), "auto", &dir.arg("a.txt"));
+    let whole = run(&dir.arg("p.npy"), "bvh", &dir.arg("b.txt"));
+    assert_eq!(streamed.lines().count(), 160_000);
+    assert!(streamed == whole, "the streamed labels differ from the whole file's");
+    assert!(streamed.contains("1\n") && streamed.contains("0\n"));
+    text.push_str("1 2\n");
+    std::fs::write(&txt, &text).unwrap();
+    let o = texgeo(&["inclusion", "builtin:knot", "--points", &dir.arg("p.txt"), "-o", &dir.arg("c.txt")]);
+    // (After the line saying which method `auto` picked: the error is found in a later block.)
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.trim_end().lines().last().unwrap_or("");
+    assert!(last.starts_with("texgeo: error: ") && last.contains("p.txt:160002: expected 'x y z'"), "{err}");
+    assert!(!dir.join("c.txt").exists());
+}
+
 #[test]
 fn inclusion_writes_one_class_per_point() {
     let dir = TempDir::new("cli-inclusion");

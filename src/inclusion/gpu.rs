@@ -96,6 +96,18 @@ pub struct GpuStats {
     pub fallback: Duration,
 }
 
+impl GpuStats {
+    /// Adds the counts and times of another call.
+    pub fn add(&mut self, other: &GpuStats) {
+        self.gpu_points += other.gpu_points;
+        self.flagged += other.flagged;
+        self.draws += other.draws;
+        self.gpu += other.gpu;
+        self.host += other.host;
+        self.fallback += other.fallback;
+    }
+}
+
 /// Normalization to the bounding cube: `(p - centre) / half`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Frame {

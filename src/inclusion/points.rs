@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 use crate::mesh::MeshError;
 use crate::mesh::error::Location;
-use crate::mesh::formats::text::{Lines, parse_coord};
+use crate::mesh::formats::text::{Lines, fast, parse_coord};
 
 /// Whether `path` names a NumPy file (by extension).
 pub fn is_npy(path: &Path) -> bool {
@@ -33,18 +33,188 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<DVec3>, MeshError> {
 
 /// Parses point-file text; `path` only names the source in errors.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
+    let points = parse_part(bytes, path, 0, 0)?;
+    if points.is_empty() {
+        return Err(MeshError::parse(path, Location::File, "no points in the file"));
+    }
+    Ok(points)
+}
+
+/// Parses whole lines of point-file text that start after `lines_before` lines and
+/// `bytes_before` bytes of the file (which only place errors); may be empty.
+fn parse_part(
+    bytes: &[u8],
+    path: &Path,
+    lines_before: usize,
+    bytes_before: usize,
+) -> Result<Vec<DVec3>, MeshError> {
     match parse_fast(bytes) {
-        Some(points) if !points.is_empty() => Ok(points),
-        _ => parse_lines(bytes, path),
+        Some(points) => Ok(points),
+        None => parse_lines(bytes, path, lines_before, bytes_before),
+    }
+}
+
+/// Bytes of text read per block by [`PointReader`].
+const BLOCK: usize = 1 << 23;
+
+/// The points of a file a block at a time, so that classifying a file of any size takes
+/// bounded memory: text in blocks of whole lines ([`BLOCK`] bytes), `.npy` in one block.
+pub struct PointReader {
+    path: std::path::PathBuf,
+    source: Source,
+    /// Points handed out so far.
+    read: usize,
+    /// Bytes of text per block.
+    block: usize,
+}
+
+enum Source {
+    Text {
+        file: std::fs::File,
+        len: u64,
+        buf: Vec<u8>,
+        /// Bytes at the front of `buf` that belong to a line not finished yet.
+        kept: usize,
+        lines_before: usize,
+        bytes_before: usize,
+        eof: bool,
+    },
+    Whole(Option<Vec<DVec3>>),
+}
+
+impl PointReader {
+    pub fn open(path: impl AsRef<Path>) -> Result<PointReader, MeshError> {
+        PointReader::with_block(path, BLOCK)
+    }
+
+    /// With blocks of about `block` bytes of text.
+    pub fn with_block(path: impl AsRef<Path>, block: usize) -> Result<PointReader, MeshError> {
+        let path = path.as_ref();
+        let io = |error| MeshError::Io { path: path.into(), error };
+        let source = if is_npy(path) {
+            Source::Whole(Some(read(path)?))
+        } else {
+            let file = std::fs::File::open(path).map_err(io)?;
+            let len = file.metadata().map_err(io)?.len();
+            Source::Text { file, len, buf: Vec::new(), kept: 0, lines_before: 0, bytes_before: 0, eof: false }
+        };
+        Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1) })
+    }
+
+    /// About how many points the file holds: exact for `.npy` and for a text file read
+    /// whole, else from the bytes per point so far (at least what was read).
+    pub fn estimated_total(&self) -> usize {
+        match &self.source {
+            Source::Text { len, bytes_before, eof, .. } if !eof && *bytes_before > 0 => {
+                ((*len as f64 / *bytes_before as f64) * self.read as f64).ceil() as usize
+            }
+            _ => self.read,
+        }
+    }
+
+    /// The next block of points, `None` after the last (an error if the file held none).
+    pub fn next_block(&mut self) -> Result<Option<Vec<DVec3>>, MeshError> {
+        Ok(self.next_block_with(|points| points)?.map(|parts| parts.concat()))
+    }
+
+    /// The next block, with `f` applied to its points a part at a time (in parallel, each
+    /// part in the task that parsed it): `f`'s results in the order of the points.
+    pub fn next_block_with<T: Send>(
+        &mut self,
+        f: impl Fn(Vec<DVec3>) -> T + Sync,
+    ) -> Result<Option<Vec<T>>, MeshError> {
+        let path = self.path.as_path();
+        let block_size = self.block;
+        let (parts, count) = match &mut self.source {
+            Source::Whole(points) => match points.take() {
+                Some(points) => {
+                    let count = points.len();
+                    (vec![f(points)], count)
+                }
+                None => (Vec::new(), 0),
+            },
+            Source::Text { file, len, buf, kept, lines_before, bytes_before, eof } => loop {
+                if *eof && *kept == 0 {
+                    break (Vec::new(), 0);
+                }
+                // Fill the buffer after the unfinished line (grown when one line fills it),
+                // no larger than what is left of the file.
+                let left = (*len as usize).saturating_sub(*bytes_before + *kept);
+                let size = block_size.max(2 * *kept).min(*kept + left + 1);
+                buf.resize(size, 0);
+                let mut filled = *kept;
+                while !*eof && filled < size {
+                    match std::io::Read::read(file, &mut buf[filled..]) {
+                        Ok(0) => *eof = true,
+                        Ok(k) => filled += k,
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                        Err(error) => return Err(MeshError::Io { path: path.into(), error }),
+                    }
+                }
+                let cut = if *eof {
+                    filled
+                } else {
+                    match buf[..filled].iter().rposition(|&b| b == b'\n') {
+                        Some(at) => at + 1,
+                        None => {
+                            *kept = filled;
+                            continue;
+                        }
+                    }
+                };
+                let text = &buf[..cut];
+                let (parts, count, lines) = match parse_fast_with(text, &f) {
+                    Some(parts) => {
+                        let (count, lines) = parts.iter().fold((0, 0), |(c, l), p| (c + p.1, l + p.2));
+                        (parts.into_iter().map(|p| p.0).collect(), count, lines)
+                    }
+                    None => {
+                        let points = parse_lines(text, path, *lines_before, *bytes_before)?;
+                        let (count, lines) = (points.len(), text.iter().filter(|&&b| b == b'\n').count());
+                        (vec![f(points)], count, lines)
+                    }
+                };
+                *lines_before += lines;
+                *bytes_before += cut;
+                buf.copy_within(cut..filled, 0);
+                *kept = filled - cut;
+                if count > 0 {
+                    break (parts, count);
+                }
+            },
+        };
+        if count > 0 {
+            self.read += count;
+            Ok(Some(parts))
+        } else if self.read == 0 {
+            Err(MeshError::parse(path, Location::File, "no points in the file"))
+        } else {
+            Ok(None)
+        }
     }
 }
 
 /// Bytes per parallel chunk of text.
-const CHUNK: usize = 1 << 20;
+const CHUNK: usize = 1 << 19;
 
 /// The fast path: chunks cut at line ends, parsed in parallel; `None` when any chunk holds
 /// something the fast parser does not take (the line reader then decides).
 fn parse_fast(bytes: &[u8]) -> Option<Vec<DVec3>> {
+    let chunks = parse_fast_with(bytes, &|points| points)?;
+    let mut points = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
+    for (c, _, _) in chunks {
+        points.extend_from_slice(&c);
+    }
+    Some(points)
+}
+
+/// [`parse_fast`] with `f` applied to the points of each chunk in the same parallel task
+/// (so a reader can classify while it parses): per chunk, in order, `f`'s result, the
+/// number of points and the number of line ends.
+fn parse_fast_with<T: Send>(
+    bytes: &[u8],
+    f: &(impl Fn(Vec<DVec3>) -> T + Sync),
+) -> Option<Vec<(T, usize, usize)>> {
     let mut cuts = vec![0];
     while let Some(&last) = cuts.last() {
         if last >= bytes.len() {
@@ -54,66 +224,41 @@ fn parse_fast(bytes: &[u8]) -> Option<Vec<DVec3>> {
         let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |e| at + e + 1);
         cuts.push(end);
     }
-    let chunks: Vec<Option<Vec<DVec3>>> =
-        cuts.par_windows(2).map(|w| parse_chunk(&bytes[w[0]..w[1]])).collect();
-    let mut points = Vec::with_capacity(chunks.iter().map(|c| c.as_ref().map_or(0, Vec::len)).sum());
-    for c in chunks {
-        points.extend_from_slice(&c?);
-    }
-    Some(points)
+    cuts.par_windows(2)
+        .map(|w| {
+            let chunk = &bytes[w[0]..w[1]];
+            let points = parse_chunk(chunk)?;
+            let (count, lines) = (points.len(), chunk.iter().filter(|&&b| b == b'\n').count());
+            Some((f(points), count, lines))
+        })
+        .collect()
 }
 
-/// One chunk of whole lines in a single pass: per line, up to three numbers read in place
-/// by fast-float (correctly rounded, as `str::parse`), each ending at a space, a comment or
-/// the line's end; `None` for anything else (another count, a non-number, a non-finite
-/// value, a non-ASCII byte), which the line reader then explains.
+/// One chunk of whole lines in a single pass ([`fast::Cursor`]): three numbers per content
+/// line, read in place and correctly rounded (as `str::parse`); `None` for anything else
+/// (another count, a non-number, a non-finite value, a non-ASCII byte), which the line
+/// reader then explains.
 fn parse_chunk(bytes: &[u8]) -> Option<Vec<DVec3>> {
-    // Spaces within a line: what `split_whitespace` takes among ASCII, but the newline.
-    let space = |b: u8| b == b' ' || b == b'\t' || b == b'\r' || b == 0x0b || b == 0x0c;
+    let mut c = fast::Cursor::new(bytes);
     let mut out = Vec::with_capacity(bytes.len() / 24);
-    let (mut i, n) = (0, bytes.len());
-    while i < n {
-        let mut v = [0.0; 3];
-        let mut k = 0;
-        loop {
-            while i < n && space(bytes[i]) {
-                i += 1;
-            }
-            if i >= n || bytes[i] == b'\n' {
-                break;
-            }
-            if bytes[i] == b'#' {
-                i += bytes[i..].iter().position(|&b| b == b'\n').unwrap_or(n - i);
-                break;
-            }
-            // Only the characters of decimal numbers may start one ("inf", "nan": slow path).
-            if k == 3 || !(bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'-' | b'+')) {
-                return None;
-            }
-            let (x, used): (f64, usize) = fast_float2::parse_partial(&bytes[i..]).ok()?;
-            i += used;
-            if used == 0
-                || !x.is_finite()
-                || (i < n && !(space(bytes[i]) || matches!(bytes[i], b'\n' | b'#')))
-            {
-                return None;
-            }
-            v[k] = x;
-            k += 1;
+    while c.next_line() {
+        out.push(DVec3::new(c.coord()?, c.coord()?, c.coord()?));
+        if !c.at_line_end() {
+            return None;
         }
-        match k {
-            3 => out.push(DVec3::from_array(v)),
-            0 => {}
-            _ => return None,
-        }
-        i += 1;
+        c.end_line()?;
     }
     Some(out)
 }
 
 /// The line-by-line reader: every accepted file, every error with its line.
-fn parse_lines(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
-    let mut lines = Lines::new(bytes, path)?;
+fn parse_lines(
+    bytes: &[u8],
+    path: &Path,
+    lines_before: usize,
+    bytes_before: usize,
+) -> Result<Vec<DVec3>, MeshError> {
+    let mut lines = Lines::after(bytes, path, lines_before, bytes_before)?;
     let mut points = Vec::new();
     while let Some((l, line)) = lines.next_content() {
         let tokens: Vec<&str> = line.split_whitespace().collect();
@@ -125,9 +270,6 @@ fn parse_lines(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
             *c = parse_coord(t).map_err(|m| lines.error(l, m))?;
         }
         points.push(DVec3::from_array(p));
-    }
-    if points.is_empty() {
-        return Err(MeshError::parse(path, Location::File, "no points in the file"));
     }
     Ok(points)
 }
@@ -282,7 +424,7 @@ mod tests {
     fn the_one_pass_reader_agrees_with_the_line_reader() {
         let p = Path::new("pts.txt");
         let text = b"1. +2 -.5e-3\n\t1\x0b2\x0c3\r\n  # c\n1e300 0 -0 #x\n7 8 9";
-        assert_eq!(parse_chunk(text).unwrap(), parse_lines(text, p).unwrap());
+        assert_eq!(parse_chunk(text).unwrap(), parse_lines(text, p, 0, 0).unwrap());
         for bad in [&b"1 2 3 4\n"[..], b"1 2\n", b"1 2 inf\n", b"1 2 3x\n", b"1 2 1e999\n", b"1 2 \xc3\xa9\n"]
         {
             assert!(parse_chunk(bad).is_none(), "{:?}", String::from_utf8_lossy(bad));
@@ -314,11 +456,62 @@ mod tests {
         }
         let fast = parse_fast(text.as_bytes()).unwrap();
         assert_eq!(fast.len(), 120_000);
-        assert_eq!(fast, parse_lines(text.as_bytes(), p).unwrap());
+        assert_eq!(fast, parse_lines(text.as_bytes(), p, 0, 0).unwrap());
         // A bad line late in the file still gets its line number.
         let bad = format!("{text}1 2\n");
         let e = parse(bad.as_bytes(), p).unwrap_err().to_string();
         assert!(e.contains("pts.txt:120001") && e.contains("expected 'x y z', found 2"), "{e}");
+    }
+
+    #[test]
+    fn blocks_read_the_same_points_and_place_errors() {
+        let dir = std::env::temp_dir().join(format!("texgeo-points-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("p.txt");
+        let mut text = String::from("# points\n\n");
+        let mut rng = crate::random::Rng::new(5);
+        for i in 0..3000 {
+            let q = rng.point_in_box(DVec3::splat(-10.0), DVec3::splat(10.0));
+            text.push_str(&format!("{} {} {}{}\n", q.x, q.y, q.z, if i % 7 == 0 { "   # note" } else { "" }));
+        }
+        text.push_str(&format!("# {}\n1 2 3", "x".repeat(5000))); // a line longer than a block, no final newline
+        std::fs::write(&path, &text).unwrap();
+        let whole = parse(text.as_bytes(), &path).unwrap();
+        for block in [1, 100, 4096, 1 << 20] {
+            let mut r = PointReader::with_block(&path, block).unwrap();
+            let mut got = Vec::new();
+            let mut blocks = 0;
+            while let Some(b) = r.next_block().unwrap() {
+                assert!(r.estimated_total() >= got.len() + b.len());
+                got.extend(b);
+                blocks += 1;
+            }
+            assert_eq!(got, whole, "block {block}");
+            assert_eq!(r.estimated_total(), whole.len());
+            assert!(block > 100_000 || blocks > 1);
+        }
+        // An error in a late block names its line of the file; non-UTF-8 bytes too.
+        for (bad, line, what) in
+            [("1 2\n", 3004, "expected 'x y z'"), ("1 2 \u{e9}\n", 3004, "'\u{e9}' is not a number")]
+        {
+            std::fs::write(&path, format!("{}{bad}", &text[..text.len() - 5])).unwrap();
+            let mut r = PointReader::with_block(&path, 4096).unwrap();
+            let e = loop {
+                match r.next_block() {
+                    Ok(Some(_)) => continue,
+                    Ok(None) => panic!("no error"),
+                    Err(e) => break e.to_string(),
+                }
+            };
+            assert!(e.contains(&format!("p.txt:{line}")) && e.contains(what), "{e}");
+        }
+        std::fs::write(&path, b"\xff\n1 2 3\n").unwrap();
+        let e = PointReader::with_block(&path, 4096).unwrap().next_block().unwrap_err().to_string();
+        assert!(e.contains("p.txt:1") && e.contains("invalid UTF-8"), "{e}");
+        std::fs::write(&path, "# nothing\n\n").unwrap();
+        let e = PointReader::with_block(&path, 4).unwrap().next_block().unwrap_err().to_string();
+        assert!(e.contains("no points"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     fn npy(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {

@@ -162,7 +162,13 @@ impl Surface {
             let (s, e) = (pts[v as usize], pts[poly[(i + 1) % poly.len()] as usize]);
             exact::segment_within(p, s, e, eps)
         });
-        on_edge || self.face_axes.get(f).copied().flatten().is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
+        on_edge
+            || self
+                .face_axes
+                .get(f)
+                .copied()
+                .flatten()
+                .is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
     }
 
     /// `p`, or `p` moved ε/2 away from the plane of the first covering triangle of an n-gon
@@ -176,6 +182,9 @@ impl Surface {
     /// plane and over them, a point is on the boundary.
     pub fn off_polygon_planes(&self, p: DVec3, triangles: impl IntoIterator<Item = usize>) -> DVec3 {
         let c = &self.covering;
+        if self.face_planes.is_empty() {
+            return p; // every face is a triangle
+        }
         for t in triangles {
             if c.face_triangles(c.face_of[t] as usize).len() < 2 || !self.near_triangle(t, p) {
                 continue;

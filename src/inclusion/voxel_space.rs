@@ -180,7 +180,8 @@ impl VoxelSpace {
         }
         drop(chunks);
         drop(next);
-        let labels = state.par_iter().with_min_len(1 << 16).map(|&s| if s == UNLABELLED { 3 } else { 2 }).collect();
+        let labels =
+            state.par_iter().with_min_len(1 << 16).map(|&s| if s == UNLABELLED { 3 } else { 2 }).collect();
         let boxes = (0..covering.triangles.len())
             .into_par_iter()
             .with_min_len(4096)
@@ -288,18 +289,18 @@ impl VoxelSpace {
     }
 
     /// The exact test for a point in surface cell `[i, j, k]` (see the module docs).
-    fn classify_near(&self, p: DVec3, [i, j, k]: [usize; 3], s: u32) -> Class {
+    fn classify_near(&self, p: DVec3, [i, j, k]: [usize; 3], s: u32, scratch: &mut Vec<u32>) -> Class {
         let list = self.list(s);
         let eps = self.surface.eps();
         let covering = self.surface.covering();
         let near = |b: &[f32; 6]| {
-            let b = b.map(f64::from);
-            p.x >= b[0] - eps
-                && p.x <= b[1] + eps
-                && p.y >= b[2] - eps
-                && p.y <= b[3] + eps
-                && p.z >= b[4] - eps
-                && p.z <= b[5] + eps
+            let b = |k: usize| f64::from(b[k]);
+            p.x >= b(0) - eps
+                && p.x <= b(1) + eps
+                && p.y >= b(2) - eps
+                && p.y <= b(3) + eps
+                && p.z >= b(4) - eps
+                && p.z <= b(5) + eps
         };
         if list.iter().any(|&t| {
             near(&self.boxes[t as usize]) && self.surface.on_face(covering.face_of[t as usize] as usize, p)
@@ -315,18 +316,18 @@ impl VoxelSpace {
             return match self.lookup(moved) {
                 (_, 0) => Class::Outside,
                 (_, 1) => Class::Inside,
-                (c, _) => self.parity(moved, [c % n, c / n % n, c / (n * n)]),
+                (c, _) => self.parity(moved, [c % n, c / n % n, c / (n * n)], scratch),
             };
         }
-        self.parity(p, [i, j, k])
+        self.parity(p, [i, j, k], scratch)
     }
 
     /// The class of a point `p` in surface cell `[i, j, k]`, off the boundary: the parity
     /// walk of the module docs.
-    fn parity(&self, p: DVec3, [i, j, k]: [usize; 3]) -> Class {
+    fn parity(&self, p: DVec3, [i, j, k]: [usize; 3], scratch: &mut Vec<u32>) -> Class {
         let n = self.cells.n;
         let row = self.cells.index([0, j, k])..self.cells.index([0, j, k]) + n;
-        let inside = self.parity_in_row(&self.labels[row.clone()], &self.state[row], p, i, &mut Vec::new());
+        let inside = self.parity_in_row(&self.labels[row.clone()], &self.state[row], p, i, scratch);
         if inside { Class::Inside } else { Class::Outside }
     }
 
@@ -335,7 +336,14 @@ impl VoxelSpace {
     /// abscissa lies in it gives R, and the crossings between P and R flip R's class.
     /// Only that cell and the surface cells before it are read (so the labelling can use
     /// it while it fills the row from the far end). `scratch` is reused between calls.
-    fn parity_in_row(&self, labels: &[u8], state: &[u32], p: DVec3, i: usize, scratch: &mut Vec<u32>) -> bool {
+    fn parity_in_row(
+        &self,
+        labels: &[u8],
+        state: &[u32],
+        p: DVec3,
+        i: usize,
+        scratch: &mut Vec<u32>,
+    ) -> bool {
         let covering = self.surface.covering();
         let n = self.cells.n;
         let mut end = i + 1;
@@ -363,8 +371,9 @@ impl VoxelSpace {
             for &t in self.list(state[m]) {
                 // Exact comparisons first: a triangle whose yz box misses P's line, whose x
                 // range ends before P or starts beyond R, cannot flip the parity.
-                let b = self.boxes[t as usize].map(f64::from);
-                if p.y < b[2] || p.y > b[3] || p.z < b[4] || p.z > b[5] || b[1] < p.x || b[0] > r_x {
+                let b = &self.boxes[t as usize];
+                let b = |k: usize| f64::from(b[k]);
+                if p.y < b(2) || p.y > b(3) || p.z < b(4) || p.z > b(5) || b(1) < p.x || b(0) > r_x {
                     continue;
                 }
                 scratch.push(t);
@@ -389,13 +398,26 @@ impl VoxelSpace {
 /// The largest f32 at most `x`.
 fn down(x: f64) -> f32 {
     let f = x as f32;
-    if f64::from(f) > x { f.next_down() } else { f }
+    if f64::from(f) > x { -next_up(-f) } else { f }
 }
 
 /// The smallest f32 at least `x`.
 fn up(x: f64) -> f32 {
     let f = x as f32;
-    if f64::from(f) < x { f.next_up() } else { f }
+    if f64::from(f) < x { next_up(f) } else { f }
+}
+
+/// The next f32 above `f` (`f32::next_up`, which needs Rust 1.86).
+fn next_up(f: f32) -> f32 {
+    if f.is_nan() || f == f32::INFINITY {
+        f
+    } else if f == 0.0 {
+        f32::from_bits(1)
+    } else if f > 0.0 {
+        f32::from_bits(f.to_bits() + 1)
+    } else {
+        f32::from_bits(f.to_bits() - 1)
+    }
 }
 
 impl VoxelSpace {
@@ -417,9 +439,9 @@ impl VoxelSpace {
     }
 
     #[inline]
-    fn near(&self, p: DVec3, c: usize) -> Class {
+    fn near(&self, p: DVec3, c: usize, scratch: &mut Vec<u32>) -> Class {
         let n = self.cells.n;
-        self.classify_near(p, [c % n, c / n % n, c / (n * n)], self.state[c])
+        self.classify_near(p, [c % n, c / n % n, c / (n * n)], self.state[c], scratch)
     }
 }
 
@@ -433,7 +455,7 @@ impl Classifier for VoxelSpace {
         match self.lookup(p) {
             (_, 0) => Class::Outside,
             (_, 1) => Class::Inside,
-            (c, _) => self.near(p, c),
+            (c, _) => self.near(p, c, &mut Vec::new()),
         }
     }
 
@@ -444,6 +466,7 @@ impl Classifier for VoxelSpace {
         let mut out = vec![Class::Outside; ps.len()];
         out.par_chunks_mut(2048).zip(ps.par_chunks(2048)).for_each(|(out, ps)| {
             let mut cells = [(0usize, 0u8); 2048];
+            let mut scratch = Vec::new();
             for (slot, &p) in cells.iter_mut().zip(ps) {
                 *slot = self.lookup(p);
             }
@@ -451,7 +474,7 @@ impl Classifier for VoxelSpace {
                 *o = match label {
                     0 => Class::Outside,
                     1 => Class::Inside,
-                    _ => self.near(p, c),
+                    _ => self.near(p, c, &mut scratch),
                 };
             }
         });
@@ -460,5 +483,28 @@ impl Classifier for VoxelSpace {
 
     fn build_stats(&self) -> BuildStats {
         self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f32_boxes_round_outwards_and_tightly() {
+        let mut rng = crate::random::Rng::new(9);
+        let mut values = vec![0.0, -0.0, 1.0, -1.0, 1e-45, -1e-45, 3.4e38, -3.4e38, 1e300, -1e300, 0.1, -0.1];
+        values.extend(
+            (0..10_000).map(|_| (rng.next_f64() - 0.5) * 10f64.powi((rng.next_f64() * 80.0) as i32 - 40)),
+        );
+        for x in values {
+            let (d, u) = (down(x), up(x));
+            assert!(f64::from(d) <= x && f64::from(u) >= x, "{x}: {d} {u}");
+            // Tight: one f32 step inwards would cross x (within f32's range).
+            if x.abs() < 3.0e38 {
+                assert!(f64::from(next_up(d)) > x || f64::from(d) == x, "{x}: {d}");
+                assert!(f64::from(-next_up(-u)) < x || f64::from(u) == x, "{x}: {u}");
+            }
+        }
     }
 }

@@ -254,7 +254,12 @@ impl Covering {
             bucket.chunk_by(|x, y| x >> 1 == y >> 1).find_map(|run| {
                 let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
                 let forward = run.len() as u32 - backward;
-                (forward != backward).then(|| UnbalancedEdge { a: v as u32, b: (run[0] >> 1) as u32, forward, backward })
+                (forward != backward).then(|| UnbalancedEdge {
+                    a: v as u32,
+                    b: (run[0] >> 1) as u32,
+                    forward,
+                    backward,
+                })
             })
         })
     }

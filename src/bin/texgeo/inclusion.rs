@@ -4,6 +4,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
+use glam::DVec3;
+use texgeo::inclusion::gpu::GpuStats;
 use texgeo::inclusion::solver::{Solver, resolve};
 use texgeo::inclusion::{Class, Method, Options, points};
 use texgeo::mesh::solidity::Policy;
@@ -55,17 +57,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
         texgeo::output::check_file(out)?;
     }
-    // The size of the request, before anything is read or allocated.
-    let count = match (&args.points, args.random) {
-        (Some(file), _) => {
-            // A point takes at least 6 bytes of text ("0 0 0\n"), 12 of .npy.
+    // The size of what is held whole, before anything is read or allocated: random points
+    // and `.npy` files (text files are read a block at a time).
+    match (&args.points, args.random) {
+        (Some(file), _) if points::is_npy(file) => {
+            // A point takes 12 bytes of .npy at least.
             let bytes = std::fs::metadata(file).map_err(|e| texgeo::output::Error::new(file, e))?.len();
-            if points::is_npy(file) { bytes / 12 + 1 } else { bytes / 6 + 1 }
+            check_size(bytes / 12 + 1, true, args.output.is_some())?;
         }
-        (None, Some(n)) => n as u64,
-        (None, None) => anyhow::bail!("give --points FILE or --random N"),
-    };
-    check_size(count, args.points.is_some(), args.output.is_some())?;
+        (None, Some(n)) => check_size(n as u64, false, args.output.is_some())?,
+        _ => {}
+    }
     let policy =
         Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
@@ -73,26 +75,32 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if solid.flipped {
         eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
-    let pts = match (&args.points, args.random) {
-        (Some(file), _) => points::read(file)?,
+    let mut source = match (&args.points, args.random) {
+        (Some(file), _) => Points::File(points::PointReader::open(file)?),
         (_, Some(n)) => {
             let (lo, hi) = mesh.bounds();
-            Rng::new(args.seed).points_in_box(n, lo, hi)
+            Points::Random(Some(Rng::new(args.seed).points_in_box(n, lo, hi)))
         }
-        (None, None) => unreachable!("checked above"),
+        (None, None) => anyhow::bail!("give --points FILE or --random N"),
     };
+    let first = source.next_block()?;
     let ctx = if args.method.is_cpu() { None } else { Some(crate::open_context_for(device, "cpu")?) };
     let options = Options {
         tetragrid_resolution: args.grid.unwrap_or(texgeo::inclusion::tetragrid::DEFAULT_RESOLUTION),
         voxel_space_resolution: args.grid,
-        points: pts.len(),
+        points: source.estimated_total(),
         allow_open: args.allow_open,
+        known_closed: !solid.open,
         ..Options::default()
     };
     let t = Instant::now();
     let (method, options, choice) = resolve(args.method, &mesh, &options);
     if let Some(choice) = &choice {
-        eprintln!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), pts.len());
+        eprintln!(
+            "texgeo: --method auto: {choice} for {} faces and {} points",
+            mesh.num_faces(),
+            options.points
+        );
     }
     let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
@@ -103,48 +111,113 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             args.mesh
         );
     }
-    let t = Instant::now();
-    let classes = solver.classify_all(&pts)?;
-    let run = t.elapsed();
-    match &args.output {
-        Some(path) if points::is_npy(path) => {
-            texgeo::output::write_with(path, |w| points::write_classes_npy(w, &classes))?
-        }
-        Some(path) => texgeo::output::write_with(path, |w| points::write_classes(w, &classes))?,
-        None => {
-            let count = |c: Class| classes.iter().filter(|&&x| x == c).count();
-            say!(
-                "{}: {} points, {} inside, {} outside, {} on the boundary",
-                args.mesh,
-                pts.len(),
-                count(Class::Inside),
-                count(Class::Outside),
-                count(Class::OnBoundary)
-            );
-            let stats = solver.build_stats();
-            say!(
-                "method {}: build {:.3} ms ({:.1} KiB of structures), classify {:.3} ms",
-                solver.name(),
-                build.as_secs_f64() * 1e3,
-                stats.bytes as f64 / 1024.0,
-                run.as_secs_f64() * 1e3
-            );
-            if let Some(g) = solver.gpu_stats() {
-                say!(
-                    "GPU: {} points drawn in {} draw(s), {:.3} ms; {} flagged and answered exactly on the CPU in {:.3} ms",
-                    g.gpu_points,
-                    g.draws,
-                    g.gpu.as_secs_f64() * 1e3,
-                    g.flagged,
-                    g.fallback.as_secs_f64() * 1e3
-                );
-                if let Some(ctx) = &ctx {
-                    say!("device: {}", ctx.info().label());
+    // Block by block: classify, count, write (a text output as it goes; a `.npy` output
+    // needs the count in its header, so its one byte per point waits for the end).
+    let mut out = match &args.output {
+        Some(path) => Some(texgeo::output::AtomicFile::create(path)?),
+        None => None,
+    };
+    let npy_out = args.output.as_deref().is_some_and(points::is_npy);
+    let mut all = Vec::new();
+    let mut counts = [0usize; 3];
+    let mut run = std::time::Duration::ZERO;
+    let mut gpu = GpuStats::default();
+    // The first block was read whole (its size sized the method); then a CPU method
+    // classifies each part of a block in the task that parsed it.
+    let mut block = first.map(|pts| vec![pts]);
+    loop {
+        let t = Instant::now();
+        let parts: Vec<Vec<Class>> = match block.take() {
+            Some(parts) => parts.iter().map(|pts| solver.classify_all(pts)).collect::<Result<_, _>>()?,
+            None => match (&solver, &mut source) {
+                (Solver::Cpu(c), Points::File(reader)) => {
+                    match reader.next_block_with(|pts| c.classify_all(&pts))? {
+                        Some(parts) => parts,
+                        None => break,
+                    }
                 }
+                _ => match source.next_block()? {
+                    Some(pts) => vec![solver.classify_all(&pts)?],
+                    None => break,
+                },
+            },
+        };
+        run += t.elapsed();
+        if let Some(g) = solver.gpu_stats() {
+            gpu.add(g);
+        }
+        for &c in parts.iter().flatten() {
+            counts[c as usize] += 1;
+        }
+        for classes in &parts {
+            match &mut out {
+                Some(_) if npy_out => all.extend_from_slice(classes),
+                Some(file) => points::write_classes(file, classes).map_err(|e| file.error(e))?,
+                None => {}
             }
         }
     }
+    if let Some(mut file) = out {
+        if npy_out {
+            points::write_classes_npy(&mut file, &all).map_err(|e| file.error(e))?;
+        }
+        file.commit()?;
+        return Ok(());
+    }
+    let total: usize = counts.iter().sum();
+    say!(
+        "{}: {} points, {} inside, {} outside, {} on the boundary",
+        args.mesh,
+        total,
+        counts[Class::Inside as usize],
+        counts[Class::Outside as usize],
+        counts[Class::OnBoundary as usize]
+    );
+    let stats = solver.build_stats();
+    say!(
+        "method {}: build {:.3} ms ({:.1} KiB of structures), read and classify {:.3} ms",
+        solver.name(),
+        build.as_secs_f64() * 1e3,
+        stats.bytes as f64 / 1024.0,
+        run.as_secs_f64() * 1e3
+    );
+    if solver.gpu_stats().is_some() {
+        say!(
+            "GPU: {} points drawn in {} draw(s), {:.3} ms; {} flagged and answered exactly on the CPU in {:.3} ms",
+            gpu.gpu_points,
+            gpu.draws,
+            gpu.gpu.as_secs_f64() * 1e3,
+            gpu.flagged,
+            gpu.fallback.as_secs_f64() * 1e3
+        );
+        if let Some(ctx) = &ctx {
+            say!("device: {}", ctx.info().label());
+        }
+    }
     Ok(())
+}
+
+/// Where the query points come from: a file read a block at a time, or random points.
+enum Points {
+    File(points::PointReader),
+    Random(Option<Vec<DVec3>>),
+}
+
+impl Points {
+    fn next_block(&mut self) -> anyhow::Result<Option<Vec<DVec3>>> {
+        Ok(match self {
+            Points::File(r) => r.next_block()?,
+            Points::Random(p) => p.take(),
+        })
+    }
+
+    /// About how many points there are in all (after the first block).
+    fn estimated_total(&self) -> usize {
+        match self {
+            Points::File(r) => r.estimated_total(),
+            Points::Random(p) => p.as_ref().map_or(0, Vec::len),
+        }
+    }
 }
 
 /// Refuses, before any work, a point count whose memory exceeds what is available; the

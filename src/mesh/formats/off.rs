@@ -19,46 +19,52 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     read_lines(bytes, path)
 }
 
-/// The fast path: plain ASCII read a byte at a time ([`fast`]); `None` sends the file to
-/// [`read_lines`], which reads the same files into the same mesh and words every error.
+/// The fast path: plain ASCII read in one pass ([`fast::Cursor`]); `None` sends the file
+/// to [`read_lines`], which reads the same files into the same mesh and words every error.
 fn read_fast(bytes: &[u8]) -> Option<Mesh> {
-    let mut lines = fast::ContentLines::new(bytes);
-    let header = lines.next()?;
-    let mut tokens = fast::tokens(header);
-    if !matches!(tokens.next()?, b"OFF" | b"COFF" | b"NOFF" | b"CNOFF") {
+    let mut c = fast::Cursor::new(bytes);
+    if !c.next_line() || !matches!(c.word()?, b"OFF" | b"COFF" | b"NOFF" | b"CNOFF") {
         return None;
     }
-    let mut counts: Vec<&[u8]> = tokens.collect();
-    if counts.is_empty() {
-        counts = fast::tokens(lines.next()?).collect();
+    if c.at_line_end() {
+        c.end_line()?;
+        if !c.next_line() {
+            return None;
+        }
     }
-    let (nv, nf) = (fast::index(counts.first()?)?, fast::index(counts.get(1)?)?);
+    let (nv, nf) = (c.index()?, c.index()?);
+    c.end_line()?;
     if nv > u32::MAX as u64 {
         return None;
     }
     // Sized by what the file can hold, never by the counts alone.
     let mut positions = Vec::with_capacity((nv as usize).min(bytes.len() / 6));
     for _ in 0..nv {
-        let mut t = fast::tokens(lines.next()?);
-        let (x, y, z) = (fast::coord(t.next()?)?, fast::coord(t.next()?)?, fast::coord(t.next()?)?);
-        positions.push(DVec3::new(x, y, z));
+        if !c.next_line() {
+            return None;
+        }
+        positions.push(DVec3::new(c.coord()?, c.coord()?, c.coord()?));
+        c.end_line()?;
     }
     let mut offsets = Vec::with_capacity((nf as usize).min(bytes.len() / 8) + 1);
     offsets.push(0usize);
     let mut indices = Vec::with_capacity(offsets.capacity() * 3);
     for _ in 0..nf {
-        let mut t = fast::tokens(lines.next()?);
-        let n = fast::index(t.next()?)?;
+        if !c.next_line() {
+            return None;
+        }
+        let n = c.index()?;
         if n < 3 {
             return None;
         }
         for _ in 0..n {
-            let i = fast::index(t.next()?)?;
+            let i = c.index()?;
             if i >= nv {
                 return None;
             }
             indices.push(i as u32);
         }
+        c.end_line()?;
         offsets.push(indices.len());
     }
     Mesh::from_parts(positions, offsets, indices).ok()

@@ -8,6 +8,8 @@ use crate::mesh::{MeshError, error::Location};
 pub(crate) struct Lines<'a> {
     path: &'a Path,
     inner: std::iter::Enumerate<std::str::Lines<'a>>,
+    /// Lines of the file before `inner`'s first.
+    before: usize,
     /// Line number of the last line handed out (for "file ends" errors).
     pub last_line: usize,
 }
@@ -15,17 +17,28 @@ pub(crate) struct Lines<'a> {
 impl<'a> Lines<'a> {
     /// Fails on bytes that are not UTF-8, naming the line and byte offset.
     pub fn new(bytes: &'a [u8], path: &'a Path) -> Result<Lines<'a>, MeshError> {
-        let text = utf8(bytes, path, 0, 0)?;
-        Ok(Lines { path, inner: text.lines().enumerate(), last_line: 0 })
+        Lines::after(bytes, path, 0, 0)
+    }
+
+    /// The lines of `bytes`, a part of a file that starts after `lines_before` lines and
+    /// `bytes_before` bytes (for the line numbers and offsets of errors).
+    pub fn after(
+        bytes: &'a [u8],
+        path: &'a Path,
+        lines_before: usize,
+        bytes_before: usize,
+    ) -> Result<Lines<'a>, MeshError> {
+        let text = utf8(bytes, path, lines_before, bytes_before)?;
+        Ok(Lines { path, inner: text.lines().enumerate(), before: lines_before, last_line: lines_before })
     }
 
     /// The next line holding something other than whitespace and a `#` comment.
     pub fn next_content(&mut self) -> Option<(usize, &'a str)> {
         for (i, line) in self.inner.by_ref() {
-            self.last_line = i + 1;
+            self.last_line = self.before + i + 1;
             let line = line.split('#').next().unwrap_or("").trim();
             if !line.is_empty() {
-                return Some((i + 1, line));
+                return Some((self.last_line, line));
             }
         }
         None
@@ -219,82 +232,115 @@ pub(crate) mod fast {
         b == b' ' || (9..=13).contains(&b)
     }
 
-    /// The content lines of `bytes` (comment after `#` removed, trimmed, non-empty), or
-    /// `None` as soon as a non-ASCII byte shows up.
-    pub struct ContentLines<'a> {
-        rest: &'a [u8],
-        /// A non-ASCII byte was seen: the caller must use the slow path.
-        pub failed: bool,
+    /// Spaces inside a line: [`is_space`] but the newline.
+    #[inline]
+    fn is_inline_space(b: u8) -> bool {
+        b != b'\n' && is_space(b)
     }
 
-    impl<'a> ContentLines<'a> {
-        pub fn new(bytes: &'a [u8]) -> ContentLines<'a> {
-            ContentLines { rest: bytes, failed: false }
+    /// Reads whitespace-separated numbers from ASCII text in one pass, line by line, in
+    /// place: no per-line or per-token allocation and no second look at a byte. Every
+    /// reader returns `None` for anything the line-by-line readers might word differently
+    /// (a non-ASCII byte, a malformed or non-finite number), which then decide.
+    pub struct Cursor<'a> {
+        bytes: &'a [u8],
+        at: usize,
+    }
+
+    impl<'a> Cursor<'a> {
+        pub fn new(bytes: &'a [u8]) -> Cursor<'a> {
+            Cursor { bytes, at: 0 }
         }
-    }
 
-    impl<'a> Iterator for ContentLines<'a> {
-        type Item = &'a [u8];
-        #[inline]
-        fn next(&mut self) -> Option<&'a [u8]> {
-            while !self.rest.is_empty() {
-                let end = self.rest.iter().position(|&b| b == b'\n').unwrap_or(self.rest.len());
-                let line = &self.rest[..end];
-                self.rest = &self.rest[(end + 1).min(self.rest.len())..];
-                if !line.is_ascii() {
-                    self.failed = true;
-                    self.rest = &[];
-                    return None;
+        /// Moves to the first token of the next content line (skipping blank lines and
+        /// `#` comments); false at the end of the text.
+        pub fn next_line(&mut self) -> bool {
+            loop {
+                while self.at < self.bytes.len() && is_space(self.bytes[self.at]) {
+                    self.at += 1;
                 }
-                let line = match line.iter().position(|&b| b == b'#') {
-                    Some(c) => &line[..c],
-                    None => line,
-                };
-                let start = line.iter().position(|&b| !is_space(b)).unwrap_or(line.len());
-                let end = line.iter().rposition(|&b| !is_space(b)).map_or(start, |e| e + 1);
-                let line = &line[start..end.max(start)];
-                if !line.is_empty() {
-                    return Some(line);
+                match self.bytes.get(self.at) {
+                    None => return false,
+                    Some(b'#') => {
+                        if self.end_line().is_none() {
+                            return false;
+                        }
+                    }
+                    Some(_) => return true,
                 }
             }
-            None
         }
-    }
 
-    /// The whitespace-separated tokens of an ASCII line.
-    #[inline]
-    pub fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-        line.split(|&b| is_space(b)).filter(|t| !t.is_empty())
-    }
-
-    /// A finite f64, parsed exactly as `str::parse` would (correctly rounded); `None` for
-    /// anything else (the slow path then explains).
-    #[inline]
-    pub fn coord(token: &[u8]) -> Option<f64> {
-        // Only the characters of decimal numbers: `str::parse` also takes "inf", "nan" and
-        // friends, which are refused anyway, and leaves nothing else for fast-float to differ on.
-        if !token.iter().all(|&b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E')) {
-            return None;
-        }
-        let v: f64 = fast_float2::parse(token).ok()?;
-        v.is_finite().then_some(v)
-    }
-
-    /// A non-negative integer (`str::parse::<u64>` grammar: an optional `+`, then digits).
-    #[inline]
-    pub fn index(token: &[u8]) -> Option<u64> {
-        let digits = token.strip_prefix(b"+").unwrap_or(token);
-        if digits.is_empty() || digits.len() > 19 {
-            return None;
-        }
-        let mut v = 0u64;
-        for &b in digits {
-            if !b.is_ascii_digit() {
+        /// Skips the rest of the line (extra values, a comment), which must be ASCII.
+        pub fn end_line(&mut self) -> Option<()> {
+            let rest = &self.bytes[self.at..];
+            let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+            if !rest[..len].is_ascii() {
                 return None;
             }
-            v = v * 10 + (b - b'0') as u64;
+            self.at += (len + 1).min(rest.len());
+            Some(())
         }
-        Some(v)
+
+        /// True at the end of the line's tokens (its end, or a comment).
+        pub fn at_line_end(&mut self) -> bool {
+            self.skip_inline_spaces();
+            matches!(self.bytes.get(self.at), None | Some(b'\n' | b'#'))
+        }
+
+        #[inline]
+        fn skip_inline_spaces(&mut self) {
+            while self.at < self.bytes.len() && is_inline_space(self.bytes[self.at]) {
+                self.at += 1;
+            }
+        }
+
+        /// The next token ends here: a space, a comment, the line's or the text's end.
+        #[inline]
+        fn delimited(&self) -> bool {
+            self.bytes.get(self.at).is_none_or(|&b| is_space(b) || b == b'#')
+        }
+
+        /// The next token of the line, whatever it holds.
+        pub fn word(&mut self) -> Option<&'a [u8]> {
+            self.skip_inline_spaces();
+            let start = self.at;
+            while !self.delimited() {
+                self.at += 1;
+            }
+            (self.at > start).then(|| &self.bytes[start..self.at])
+        }
+
+        /// The next token of the line as a finite f64, correctly rounded like [`coord`].
+        #[inline]
+        pub fn coord(&mut self) -> Option<f64> {
+            self.skip_inline_spaces();
+            // Only the characters that start decimal numbers ("inf", "nan": slow path).
+            let &first = self.bytes.get(self.at)?;
+            if !(first.is_ascii_digit() || matches!(first, b'.' | b'-' | b'+')) {
+                return None;
+            }
+            let (v, used): (f64, usize) = fast_float2::parse_partial(&self.bytes[self.at..]).ok()?;
+            self.at += used;
+            (used > 0 && v.is_finite() && self.delimited()).then_some(v)
+        }
+
+        /// The next token of the line as a non-negative integer, like [`index`].
+        #[inline]
+        pub fn index(&mut self) -> Option<u64> {
+            self.skip_inline_spaces();
+            if self.bytes.get(self.at) == Some(&b'+') {
+                self.at += 1;
+            }
+            let start = self.at;
+            let mut v = 0u64;
+            while let Some(&b) = self.bytes.get(self.at).filter(|b| b.is_ascii_digit()) {
+                v = v.wrapping_mul(10).wrapping_add((b - b'0') as u64);
+                self.at += 1;
+            }
+            let digits = self.at - start;
+            (digits > 0 && digits <= 19 && self.delimited()).then_some(v)
+        }
     }
 
     #[cfg(test)]
@@ -313,24 +359,34 @@ pub(crate) mod fast {
                         (0..len).map(|_| alphabet[rng.below(alphabet.len() as u64) as usize]).collect();
                     let s = std::str::from_utf8(&t).unwrap();
                     let std = s.parse::<f64>().ok().filter(|v| v.is_finite());
-                    assert_eq!(coord(&t).map(f64::to_bits), std.map(f64::to_bits), "{s}");
-                    assert_eq!(index(&t), s.parse::<u64>().ok(), "{s}");
+                    // The cursor, with the token ending at a space or at the end of the text.
+                    for text in [t.clone(), [&t[..], b" 7"].concat()] {
+                        let got = Cursor::new(&text).coord();
+                        assert_eq!(got.map(f64::to_bits), std.map(f64::to_bits), "{s}");
+                        assert_eq!(Cursor::new(&text).index(), s.parse::<u64>().ok(), "{s}");
+                    }
                     tried += 1;
                 }
             }
             for s in ["1.5e300", "-0", "0.1", "4.9406564584124654e-324", "1e400", "123456789012345678901"] {
                 let std = s.parse::<f64>().ok().filter(|v| v.is_finite());
-                assert_eq!(coord(s.as_bytes()).map(f64::to_bits), std.map(f64::to_bits), "{s}");
-                assert_eq!(index(s.as_bytes()), s.parse::<u64>().ok(), "{s}");
+                assert_eq!(Cursor::new(s.as_bytes()).coord().map(f64::to_bits), std.map(f64::to_bits), "{s}");
+                // 21 digits: not a u64 for either.
+                assert_eq!(Cursor::new(s.as_bytes()).index(), s.parse::<u64>().ok(), "{s}");
             }
             assert!(tried > 40_000);
-            assert_eq!(coord(b"inf"), None);
-            let lines: Vec<&[u8]> = ContentLines::new(b"  a b # c\n\n# x\r\n d\r\n").collect();
-            assert_eq!(lines, vec![&b"a b"[..], &b"d"[..]]);
-            let mut l = ContentLines::new("1 2\n\u{e9}\n".as_bytes());
-            assert_eq!(l.next(), Some(&b"1 2"[..]));
-            assert_eq!(l.next(), None);
-            assert!(l.failed);
+            assert_eq!(Cursor::new(b"inf").coord(), None);
+            let mut c = Cursor::new(b"  a b # c\n\n# x\r\n d\r\n");
+            assert!(c.next_line());
+            assert_eq!((c.word(), c.word(), c.word()), (Some(&b"a"[..]), Some(&b"b"[..]), None));
+            assert!(c.at_line_end() && c.end_line().is_some() && c.next_line());
+            assert_eq!(c.word(), Some(&b"d"[..]));
+            assert!(c.end_line().is_some() && !c.next_line());
+            let mut c = Cursor::new("1 2\n\u{e9}\n".as_bytes());
+            assert!(c.next_line());
+            assert_eq!((c.index(), c.coord()), (Some(1), Some(2.0)));
+            assert!(c.end_line().is_some() && c.next_line());
+            assert_eq!(c.end_line(), None);
         }
     }
 }
