@@ -50,7 +50,7 @@ fn errors_exit_2_with_one_message() {
     assert_refused(&texgeo(&["inclusion"]), &["--points <FILE>"]);
 }
 
-/// A point file larger than one read block (8 MiB) is read, classified and written a
+/// A point file larger than one read block (4 MiB) is read, classified and written a
 /// block at a time: the same labels as the same points read whole from `.npy` by another
 /// method; a bad line late in it is an error with its line number and leaves no file.
 #[test]

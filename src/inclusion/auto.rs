@@ -38,11 +38,12 @@ impl std::fmt::Display for Choice {
 ///
 /// Fitted to single-thread runs of the voxel space on `builtin:knot` (1 200 triangles) and
 /// `armadillo.off` (52 000) at 1 k … 1 M points and n = 8 … 256 on the 2-core reference
-/// machine. Checked again on 2026-12-02 (armadillo, `texgeo inclusion --method voxel-space
-/// --grid n`, machine shared, so absolute times ~3× high): build + classification of 1 M
-/// uniform points took 3.26 s at n = 16, 1.13 s at 32, 0.59 s at 64, 0.65 s at 128 — the
-/// model's pick, 64, is the measured minimum; for 1 000 points n = 16 and 32 were within
-/// noise (0.14 s) and 128 was 2.4× slower, and the model picks 16.
+/// machine. The build terms were fitted again on 2026-12-02 after the labelling became a
+/// parity walk per row (armadillo, 2 threads, quiet machine): 12 ms at n = 16, 21 at 64,
+/// 29 at 96, 46 at 128, 114 at 192. Whole `texgeo inclusion --method voxel-space --grid n`
+/// runs then measured, for 1 M points, 208–236 ms at n = 64, 205–249 at 96 (the model's
+/// pick) and 262–266 at 128; for 1 000 points 21.6 ms at 16, 21.0–27.3 at 24 (the pick)
+/// and 20.8–21.7 at 32 — the model's picks are within noise of the measured minimum.
 fn voxel_space_cost(t: f64, p: f64, n: f64) -> f64 {
     let (build, per_point) = voxel_space_model(t, n);
     build + p * per_point
@@ -53,7 +54,7 @@ fn voxel_space_model(t: f64, n: f64) -> (f64, f64) {
     // Build: rasterizing the triangles, the scanline labels (rows × crossings) and the
     // n³ cell array. Query: O(1) in labelled cells; in surface cells (a fraction ∝ area·n²
     // / n³ of a uniform sample) an exact test over about t / n² triangles.
-    let build = 2.0e-4 + 6.0e-8 * t + 4.0e-9 * n * n * n + 2.0e-8 * t.sqrt() * n * n;
+    let build = 2.0e-4 + 2.0e-7 * t + 2.75e-9 * n * n * n + 1.0e-8 * t.sqrt() * n * n;
     let surface_fraction = (6.0 / n).min(1.0);
     let per_point = 1.5e-8 + surface_fraction * (1.0e-7 + 3.0e-9 * t / (n * n) * 8.0);
     (build, per_point)
