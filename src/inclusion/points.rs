@@ -55,7 +55,7 @@ fn parse_part(
 }
 
 /// Bytes of text read per block by [`PointReader`].
-const BLOCK: usize = 1 << 22;
+const BLOCK: usize = 1 << 23;
 
 /// The points of a file a block at a time, so that classifying a file of any size takes
 /// bounded memory: text in blocks of whole lines ([`BLOCK`] bytes), `.npy` in one block.
@@ -72,9 +72,11 @@ enum Source {
     Text {
         file: std::fs::File,
         len: u64,
+        /// Read and not handed out yet: `buf[..filled]`.
         buf: Vec<u8>,
-        /// Bytes at the front of `buf` that belong to a line not finished yet.
-        kept: usize,
+        filled: usize,
+        /// The next block is read into this one while `buf`'s is parsed.
+        spare: Vec<u8>,
         lines_before: usize,
         bytes_before: usize,
         eof: bool,
@@ -96,7 +98,16 @@ impl PointReader {
         } else {
             let file = std::fs::File::open(path).map_err(io)?;
             let len = file.metadata().map_err(io)?.len();
-            Source::Text { file, len, buf: Vec::new(), kept: 0, lines_before: 0, bytes_before: 0, eof: false }
+            Source::Text {
+                file,
+                len,
+                buf: Vec::new(),
+                filled: 0,
+                spare: Vec::new(),
+                lines_before: 0,
+                bytes_before: 0,
+                eof: false,
+            }
         };
         Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1) })
     }
@@ -105,7 +116,7 @@ impl PointReader {
     /// whole, else from the bytes per point so far (at least what was read).
     pub fn estimated_total(&self) -> usize {
         match &self.source {
-            Source::Text { len, bytes_before, eof, .. } if !eof && *bytes_before > 0 => {
+            Source::Text { len, bytes_before, .. } if *bytes_before > 0 && (*bytes_before as u64) < *len => {
                 ((*len as f64 / *bytes_before as f64) * self.read as f64).ceil() as usize
             }
             _ => self.read,
@@ -124,6 +135,7 @@ impl PointReader {
         f: impl Fn(Vec<DVec3>) -> T + Sync,
     ) -> Result<Option<Vec<T>>, MeshError> {
         let path = self.path.as_path();
+        let io = |error| MeshError::Io { path: path.into(), error };
         let block_size = self.block;
         let (parts, count) = match &mut self.source {
             Source::Whole(points) => match points.take() {
@@ -133,37 +145,37 @@ impl PointReader {
                 }
                 None => (Vec::new(), 0),
             },
-            Source::Text { file, len, buf, kept, lines_before, bytes_before, eof } => loop {
-                if *eof && *kept == 0 {
+            Source::Text { file, len, buf, filled, spare, lines_before, bytes_before, eof } => loop {
+                if *eof && *filled == 0 {
                     break (Vec::new(), 0);
                 }
-                // Fill the buffer after the unfinished line (grown when one line fills it),
-                // no larger than what is left of the file.
-                let left = (*len as usize).saturating_sub(*bytes_before + *kept);
-                let size = block_size.max(2 * *kept).min(*kept + left + 1);
-                buf.resize(size, 0);
-                let mut filled = *kept;
-                while !*eof && filled < size {
-                    match std::io::Read::read(file, &mut buf[filled..]) {
-                        Ok(0) => *eof = true,
-                        Ok(k) => filled += k,
-                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                        Err(error) => return Err(MeshError::Io { path: path.into(), error }),
-                    }
+                // A whole line at least (or the end of the file) before parsing.
+                let last_end = buf[..*filled].iter().rposition(|&b| b == b'\n');
+                if !*eof && last_end.is_none() {
+                    let size =
+                        block_size.max(2 * *filled).min(*filled + remaining(*len, *bytes_before + *filled));
+                    *filled = fill(file, buf, *filled, size, eof).map_err(io)?;
+                    continue;
                 }
-                let cut = if *eof {
-                    filled
-                } else {
-                    match buf[..filled].iter().rposition(|&b| b == b'\n') {
-                        Some(at) => at + 1,
-                        None => {
-                            *kept = filled;
-                            continue;
+                let cut = if *eof { *filled } else { last_end.map_or(*filled, |at| at + 1) };
+                // Parse this block while the next one is read (after this one's unfinished line).
+                let (text, rest) = buf[..*filled].split_at(cut);
+                let next_start = *bytes_before + *filled;
+                let (parsed, next) = rayon::join(
+                    || parse_fast_with(text, &f),
+                    || -> std::io::Result<usize> {
+                        spare.clear();
+                        spare.extend_from_slice(rest);
+                        if *eof {
+                            return Ok(rest.len());
                         }
-                    }
-                };
-                let text = &buf[..cut];
-                let (parts, count, lines) = match parse_fast_with(text, &f) {
+                        let size =
+                            block_size.max(2 * rest.len()).min(rest.len() + remaining(*len, next_start));
+                        fill(file, spare, rest.len(), size, eof)
+                    },
+                );
+                let next = next.map_err(io)?;
+                let (parts, count, lines) = match parsed {
                     Some(parts) => {
                         let (count, lines) = parts.iter().fold((0, 0), |(c, l), p| (c + p.1, l + p.2));
                         (parts.into_iter().map(|p| p.0).collect(), count, lines)
@@ -176,8 +188,8 @@ impl PointReader {
                 };
                 *lines_before += lines;
                 *bytes_before += cut;
-                buf.copy_within(cut..filled, 0);
-                *kept = filled - cut;
+                std::mem::swap(buf, spare);
+                *filled = next;
                 if count > 0 {
                     break (parts, count);
                 }
@@ -194,8 +206,35 @@ impl PointReader {
     }
 }
 
+/// Bytes left in a file of `len` bytes after `at`, plus one (so that a read sees its end).
+fn remaining(len: u64, at: usize) -> usize {
+    (len as usize).saturating_sub(at) + 1
+}
+
+/// Reads from `file` into `buf[start..]`, `buf` resized to `size`, until it is full or the
+/// file ends (`eof` then set); the bytes now held.
+fn fill(
+    file: &mut std::fs::File,
+    buf: &mut Vec<u8>,
+    start: usize,
+    size: usize,
+    eof: &mut bool,
+) -> std::io::Result<usize> {
+    buf.resize(size.max(start), 0);
+    let mut filled = start;
+    while !*eof && filled < buf.len() {
+        match std::io::Read::read(file, &mut buf[filled..]) {
+            Ok(0) => *eof = true,
+            Ok(k) => filled += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
+}
+
 /// Bytes per parallel chunk of text.
-const CHUNK: usize = 1 << 19;
+const CHUNK: usize = 1 << 18;
 
 /// The fast path: chunks cut at line ends, parsed in parallel; `None` when any chunk holds
 /// something the fast parser does not take (the line reader then decides).

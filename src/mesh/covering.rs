@@ -123,8 +123,10 @@ impl Covering {
     }
 
     /// The three corners of covering triangle `t`.
+    #[inline]
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
-        self.triangles[t].map(|i| self.points[i as usize])
+        let [a, b, c] = self.triangles[t];
+        [self.points[a as usize], self.points[b as usize], self.points[c as usize]]
     }
 
     /// Axis-aligned bounds of the covering points (both zero when there are none).
