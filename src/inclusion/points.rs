@@ -55,7 +55,7 @@ fn parse_part(
 }
 
 /// Bytes of text read per block by [`PointReader`].
-const BLOCK: usize = 1 << 23;
+const BLOCK: usize = 1 << 22;
 
 /// The points of a file a block at a time, so that classifying a file of any size takes
 /// bounded memory: text in blocks of whole lines ([`BLOCK`] bytes), `.npy` in one block.
