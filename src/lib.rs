@@ -15,6 +15,7 @@ pub mod output;
 pub mod random;
 pub mod render;
 pub mod report;
+pub mod scratch;
 pub mod subdiv;
 pub mod sweep;
 pub mod tetragrid;

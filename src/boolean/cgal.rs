@@ -14,10 +14,10 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::Operation;
 use crate::mesh::{Mesh, formats};
+use crate::scratch::ScratchDir;
 
 /// Environment variable naming the helper binary, overriding the default location.
 pub const HELPER_ENV: &str = "TEXGEO_CGAL_BOOLEAN";
@@ -35,6 +35,12 @@ pub enum CgalError {
 }
 
 pub type Result<T, E = CgalError> = std::result::Result<T, E>;
+
+impl From<crate::output::Error> for CgalError {
+    fn from(e: crate::output::Error) -> CgalError {
+        CgalError::Io { path: e.path, source: e.error }
+    }
+}
 
 /// The helper binary: `$TEXGEO_CGAL_BOOLEAN`, else `target/tools/cgal-boolean` of this
 /// checkout, else `tools/cgal-boolean` in an ancestor of the running executable.
@@ -133,8 +139,8 @@ pub fn reference(a: &Mesh, b: &Mesh, repeat: Option<u32>) -> Result<Reference> {
 
 /// CGAL's result mesh of `op` (union, intersection or difference), or its reason to decline.
 pub fn result_mesh(a: &Mesh, b: &Mesh, op: Operation) -> Result<std::result::Result<Mesh, String>> {
-    let dir = TempDir::new()?;
-    let out = dir.path.join("result.off");
+    let dir = ScratchDir::new("cgal")?;
+    let out = dir.join("result.off");
     let name = match op {
         Operation::Union => "union",
         Operation::Intersection => "intersection",
@@ -159,8 +165,8 @@ fn run(
     output: Option<&Path>,
 ) -> Result<Vec<(String, Outcome)>> {
     let helper = helper_path()?;
-    let dir = TempDir::new()?;
-    let (pa, pb) = (dir.path.join("a.off"), dir.path.join("b.off"));
+    let dir = ScratchDir::new("cgal")?;
+    let (pa, pb) = (dir.join("a.off"), dir.join("b.off"));
     formats::write(&pa, a)?;
     formats::write(&pb, b)?;
     let mut command = Command::new(&helper);
@@ -222,28 +228,6 @@ fn parse(stdout: &str) -> Vec<(String, Outcome)> {
         }
     }
     out
-}
-
-/// A private temporary folder, removed on drop.
-struct TempDir {
-    path: PathBuf,
-}
-
-impl TempDir {
-    fn new() -> Result<TempDir> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let path = std::env::temp_dir().join(format!("texgeo-cgal-{}-{n}", std::process::id()));
-        std::fs::create_dir_all(&path).map_err(|source| CgalError::Io { path: path.clone(), source })?;
-        Ok(TempDir { path })
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        // Best effort: a leftover folder in the temp dir is harmless.
-        let _ = std::fs::remove_dir_all(&self.path);
-    }
 }
 
 #[cfg(test)]

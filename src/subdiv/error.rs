@@ -43,3 +43,9 @@ pub enum SubdivError {
     #[error("{}: {error}", path.display())]
     Io { path: PathBuf, error: std::io::Error },
 }
+
+impl From<crate::output::Error> for SubdivError {
+    fn from(e: crate::output::Error) -> SubdivError {
+        SubdivError::Io { path: e.path, error: e.error }
+    }
+}

@@ -5,9 +5,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::mesh::{Mesh, formats};
+use crate::scratch::ScratchDir;
 
 use super::{Result, SubdivError, Surface, tags};
 
@@ -82,9 +82,9 @@ pub fn time_median(surface: &Surface, level: u32, repeat: u32) -> Result<f64> {
 /// Runs the helper on `surface` with `options`.
 pub fn run(surface: &Surface, level: u32, options: &Options) -> Result<Run> {
     let helper = helper_path()?;
-    let dir = TempDir::new()?;
-    let input = dir.path.join("in.obj");
-    let output = dir.path.join("out.off");
+    let dir = ScratchDir::new("osd")?;
+    let input = dir.join("in.obj");
+    let output = dir.join("out.off");
     let mut text = Vec::new();
     tags::write_obj(&mut text, surface).map_err(|error| SubdivError::Io { path: input.clone(), error })?;
     std::fs::write(&input, text).map_err(|error| SubdivError::Io { path: input.clone(), error })?;
@@ -131,28 +131,6 @@ fn helper_error(path: &Path, message: impl Into<String>) -> SubdivError {
 /// The value of `key` (`min_seconds=` or `median_seconds=`) in the helper's timing line.
 fn parse_seconds(stdout: &str, key: &str) -> Option<f64> {
     stdout.split_whitespace().find_map(|t| t.strip_prefix(key))?.parse().ok()
-}
-
-/// A private temporary folder, removed on drop.
-struct TempDir {
-    path: PathBuf,
-}
-
-impl TempDir {
-    fn new() -> Result<TempDir> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let path = std::env::temp_dir().join(format!("texgeo-osd-{}-{n}", std::process::id()));
-        std::fs::create_dir_all(&path).map_err(|error| SubdivError::Io { path: path.clone(), error })?;
-        Ok(TempDir { path })
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        // Best effort: a leftover folder in the temp dir is harmless.
-        let _ = std::fs::remove_dir_all(&self.path);
-    }
 }
 
 #[cfg(test)]

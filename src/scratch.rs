@@ -1,0 +1,54 @@
+//! A private temporary folder for the files a helper process reads and writes (the
+//! OpenSubdiv and CGAL helpers), removed with everything in it when dropped.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A fresh folder `texgeo-PREFIX-PID-N` in the system's temporary folder.
+#[derive(Debug)]
+pub struct ScratchDir {
+    path: PathBuf,
+}
+
+impl ScratchDir {
+    /// Creates the folder; the error names it.
+    pub fn new(prefix: &str) -> crate::output::Result<ScratchDir> {
+        // One per call, also across threads of this process.
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let path = std::env::temp_dir().join(format!("texgeo-{prefix}-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&path).map_err(|e| crate::output::Error::new(&path, e))?;
+        Ok(ScratchDir { path })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The path of `name` inside the folder.
+    pub fn join(&self, name: &str) -> PathBuf {
+        self.path.join(name)
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        // Best effort: a leftover folder in the temp dir is harmless.
+        let _ = std::fs::remove_dir_all(&self.path);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn folders_are_distinct_and_removed() {
+        let (a, b) = (ScratchDir::new("t").unwrap(), ScratchDir::new("t").unwrap());
+        assert_ne!(a.path(), b.path());
+        std::fs::write(a.join("f"), b"x").unwrap();
+        let p = a.path().to_path_buf();
+        drop(a);
+        assert!(!p.exists() && b.path().is_dir());
+    }
+}
