@@ -60,26 +60,13 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
     let cgal_ready = cgal::helper_path().is_ok();
     r.progress.total(models.len() as u64);
 
-    let mut table = Table::new(
-        "Table 6-1 today: Boolean operations (ms)",
-        &[
-            "pair (A and its turned copy)",
-            "thesis pair",
-            "op",
-            "triangles",
-            "cut A+B",
-            "point tests grouped / plain",
-            "saved",
-            "phase 1",
-            "phase 2 grouped CPU",
-            "phase 2 grouped GPU",
-            "phase 2 plain CPU",
-            "total grouped GPU",
-            "CGAL corefinement",
-            "volume",
-            "check",
-        ],
-    );
+    let columns = [
+        &["pair (A and its turned copy)"][..],
+        &crate::report::bench::boolean::PHASE_COLUMNS,
+        &["total grouped GPU", "CGAL corefinement", "volume", "check"],
+    ]
+    .concat();
+    let mut table = Table::new("Table 6-1 today: Boolean operations (ms)", &columns);
     let mut list: Vec<(String, &str, usize)> = Vec::new();
     let mut refused = Vec::new();
     let mut failed = Vec::new();
