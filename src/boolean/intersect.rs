@@ -142,18 +142,24 @@ fn locate_2d(tri: [DVec2; 3], ids: [u32; 3], face: u32, x: DVec2) -> Option<Simp
     if o.contains(&-1) {
         return None;
     }
-    Some(match o.iter().filter(|&&v| v == 0).count() {
+    Some(simplex_of_signs(o, ids, face))
+}
+
+/// The simplex that the signs `o` of a point against a triangle's three edges name, the
+/// point being on the triangle: its face (no zero), edge k (o[k] = 0) or, on two edges,
+/// their common vertex (edges k and k+1 share vertex k+1).
+fn simplex_of_signs(o: [i8; 3], ids: [u32; 3], face: u32) -> Simplex {
+    match o.iter().filter(|&&v| v == 0).count() {
         0 => Simplex::Face(face),
         1 => {
             let k = o.iter().position(|&v| v == 0).unwrap_or(0);
             Simplex::edge(ids[k], ids[(k + 1) % 3])
         }
-        // On two edges: their common vertex (edges k and k+1 share vertex k+1).
         _ => {
             let k = (0..3).find(|&k| o[k] == 0 && o[(k + 1) % 3] == 0).unwrap_or(0);
             Simplex::Vertex(ids[(k + 1) % 3])
         }
-    })
+    }
 }
 
 /// The minimal simplex of triangle `tri` (ids `ids`) where the segment pq, which
@@ -163,17 +169,7 @@ fn locate_crossing(p: DVec3, q: DVec3, tri: [DVec3; 3], ids: [u32; 3], face: u32
     if o.contains(&1) && o.contains(&-1) {
         return None;
     }
-    Some(match o.iter().filter(|&&v| v == 0).count() {
-        0 => Simplex::Face(face),
-        1 => {
-            let k = o.iter().position(|&v| v == 0).unwrap_or(0);
-            Simplex::edge(ids[k], ids[(k + 1) % 3])
-        }
-        _ => {
-            let k = (0..3).find(|&k| o[k] == 0 && o[(k + 1) % 3] == 0).unwrap_or(0);
-            Simplex::Vertex(ids[(k + 1) % 3])
-        }
-    })
+    Some(simplex_of_signs(o, ids, face))
 }
 
 /// Up to two distinct keys (more would mean the inputs are not what the exact tests
