@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{TempDir, assert_refused, stderr, stdout, texgeo};
+use common::{TempDir, assert_refused, stderr, stdout, texgeo, texgeo_in_shell};
 
 #[test]
 fn info_names_the_device_and_logic_op() {
@@ -78,6 +78,13 @@ fn inclusion_streams_a_large_point_file() {
     let whole = run(&dir.arg("p.npy"), "bvh", &dir.arg("b.txt"));
     assert_eq!(streamed.lines().count(), 160_000);
     assert!(streamed == whole, "the streamed labels differ from the whole file's");
+    // From a pipe (no length to size the reads by): the same labels.
+    let o = texgeo_in_shell(
+        &format!("cat '{}' |", dir.arg("p.txt")),
+        &["inclusion", "builtin:knot", "--points", "/dev/stdin", "-o", &dir.arg("d.txt")],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read_to_string(dir.join("d.txt")).unwrap() == whole, "labels read from a pipe differ");
     assert!(streamed.contains("1\n") && streamed.contains("0\n"));
     text.push_str("1 2\n");
     std::fs::write(&txt, &text).unwrap();

@@ -71,7 +71,8 @@ pub struct PointReader {
 enum Source {
     Text {
         file: std::fs::File,
-        len: u64,
+        /// The size of a regular file (`None`: a pipe, read until it ends).
+        len: Option<u64>,
         /// Read and not handed out yet: `buf[..filled]`.
         buf: Vec<u8>,
         filled: usize,
@@ -97,7 +98,9 @@ impl PointReader {
             Source::Whole(Some(read(path)?))
         } else {
             let file = std::fs::File::open(path).map_err(io)?;
-            let len = file.metadata().map_err(io)?.len();
+            let meta = file.metadata().map_err(io)?;
+            // A pipe or a device has no length to size the reads by.
+            let len = meta.is_file().then_some(meta.len());
             Source::Text {
                 file,
                 len,
@@ -116,7 +119,9 @@ impl PointReader {
     /// whole, else from the bytes per point so far (at least what was read).
     pub fn estimated_total(&self) -> usize {
         match &self.source {
-            Source::Text { len, bytes_before, .. } if *bytes_before > 0 && (*bytes_before as u64) < *len => {
+            Source::Text { len: Some(len), bytes_before, .. }
+                if *bytes_before > 0 && (*bytes_before as u64) < *len =>
+            {
                 ((*len as f64 / *bytes_before as f64) * self.read as f64).ceil() as usize
             }
             _ => self.read,
@@ -206,9 +211,10 @@ impl PointReader {
     }
 }
 
-/// Bytes left in a file of `len` bytes after `at`, plus one (so that a read sees its end).
-fn remaining(len: u64, at: usize) -> usize {
-    (len as usize).saturating_sub(at) + 1
+/// Bytes left in a file of `len` bytes after `at`, plus one (so that a read sees its end);
+/// unbounded for a pipe.
+fn remaining(len: Option<u64>, at: usize) -> usize {
+    len.map_or(usize::MAX / 4, |len| (len as usize).saturating_sub(at) + 1)
 }
 
 /// Reads from `file` into `buf[start..]`, `buf` resized to `size`, until it is full or the
