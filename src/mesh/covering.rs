@@ -234,52 +234,25 @@ impl Covering {
     /// surface (a 2-cycle), which is what the covering methods need; non-manifold edges
     /// (used twice each way) are fine.
     pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
-        // Every directed edge bucketed by its smaller end (a counting sort), as
-        // (larger end, direction) packed in a u64; each bucket sorted, the uses of an
-        // undirected edge are adjacent, and buckets are read in order: smallest edge first.
-        let nv = self.points.len();
-        let mut start = vec![0u32; nv + 1];
-        self.for_each_edge(|a, b| start[a.min(b) as usize + 1] += 1);
-        for v in 0..nv {
-            start[v + 1] += start[v];
-        }
-        let mut next = start.clone();
-        let mut keys = vec![0u64; start[nv] as usize];
-        self.for_each_edge(|a, b| {
-            let lo = a.min(b) as usize;
-            keys[next[lo] as usize] = (a.max(b) as u64) << 1 | (a > b) as u64;
-            next[lo] += 1;
-        });
-        (0..nv).find_map(|v| {
-            let bucket = &mut keys[start[v] as usize..start[v + 1] as usize];
-            bucket.sort_unstable();
-            bucket.chunk_by(|x, y| x >> 1 == y >> 1).find_map(|run| {
-                let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
-                let forward = run.len() as u32 - backward;
+        // The uses of each edge are adjacent in its lower vertex's bucket, edges in
+        // increasing order: the first unbalanced one is the smallest.
+        let indices = &self.polygon_indices;
+        let (start, items) =
+            super::validate::half_edges_by_lower_vertex(&self.polygon_offsets, indices, self.points.len());
+        (0..self.points.len()).find_map(|lo| {
+            items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32).find_map(|run| {
+                // A use leaving the lower vertex goes lo→hi.
+                let forward =
+                    run.iter().filter(|&&i| indices[(i & 0xffff_ffff) as usize] as usize == lo).count();
+                let backward = run.len() - forward;
                 (forward != backward).then(|| UnbalancedEdge {
-                    a: v as u32,
-                    b: (run[0] >> 1) as u32,
-                    forward,
-                    backward,
+                    a: lo as u32,
+                    b: (run[0] >> 32) as u32,
+                    forward: forward as u32,
+                    backward: backward as u32,
                 })
             })
         })
-    }
-
-    /// Calls `f(a, b)` for every directed edge a→b (a ≠ b) of the mesh faces.
-    #[inline]
-    fn for_each_edge(&self, mut f: impl FnMut(u32, u32)) {
-        for w in self.polygon_offsets.windows(2) {
-            let poly = &self.polygon_indices[w[0]..w[1]];
-            let Some(&last) = poly.last() else { continue };
-            let mut a = last;
-            for &b in poly {
-                if a != b {
-                    f(a, b);
-                }
-                a = b;
-            }
-        }
     }
 }
 

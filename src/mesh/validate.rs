@@ -70,6 +70,45 @@ impl Report {
     }
 }
 
+/// Every half-edge a→b (a ≠ b) of the faces `offsets`/`indices` (`nv` vertices),
+/// bucketed by its lower vertex (a counting sort): bucket `lo` is
+/// `items[start[lo]..start[lo + 1]]`, each item `higher << 32 | corner` (the corner the
+/// half-edge leaves), sorted, so the uses of one edge are adjacent and edges come in
+/// increasing (lower, higher) order.
+pub(crate) fn half_edges_by_lower_vertex(
+    offsets: &[usize],
+    indices: &[u32],
+    nv: usize,
+) -> (Vec<usize>, Vec<u64>) {
+    let each = |f: &mut dyn FnMut(u32, u32, usize)| {
+        for w in offsets.windows(2) {
+            let face = &indices[w[0]..w[1]];
+            for (k, &a) in face.iter().enumerate() {
+                let b = face[(k + 1) % face.len()];
+                if a != b {
+                    f(a, b, w[0] + k);
+                }
+            }
+        }
+    };
+    let mut start = vec![0usize; nv + 1];
+    each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
+    for v in 0..nv {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut items = vec![0u64; start[nv]];
+    each(&mut |a, b, corner| {
+        let slot = &mut fill[a.min(b) as usize];
+        items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
+        *slot += 1;
+    });
+    for lo in 0..nv {
+        items[start[lo]..start[lo + 1]].sort_unstable();
+    }
+    (start, items)
+}
+
 /// Builds the [`Report`] of `mesh`.
 pub fn report(mesh: &Mesh) -> Report {
     let (offsets, indices) = mesh.face_parts();
@@ -77,9 +116,7 @@ pub fn report(mesh: &Mesh) -> Report {
     let nv = mesh.num_vertices();
     let mut r = Report { vertices: nv, faces: mesh.num_faces(), ..Report::default() };
 
-    // Pass 1: degrees, degenerate faces, vertex use and components; half-edges a→b
-    // (a ≠ b) bucketed by their lower vertex (a counting sort), as (higher << 32 | corner).
-    let mut start = vec![0usize; nv + 1];
+    // Pass 1: degrees, degenerate faces, vertex use and components.
     let mut used = vec![false; nv];
     let mut vertex_sets = UnionFind::new(nv);
     for w in offsets.windows(2) {
@@ -92,36 +129,16 @@ pub fn report(mesh: &Mesh) -> Report {
             let b = face[(k + 1) % face.len()];
             used[a as usize] = true;
             vertex_sets.union(a, b);
-            if a != b {
-                start[a.min(b) as usize + 1] += 1;
-            }
         }
     }
-    for v in 0..nv {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut buckets = vec![0u64; start[nv]];
-    for w in offsets.windows(2) {
-        let face = &indices[w[0]..w[1]];
-        for (k, &a) in face.iter().enumerate() {
-            let b = face[(k + 1) % face.len()];
-            if a != b {
-                let slot = &mut fill[a.min(b) as usize];
-                buckets[*slot] = u64::from(a.max(b)) << 32 | (w[0] + k) as u64;
-                *slot += 1;
-            }
-        }
-    }
-    drop(fill);
+    let (start, buckets) = half_edges_by_lower_vertex(offsets, indices, nv);
     // Edges: runs of equal higher vertex in each sorted bucket. Half-edge counts per
     // edge are [lo→hi, hi→lo]; `corner_edge` is the edge leaving each corner (u32::MAX
     // for a side that is not an edge).
     let mut counts: Vec<[u32; 2]> = Vec::with_capacity(buckets.len() / 2);
     let mut corner_edge = vec![u32::MAX; indices.len()];
     for lo in 0..nv {
-        let bucket = &mut buckets[start[lo]..start[lo + 1]];
-        bucket.sort_unstable();
+        let bucket = &buckets[start[lo]..start[lo + 1]];
         let mut prev_hi = u64::MAX;
         for &item in bucket.iter() {
             let (hi, c) = (item >> 32, (item & 0xffff_ffff) as usize);
