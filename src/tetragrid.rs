@@ -27,6 +27,7 @@
 use std::ops::Range;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The plane offset SPEC §4.4 asks for, in cell diagonals.
 pub const SPEC_OFFSET: f64 = 2.0;
@@ -287,12 +288,13 @@ pub struct TetraGrid {
 }
 
 impl TetraGrid {
-    /// Lists `count` tetras: `cover(t, out)` appends the indices of the cells tetra `t`
-    /// touches (no duplicates). A cover may list extra cells, never miss one.
+    /// Lists `count` tetras (or any items): `cover(t, out)` appends the indices of the
+    /// cells item `t` touches (no duplicates). A cover may list extra cells, never miss
+    /// one. Covers run in parallel; the lists are the same for any number of threads.
     pub fn build(
         cells: Cells,
         count: usize,
-        mut cover: impl FnMut(usize, &mut Vec<u32>),
+        cover: impl Fn(usize, &mut Vec<u32>) + Sync,
     ) -> Result<TetraGrid, TooLarge> {
         let check = |what: &'static str, bytes: u64| {
             crate::host::check_available(bytes).map_err(|(need_mib, have_mib)| TooLarge {
@@ -303,35 +305,46 @@ impl TetraGrid {
         };
         let num_cells = cells.num_cells();
         check("cell offsets", (num_cells as u64 + 1) * 4)?;
-        // Cells of every tetra, then a counting sort into per-cell lists.
-        let mut entries = Vec::new();
-        let mut offsets = Vec::with_capacity(count + 1);
-        offsets.push(0usize);
-        for t in 0..count {
-            cover(t, &mut entries);
-            offsets.push(entries.len());
-        }
-        if entries.len() >= u32::MAX as usize {
+        // Cells of every item (in parallel chunks, in order), then a counting sort into
+        // per-cell lists.
+        const CHUNK: usize = 4096;
+        let parts: Vec<(Vec<u32>, Vec<usize>)> = (0..count.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|k| {
+                let (mut entries, mut ends) = (Vec::new(), Vec::with_capacity(CHUNK));
+                for t in k * CHUNK..((k + 1) * CHUNK).min(count) {
+                    cover(t, &mut entries);
+                    ends.push(entries.len());
+                }
+                (entries, ends)
+            })
+            .collect();
+        let total: usize = parts.iter().map(|p| p.0.len()).sum();
+        if total >= u32::MAX as usize {
             return Err(TooLarge {
                 what: "lists (more than 2^32 entries)",
-                need_mib: (entries.len() as u64 * 4) >> 20,
+                need_mib: (total as u64 * 4) >> 20,
                 have_mib: 0,
             });
         }
-        check("lists", entries.len() as u64 * 4)?;
+        check("lists", total as u64 * 4)?;
         let mut start = vec![0u32; num_cells + 1];
-        for &c in &entries {
+        for &c in parts.iter().flat_map(|p| &p.0) {
             start[c as usize + 1] += 1;
         }
         for c in 0..num_cells {
             start[c + 1] += start[c];
         }
         let mut fill = start.clone();
-        let mut ids = vec![0u32; entries.len()];
-        for (t, w) in offsets.windows(2).enumerate() {
-            for &c in &entries[w[0]..w[1]] {
-                ids[fill[c as usize] as usize] = t as u32;
-                fill[c as usize] += 1;
+        let mut ids = vec![0u32; total];
+        for (k, (entries, ends)) in parts.iter().enumerate() {
+            let mut from = 0;
+            for (t, &end) in (k * CHUNK..).zip(ends) {
+                for &c in &entries[from..end] {
+                    ids[fill[c as usize] as usize] = t as u32;
+                    fill[c as usize] += 1;
+                }
+                from = end;
             }
         }
         Ok(TetraGrid { cells, start, ids })

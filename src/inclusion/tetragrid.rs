@@ -92,7 +92,7 @@ impl GridClassifier {
     pub fn with_cover(
         ft: FeitoTorres,
         n: usize,
-        cover: impl Fn(&Cells, &TetraPlanes, f64, &mut Vec<u32>),
+        cover: impl Fn(&Cells, &TetraPlanes, f64, &mut Vec<u32>) + Sync,
     ) -> Result<GridClassifier> {
         if !RESOLUTIONS.contains(&n) {
             return Err(InclusionError::Resolution(n));

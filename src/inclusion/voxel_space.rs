@@ -45,18 +45,18 @@ use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::{InclusionError, Result};
 use super::surface::Surface;
 use crate::mesh::Mesh;
-use crate::tetragrid::Cells;
+use crate::tetragrid::{Cells, TetraGrid};
 use crate::voxel::exact::{crossing_ahead, inside_yz, orient2d};
 
 /// Resolutions the method accepts (n³ cells).
 pub const RESOLUTIONS: std::ops::RangeInclusive<usize> = 2..=512;
 
-const OUTSIDE: u32 = 0;
-const INSIDE: u32 = 1;
-/// A cell not labelled yet (while building).
-const UNLABELLED: u32 = u32::MAX;
-/// `state` values from here on are surface cells: `state − FIRST_SURFACE` indexes their lists.
-const FIRST_SURFACE: u32 = 2;
+/// Cell labels: outside, inside, surface (a list to test), and not labelled yet (while
+/// building).
+const OUTSIDE: u8 = 0;
+const INSIDE: u8 = 1;
+const SURFACE: u8 = 2;
+const UNLABELLED: u8 = 3;
 
 /// The grid size for `triangles` covering triangles and about `points` query points: the
 /// cost model of [`super::auto`] (see there for the measurements behind it).
@@ -68,22 +68,18 @@ pub fn resolution_for(triangles: usize, points: usize) -> usize {
 #[derive(Clone, Debug)]
 pub struct VoxelSpace {
     surface: Surface,
-    cells: Cells,
-    /// Per cell: [`OUTSIDE`], [`INSIDE`], or [`FIRST_SURFACE`] + the index of its list.
-    state: Vec<u32>,
-    /// Per cell, one byte: 0 outside, 1 inside, 2 surface — what most points read (a
-    /// quarter of `state`'s memory, so it stays in cache).
+    /// Per cell, the covering triangles that may come within ε of it (increasing ids;
+    /// empty for a labelled cell).
+    lists: TetraGrid,
+    /// Per cell: [`OUTSIDE`], [`INSIDE`] or [`SURFACE`] — what most points read, one byte
+    /// a cell so it stays in cache.
     labels: Vec<u8>,
     /// Box of every covering triangle: x, y, z ranges (`[xlo, xhi, ylo, yhi, zlo, zhi]`),
     /// rounded outwards to f32 (half the memory; only ever a filter before exact tests).
     boxes: Vec<[f32; 6]>,
     /// Per column i: the abscissa of its centre, when it rounds into the column.
     column_x: Vec<Option<f64>>,
-    /// Lists of the surface cells (CSR, covering triangle ids in increasing order).
-    start: Vec<u32>,
-    ids: Vec<u32>,
     stats: BuildStats,
-    surface_cells: usize,
 }
 
 impl VoxelSpace {
@@ -114,74 +110,35 @@ impl VoxelSpace {
         let eps = surface.eps();
         let cells = Cells::around(lo, hi, 4.0 * eps, n);
         let covering = surface.covering();
-        // 1. Surface cells: per chunk of triangles (in parallel, in order), every listing
-        // as (cell << 32 | triangle); then bucketed by cell (a counting sort, which keeps
-        // each list in increasing triangle order).
+        // 1. Surface cells: every cell a covering triangle may come within ε of lists it.
         let h = cells.cell;
         let slack = 1e-9 * h + 8.0 * f64::EPSILON * (cells.lo.abs().max_element() + h * n as f64);
         let grow = eps + slack;
-        let chunks: Vec<Vec<u64>> = (0..covering.triangles.len())
-            .into_par_iter()
-            .with_min_len(4096)
-            .chunks(4096)
-            .map(|ts| {
-                let mut out = Vec::with_capacity(ts.len() * 2);
-                for t in ts {
-                    let [a, b, c] = covering.triangle(t);
-                    let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
-                    let normal = (b - a).cross(c - a).normalize_or_zero();
-                    let reach = 0.5 * h * normal.abs().element_sum() + grow;
-                    let base = cells.lo - a;
-                    let [rx, ry, rz] = cells.ranges(tlo, thi);
-                    for k in rz {
-                        for j in ry.clone() {
-                            for i in rx.clone() {
-                                let centre =
-                                    base + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
-                                if normal != DVec3::ZERO && normal.dot(centre).abs() > reach {
-                                    continue;
-                                }
-                                out.push((cells.index([i, j, k]) as u64) << 32 | t as u64);
-                            }
+        let lists = TetraGrid::build(cells, covering.triangles.len(), |t, out| {
+            let [a, b, c] = covering.triangle(t);
+            let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            let reach = 0.5 * h * normal.abs().element_sum() + grow;
+            let base = cells.lo - a;
+            let [rx, ry, rz] = cells.ranges(tlo, thi);
+            for k in rz {
+                for j in ry.clone() {
+                    for i in rx.clone() {
+                        let centre = base + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * h;
+                        if normal != DVec3::ZERO && normal.dot(centre).abs() > reach {
+                            continue;
                         }
+                        out.push(cells.index([i, j, k]) as u32);
                     }
                 }
-                out
-            })
-            .collect();
-        // `state` counts first, then names each cell's list.
-        let mut state = vec![0u32; num_cells];
-        for &e in chunks.iter().flatten() {
-            state[(e >> 32) as usize] += 1;
-        }
-        let mut start = Vec::new();
-        let mut total = 0u32;
-        for s in state.iter_mut() {
-            if *s == 0 {
-                *s = UNLABELLED;
-            } else {
-                let count = *s;
-                *s = FIRST_SURFACE + start.len() as u32;
-                start.push(total);
-                total += count;
             }
-        }
-        let lists = start.len();
-        start.push(total);
-        // One shared empty list for the cells whose centre rounds out of the cell.
-        let empty_list = FIRST_SURFACE + lists as u32;
-        start.push(total);
-        let mut ids = vec![0u32; total as usize];
-        let mut next = start[..lists].to_vec();
-        for &e in chunks.iter().flatten() {
-            let k = (state[(e >> 32) as usize] - FIRST_SURFACE) as usize;
-            ids[next[k] as usize] = e as u32;
-            next[k] += 1;
-        }
-        drop(chunks);
-        drop(next);
-        let labels =
-            state.par_iter().with_min_len(1 << 16).map(|&s| if s == UNLABELLED { 3 } else { 2 }).collect();
+        })
+        .map_err(|e| InclusionError::TooLarge(format!("voxel space: {e}")))?;
+        let labels = (0..num_cells)
+            .into_par_iter()
+            .with_min_len(1 << 16)
+            .map(|c| if lists.cell(c).is_empty() { UNLABELLED } else { SURFACE })
+            .collect();
         let boxes = (0..covering.triangles.len())
             .into_par_iter()
             .with_min_len(4096)
@@ -197,100 +154,78 @@ impl VoxelSpace {
                 (cells.coords_axis(x, 0) == Some(i)).then_some(x)
             })
             .collect();
-        let mut vs = VoxelSpace {
-            surface,
-            cells,
-            state,
-            labels,
-            boxes,
-            column_x,
-            start,
-            ids,
-            stats: BuildStats::default(),
-            surface_cells: 0,
-        };
+        let mut vs =
+            VoxelSpace { surface, lists, labels: Vec::new(), boxes, column_x, stats: BuildStats::default() };
         // 2. Labels: every other cell gets its centre's class, row by row from the far end
         // (outside beyond the grid), each centre by the parity walk of a query point to the
         // labelled cell on its right. A cell whose centre rounds out of the cell becomes a
-        // surface cell with the empty list (its points walk to a labelled cell).
-        let mut state = std::mem::take(&mut vs.state);
-        let mut labels = std::mem::take(&mut vs.labels);
+        // surface cell with an empty list (its points walk to a labelled cell).
+        let mut labels: Vec<u8> = labels;
         let centre = |axis: usize, j: usize| {
             let y = cells.lo[axis] + (j as f64 + 0.5) * cells.cell;
             (cells.coords_axis(y, axis) == Some(j)).then_some(y)
         };
-        labels.par_chunks_mut(n).zip(state.par_chunks_mut(n)).enumerate().for_each(|(row, (lab, st))| {
+        labels.par_chunks_mut(n).enumerate().for_each(|(row, lab)| {
             let (j, k) = (row % n, row / n);
             let yz = centre(1, j).zip(centre(2, k));
             let mut scratch = Vec::new();
             for i in (0..n).rev() {
-                if lab[i] == 2 {
+                if lab[i] == SURFACE {
                     continue;
                 }
-                match (yz, vs.column_x[i]) {
+                lab[i] = match (yz, vs.column_x[i]) {
                     (Some((y, z)), Some(x)) => {
-                        let inside = vs.parity_in_row(lab, st, DVec3::new(x, y, z), i, &mut scratch);
-                        lab[i] = inside as u8;
-                        st[i] = if inside { INSIDE } else { OUTSIDE };
+                        if vs.parity_in_row(lab, row * n, DVec3::new(x, y, z), i, &mut scratch) {
+                            INSIDE
+                        } else {
+                            OUTSIDE
+                        }
                     }
-                    _ => {
-                        lab[i] = 2;
-                        st[i] = empty_list;
-                    }
-                }
+                    _ => SURFACE,
+                };
             }
         });
-        vs.surface_cells = labels.par_iter().with_min_len(1 << 16).filter(|&&l| l == 2).count();
-        vs.state = state;
         vs.labels = labels;
         vs.stats = BuildStats {
             build_time: start_time.elapsed(),
             bytes: vs.surface.bytes()
-                + vec_bytes(&vs.state)
+                + vs.lists.memory_bytes()
                 + vec_bytes(&vs.labels)
-                + vec_bytes(&vs.boxes)
-                + vec_bytes(&vs.start)
-                + vec_bytes(&vs.ids),
+                + vec_bytes(&vs.boxes),
         };
         Ok(vs)
     }
 
     pub fn resolution(&self) -> usize {
-        self.cells.n
+        self.lists.cells().n
     }
 
-    /// Cells that are surface cells (hold a list) out of n³.
+    /// Cells that are surface cells (hold a list, perhaps empty) out of n³.
     pub fn surface_cells(&self) -> usize {
-        self.surface_cells
+        self.labels.par_iter().with_min_len(1 << 16).filter(|&&l| l == SURFACE).count()
     }
 
     /// Total entries of the lists.
     pub fn entries(&self) -> usize {
-        self.ids.len()
+        self.lists.lists().1.len()
     }
 
     pub fn surface(&self) -> &Surface {
         &self.surface
     }
 
-    #[inline]
-    fn list(&self, s: u32) -> &[u32] {
-        let k = (s - FIRST_SURFACE) as usize;
-        &self.ids[self.start[k] as usize..self.start[k + 1] as usize]
-    }
-
     /// The label of cell `c` if it has one, `None` for a surface cell.
     pub fn label(&self, c: usize) -> Option<Class> {
-        match self.state[c] {
+        match self.labels[c] {
             OUTSIDE => Some(Class::Outside),
             INSIDE => Some(Class::Inside),
             _ => None,
         }
     }
 
-    /// The exact test for a point in surface cell `[i, j, k]` (see the module docs).
-    fn classify_near(&self, p: DVec3, [i, j, k]: [usize; 3], s: u32, scratch: &mut Vec<u32>) -> Class {
-        let list = self.list(s);
+    /// The exact test for a point in surface cell `c` (see the module docs).
+    fn classify_near(&self, p: DVec3, c: usize, scratch: &mut Vec<u32>) -> Class {
+        let list = self.lists.cell(c);
         let eps = self.surface.eps();
         let covering = self.surface.covering();
         let near = |b: &[f32; 6]| {
@@ -312,46 +247,38 @@ impl VoxelSpace {
         // that plane (same class, P being > ε from every face), from the moved point's cell.
         let moved = self.surface.off_polygon_planes(p, list.iter().map(|&t| t as usize));
         if moved != p {
-            let n = self.cells.n;
             return match self.lookup(moved) {
-                (_, 0) => Class::Outside,
-                (_, 1) => Class::Inside,
-                (c, _) => self.parity(moved, [c % n, c / n % n, c / (n * n)], scratch),
+                (_, OUTSIDE) => Class::Outside,
+                (_, INSIDE) => Class::Inside,
+                (c, _) => self.parity(moved, c, scratch),
             };
         }
-        self.parity(p, [i, j, k], scratch)
+        self.parity(p, c, scratch)
     }
 
-    /// The class of a point `p` in surface cell `[i, j, k]`, off the boundary: the parity
-    /// walk of the module docs.
-    fn parity(&self, p: DVec3, [i, j, k]: [usize; 3], scratch: &mut Vec<u32>) -> Class {
-        let n = self.cells.n;
-        let row = self.cells.index([0, j, k])..self.cells.index([0, j, k]) + n;
-        let inside = self.parity_in_row(&self.labels[row.clone()], &self.state[row], p, i, scratch);
+    /// The class of a point `p` in surface cell `c`, off the boundary: the parity walk of
+    /// the module docs.
+    fn parity(&self, p: DVec3, c: usize, scratch: &mut Vec<u32>) -> Class {
+        let n = self.lists.cells().n;
+        let row = c - c % n;
+        let inside = self.parity_in_row(&self.labels[row..row + n], row, p, c % n, scratch);
         if inside { Class::Inside } else { Class::Outside }
     }
 
-    /// Whether `p`, off the boundary in cell `i` of the row whose labels and states are
-    /// `labels` and `state`, is inside: the first labelled cell along +x whose centre
+    /// Whether `p`, off the boundary in cell `i` of the row whose first cell is `row` and
+    /// whose labels are `labels`, is inside: the first labelled cell along +x whose centre
     /// abscissa lies in it gives R, and the crossings between P and R flip R's class.
     /// Only that cell and the surface cells before it are read (so the labelling can use
     /// it while it fills the row from the far end). `scratch` is reused between calls.
-    fn parity_in_row(
-        &self,
-        labels: &[u8],
-        state: &[u32],
-        p: DVec3,
-        i: usize,
-        scratch: &mut Vec<u32>,
-    ) -> bool {
+    fn parity_in_row(&self, labels: &[u8], row: usize, p: DVec3, i: usize, scratch: &mut Vec<u32>) -> bool {
         let covering = self.surface.covering();
-        let n = self.cells.n;
+        let n = labels.len();
         let mut end = i + 1;
         let mut reference: Option<(f64, bool)> = None;
         while end < n {
-            if labels[end] < 2 {
+            if labels[end] <= INSIDE {
                 if let Some(x) = self.column_x[end] {
-                    reference = Some((x, labels[end] == 1));
+                    reference = Some((x, labels[end] == INSIDE));
                     break;
                 }
             }
@@ -364,11 +291,8 @@ impl VoxelSpace {
         // listed in several cells of the row (sorted and deduplicated here rather than
         // trusting its cells to be consecutive, which rounding need not keep).
         scratch.clear();
-        for m in i..end {
-            if labels[m] != 2 {
-                continue;
-            }
-            for &t in self.list(state[m]) {
+        for (m, _) in labels.iter().enumerate().take(end).skip(i).filter(|&(_, &l)| l == SURFACE) {
+            for &t in self.lists.cell(row + m) {
                 // Exact comparisons first: a triangle whose yz box misses P's line, whose x
                 // range ends before P or starts beyond R, cannot flip the parity.
                 let b = &self.boxes[t as usize];
@@ -429,19 +353,14 @@ impl VoxelSpace {
         if !self.surface.in_bounds(p) {
             return (0, 0);
         }
-        let t = (p - self.cells.lo) / self.cells.cell;
-        let n = self.cells.n as f64;
+        let cells = self.lists.cells();
+        let t = (p - cells.lo) / cells.cell;
+        let n = cells.n as f64;
         if !(t.cmpge(DVec3::ZERO).all() && t.cmplt(DVec3::splat(n)).all()) {
             return (0, 0);
         }
-        let c = self.cells.index([t.x as usize, t.y as usize, t.z as usize]);
+        let c = cells.index([t.x as usize, t.y as usize, t.z as usize]);
         (c, self.labels[c])
-    }
-
-    #[inline]
-    fn near(&self, p: DVec3, c: usize, scratch: &mut Vec<u32>) -> Class {
-        let n = self.cells.n;
-        self.classify_near(p, [c % n, c / n % n, c / (n * n)], self.state[c], scratch)
     }
 }
 
@@ -453,9 +372,9 @@ impl Classifier for VoxelSpace {
     #[inline]
     fn classify(&self, p: DVec3) -> Class {
         match self.lookup(p) {
-            (_, 0) => Class::Outside,
-            (_, 1) => Class::Inside,
-            (c, _) => self.near(p, c, &mut Vec::new()),
+            (_, OUTSIDE) => Class::Outside,
+            (_, INSIDE) => Class::Inside,
+            (c, _) => self.classify_near(p, c, &mut Vec::new()),
         }
     }
 
@@ -472,9 +391,9 @@ impl Classifier for VoxelSpace {
             }
             for ((o, &p), &(c, label)) in out.iter_mut().zip(ps).zip(cells.iter()) {
                 *o = match label {
-                    0 => Class::Outside,
-                    1 => Class::Inside,
-                    _ => self.near(p, c, &mut scratch),
+                    OUTSIDE => Class::Outside,
+                    INSIDE => Class::Inside,
+                    _ => self.classify_near(p, c, &mut scratch),
                 };
             }
         });
