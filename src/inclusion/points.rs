@@ -33,25 +33,14 @@ pub fn read(path: impl AsRef<Path>) -> Result<Vec<DVec3>, MeshError> {
 
 /// Parses point-file text; `path` only names the source in errors.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
-    let points = parse_part(bytes, path, 0, 0)?;
+    let points = match parse_fast(bytes) {
+        Some(points) => points,
+        None => parse_lines(bytes, path, 0, 0)?,
+    };
     if points.is_empty() {
         return Err(MeshError::parse(path, Location::File, "no points in the file"));
     }
     Ok(points)
-}
-
-/// Parses whole lines of point-file text that start after `lines_before` lines and
-/// `bytes_before` bytes of the file (which only place errors); may be empty.
-fn parse_part(
-    bytes: &[u8],
-    path: &Path,
-    lines_before: usize,
-    bytes_before: usize,
-) -> Result<Vec<DVec3>, MeshError> {
-    match parse_fast(bytes) {
-        Some(points) => Ok(points),
-        None => parse_lines(bytes, path, lines_before, bytes_before),
-    }
 }
 
 /// Bytes of text read per block by [`PointReader`].
@@ -115,10 +104,16 @@ impl PointReader {
         Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1) })
     }
 
+    /// Points already in memory (random ones), handed out as one block; `name` names them.
+    pub fn from_points(points: Vec<DVec3>, name: &str) -> PointReader {
+        PointReader { path: name.into(), source: Source::Whole(Some(points)), read: 0, block: BLOCK }
+    }
+
     /// About how many points the file holds: exact for `.npy` and for a text file read
     /// whole, else from the bytes per point so far (at least what was read).
     pub fn estimated_total(&self) -> usize {
         match &self.source {
+            Source::Whole(Some(points)) => self.read + points.len(),
             Source::Text { len: Some(len), bytes_before, .. }
                 if *bytes_before > 0 && (*bytes_before as u64) < *len =>
             {
@@ -157,26 +152,19 @@ impl PointReader {
                 // A whole line at least (or the end of the file) before parsing.
                 let last_end = buf[..*filled].iter().rposition(|&b| b == b'\n');
                 if !*eof && last_end.is_none() {
-                    let size =
-                        block_size.max(2 * *filled).min(*filled + remaining(*len, *bytes_before + *filled));
-                    *filled = fill(file, buf, *filled, size, eof).map_err(io)?;
+                    *filled = fill(file, buf, *filled, block_size, *len, *bytes_before, eof).map_err(io)?;
                     continue;
                 }
                 let cut = if *eof { *filled } else { last_end.map_or(*filled, |at| at + 1) };
                 // Parse this block while the next one is read (after this one's unfinished line).
                 let (text, rest) = buf[..*filled].split_at(cut);
-                let next_start = *bytes_before + *filled;
+                let next_at = *bytes_before + cut;
                 let (parsed, next) = rayon::join(
                     || parse_fast_with(text, &f),
                     || -> std::io::Result<usize> {
                         spare.clear();
                         spare.extend_from_slice(rest);
-                        if *eof {
-                            return Ok(rest.len());
-                        }
-                        let size =
-                            block_size.max(2 * rest.len()).min(rest.len() + remaining(*len, next_start));
-                        fill(file, spare, rest.len(), size, eof)
+                        fill(file, spare, rest.len(), block_size, *len, next_at, eof)
                     },
                 );
                 let next = next.map_err(io)?;
@@ -211,23 +199,25 @@ impl PointReader {
     }
 }
 
-/// Bytes left in a file of `len` bytes after `at`, plus one (so that a read sees its end);
-/// unbounded for a pipe.
-fn remaining(len: Option<u64>, at: usize) -> usize {
-    len.map_or(usize::MAX / 4, |len| (len as usize).saturating_sub(at) + 1)
-}
-
-/// Reads from `file` into `buf[start..]`, `buf` resized to `size`, until it is full or the
-/// file ends (`eof` then set); the bytes now held.
+/// Reads from `file` into `buf[held..]` until the buffer — `block` bytes, or twice what it
+/// holds — is full or the file ends (`eof` then set); the bytes now held. `buf[0]` is at
+/// offset `at` of a file of `len` bytes (`None`: a pipe), so the buffer is never made
+/// larger than what is left of it (plus one byte, for the read that sees its end).
 fn fill(
     file: &mut std::fs::File,
     buf: &mut Vec<u8>,
-    start: usize,
-    size: usize,
+    held: usize,
+    block: usize,
+    len: Option<u64>,
+    at: usize,
     eof: &mut bool,
 ) -> std::io::Result<usize> {
-    buf.resize(size.max(start), 0);
-    let mut filled = start;
+    if *eof {
+        return Ok(held);
+    }
+    let left = len.map_or(usize::MAX / 4, |len| (len as usize).saturating_sub(at + held) + 1);
+    buf.resize(block.max(2 * held).min(held + left), 0);
+    let mut filled = held;
     while !*eof && filled < buf.len() {
         match std::io::Read::read(file, &mut buf[filled..]) {
             Ok(0) => *eof = true,

@@ -116,6 +116,11 @@ impl Surface {
         self.face_planes.get(f).copied().flatten()
     }
 
+    /// The axis face `f` (a polygon with area) is projected along for its winding test.
+    fn face_axis(&self, f: usize) -> Option<usize> {
+        self.face_axes.get(f).copied().flatten()
+    }
+
     /// Signed distance from `p` to the plane of face `f` (0 when it has none, see [`Self::face_plane`]).
     pub fn face_distance(&self, f: usize, p: DVec3) -> f64 {
         self.face_plane(f).map_or(0.0, |(n, c)| n.dot(p - c))
@@ -162,13 +167,7 @@ impl Surface {
             let (s, e) = (pts[v as usize], pts[poly[(i + 1) % poly.len()] as usize]);
             exact::segment_within(p, s, e, eps)
         });
-        on_edge
-            || self
-                .face_axes
-                .get(f)
-                .copied()
-                .flatten()
-                .is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
+        on_edge || self.face_axis(f).is_some_and(|axis| polygon_winds_around(poly, pts, axis, p))
     }
 
     /// `p`, or `p` moved ε/2 away from the plane of the first covering triangle of an n-gon

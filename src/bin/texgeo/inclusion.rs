@@ -4,7 +4,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use glam::DVec3;
 use texgeo::inclusion::gpu::GpuStats;
 use texgeo::inclusion::solver::{Solver, resolve};
 use texgeo::inclusion::{Class, Method, Options, points};
@@ -76,10 +75,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     let mut source = match (&args.points, args.random) {
-        (Some(file), _) => Points::File(points::PointReader::open(file)?),
+        (Some(file), _) => points::PointReader::open(file)?,
         (_, Some(n)) => {
             let (lo, hi) = mesh.bounds();
-            Points::Random(Some(Rng::new(args.seed).points_in_box(n, lo, hi)))
+            points::PointReader::from_points(Rng::new(args.seed).points_in_box(n, lo, hi), "--random")
         }
         (None, None) => anyhow::bail!("give --points FILE or --random N"),
     };
@@ -129,18 +128,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         let t = Instant::now();
         let parts: Vec<Vec<Class>> = match block.take() {
             Some(parts) => parts.iter().map(|pts| solver.classify_all(pts)).collect::<Result<_, _>>()?,
-            None => match (&solver, &mut source) {
-                (Solver::Cpu(c), Points::File(reader)) => {
-                    match reader.next_block_with(|pts| c.classify_all(&pts))? {
-                        Some(parts) => parts,
-                        None => break,
-                    }
-                }
-                _ => match source.next_block()? {
-                    Some(pts) => vec![solver.classify_all(&pts)?],
+            None => {
+                let parts = if let Solver::Cpu(c) = &solver {
+                    source.next_block_with(|pts| c.classify_all(&pts))?
+                } else {
+                    source.next_block()?.map(|pts| solver.classify_all(&pts).map(|c| vec![c])).transpose()?
+                };
+                match parts {
+                    Some(parts) => parts,
                     None => break,
-                },
-            },
+                }
+            }
         };
         run += t.elapsed();
         if let Some(g) = solver.gpu_stats() {
@@ -195,29 +193,6 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// Where the query points come from: a file read a block at a time, or random points.
-enum Points {
-    File(points::PointReader),
-    Random(Option<Vec<DVec3>>),
-}
-
-impl Points {
-    fn next_block(&mut self) -> anyhow::Result<Option<Vec<DVec3>>> {
-        Ok(match self {
-            Points::File(r) => r.next_block()?,
-            Points::Random(p) => p.take(),
-        })
-    }
-
-    /// About how many points there are in all (after the first block).
-    fn estimated_total(&self) -> usize {
-        match self {
-            Points::File(r) => r.estimated_total(),
-            Points::Random(p) => p.as_ref().map_or(0, Vec::len),
-        }
-    }
 }
 
 /// Refuses, before any work, a point count whose memory exceeds what is available; the

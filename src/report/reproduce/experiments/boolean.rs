@@ -165,21 +165,10 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             let grouped_cpu = sum(&[&p1, &p2, &asm[k]]);
             // The plain run's phase 1 is a single run: its median is itself.
             let plain = sum(&[&p1, &p2_plain, &asm_plain[k]]);
-            r.facts.add(
-                EXP,
-                &name,
-                &format!("time:grouped:{}", op.name()),
-                "s",
-                Stat::median_of(&grouped_gpu),
-            );
-            r.facts.add(
-                EXP,
-                &name,
-                &format!("time:grouped-cpu:{}", op.name()),
-                "s",
-                Stat::median_of(&grouped_cpu),
-            );
-            r.facts.add(EXP, &name, &format!("time:plain:{}", op.name()), "s", Stat::median_of(&plain));
+            for (kind, times) in [("grouped", &grouped_gpu), ("grouped-cpu", &grouped_cpu), ("plain", &plain)]
+            {
+                r.facts.add(EXP, &name, &format!("time:{kind}:{}", op.name()), "s", Stat::median_of(times));
+            }
             let cgal_cell = match &reference {
                 None => "–".to_string(),
                 Some(reference) => match reference.measures(op) {
