@@ -4,6 +4,8 @@
 //! edges and vertices (the tie rule) or a hair off them (the GPU fallback bound). Runs on
 //! the default device (lavapipe in tools/test) with validation when TEXGEO_VALIDATION=1.
 
+mod common;
+
 use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::inclusion::{Class, Classifier, FeitoTorres};
@@ -116,10 +118,36 @@ fn exact_volume(mesh: &Mesh, n: usize) -> (Grid, Solid, Volume) {
     (grid, solid, v)
 }
 
-/// Runs every method and checks each against `expected`.
+/// The volume [`scanline::x_planes`] streams, gathered plane by plane.
+fn streamed(solid: &Solid, grid: &Grid) -> Result<Volume, std::io::Error> {
+    let mut v = Volume::new(grid.n).unwrap();
+    let mut x0 = 0;
+    let occupied = scanline::x_planes(solid, grid, |planes| {
+        for p in 0..planes.len() {
+            for k in 0..grid.n {
+                for (w, &bits) in planes.row(p, k).iter().enumerate() {
+                    for b in (0..64).filter(|b| bits >> b & 1 == 1) {
+                        v.set(x0 + p, 64 * w + b, k, true);
+                    }
+                }
+            }
+        }
+        x0 += planes.len();
+        Ok(())
+    })?;
+    assert_eq!(x0, grid.n, "every plane once");
+    assert_eq!(occupied, v.count(), "the count of occupied voxels");
+    Ok(v)
+}
+
+/// Runs every method, and the scanline streamed in x planes, and checks each against
+/// `expected`.
 fn all_methods_equal(v: &mut Voxelizer, name: &str, mesh: &Mesh, n: usize, expected: &Volume) {
     let grid = Grid::for_mesh(mesh, n).unwrap();
     let solid = Solid::new(mesh).unwrap();
+    let planes = streamed(&solid, &grid).unwrap_or_else(|e| panic!("{name} {n}³ x planes: {e}"));
+    let diff = planes.differences(expected, 5).unwrap();
+    assert!(diff.is_empty(), "{name} {n}³ x planes: voxels differ, e.g. {diff:?}");
     for m in Method::ALL {
         let r = v.run(&solid, &grid, m).unwrap_or_else(|e| panic!("{name} {n}³ {m}: {e}"));
         let diff = r.volume.differences(expected, 5).unwrap();
@@ -159,27 +187,34 @@ fn every_method_matches_the_exact_test_on_builtin_solids() {
 
 #[test]
 fn parallel_rasterizers_and_encoder_give_the_same_bits_for_any_thread_count() {
-    let in_pool = |threads: usize, work: &(dyn Fn() -> (Volume, Volume, Vec<u8>) + Sync)| {
+    let dir = common::TempDir::new("voxel-threads");
+    let in_pool = |threads: usize, work: &(dyn Fn() -> (Volume, Volume, Vec<u8>, Vec<u8>) + Sync)| {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(work)
     };
     for (name, mesh) in [("knot", procedural::torus_knot()), ("cavity", procedural::cube_with_cavity())] {
-        // Sizes below, at and above one slab per slice, and rows of 1, 2 and 3 words.
-        for n in [1, 7, 64, 130, 150] {
+        // Sizes below, at and above one slab per slice, and rows of 1, 2 and 3 words;
+        // one, several and a partial last batch of x planes.
+        for n in [1, 7, 16, 64, 130, 150] {
             let grid = Grid::for_mesh(&mesh, n).unwrap();
             let solid = Solid::new(&mesh).unwrap();
+            let file = dir.join(&format!("{name}-{n}.binvox"));
             let run = || {
                 let s = scanline::voxelize(&solid, &grid).unwrap();
                 let c = cpu::voxelize(&solid, &grid).unwrap().0;
                 let bytes = binvox::to_bytes(&grid, &s).unwrap();
-                (s, c, bytes)
+                let streamed = binvox::write_scanline(&file, &grid, &solid).unwrap();
+                assert!(!streamed.whole_volume && streamed.occupied == s.count(), "{name} {n}³ {streamed:?}");
+                (s, c, bytes, std::fs::read(&file).unwrap())
             };
             let one = in_pool(1, &run);
             assert_eq!(one.0, one.1, "{name} {n}³: cpu and scanline differ");
+            assert!(one.3 == one.2, "{name} {n}³: the streamed file differs from the whole volume's");
             for threads in [2, 3, 5] {
                 let many = in_pool(threads, &run);
                 assert_eq!(many.0, one.0, "{name} {n}³ scanline, {threads} threads");
                 assert_eq!(many.1, one.1, "{name} {n}³ cpu, {threads} threads");
                 assert!(many.2 == one.2, "{name} {n}³ binvox bytes, {threads} threads");
+                assert!(many.3 == one.3, "{name} {n}³ streamed binvox bytes, {threads} threads");
             }
         }
     }
@@ -351,4 +386,25 @@ fn bad_requests_get_clear_errors() {
     // A flat mesh has no volume to voxelize but is still handled.
     let gpu_needed = voxelize(None, &cube, 16, Method::Pgpu).unwrap_err();
     assert!(gpu_needed.to_string().contains("Vulkan"), "{gpu_needed}");
+}
+
+#[test]
+fn an_odd_row_falls_back_to_the_whole_volume() {
+    // A covering with a hole (built directly: `Solid::new` refuses open meshes) leaves
+    // rows that meet it once. The x planes notice at the end, and the file written
+    // instead is the whole volume's, never a half-checked one.
+    let cube = procedural::cube();
+    let grid = Grid::for_mesh(&cube, 24).unwrap();
+    let mut solid = Solid::new(&cube).unwrap();
+    solid.triangles.remove(0);
+    let err = streamed(&solid, &grid).unwrap_err();
+    assert!(err.get_ref().is_some_and(|e| e.is::<scanline::OddRow>()), "{err}");
+    let dir = common::TempDir::new("voxel-odd-row");
+    let file = dir.join("open.binvox");
+    let written = binvox::write_scanline(&file, &grid, &solid).unwrap();
+    assert!(written.whole_volume);
+    let whole = scanline::voxelize(&solid, &grid).unwrap();
+    assert_eq!(written.occupied, whole.count());
+    assert!(std::fs::read(&file).unwrap() == binvox::to_bytes(&grid, &whole).unwrap());
+    assert_eq!(dir.entries(), ["open.binvox"], "no temporary file left");
 }

@@ -12,6 +12,8 @@ use glam::DVec3;
 
 use super::error::{Result, VoxelError};
 use super::grid::{Grid, MAX_RES};
+use super::scanline;
+use super::solid::Solid;
 use super::volume::Volume;
 
 /// Encodes `volume` on `grid` as a binvox file.
@@ -49,13 +51,8 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
             grid.n
         ))));
     }
-    let m = grid.min;
-    write!(
-        out,
-        "#binvox 1\ndim {n} {n} {n}\ntranslate {} {} {}\nscale {}\ndata\n",
-        m.x, m.y, m.z, grid.side
-    )?;
-    let mut runs = Runs { out, buf: Vec::with_capacity(1 << 16), value: 0, count: 0 };
+    header(out, grid)?;
+    let mut runs = Runs::new(out);
     let wpr = volume.words_per_row();
     // Words of a row read together: a cache line's worth (8) reads the volume once, but a
     // group holds the columns of all its x values (8·64·N² bits, 64 MiB at 1024³), so with
@@ -81,6 +78,67 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
         }
     }
     runs.finish()
+}
+
+fn header(out: &mut impl Write, grid: &Grid) -> std::io::Result<()> {
+    let (n, m) = (grid.n, grid.min);
+    write!(out, "#binvox 1\ndim {n} {n} {n}\ntranslate {} {} {}\nscale {}\ndata\n", m.x, m.y, m.z, grid.side)
+}
+
+/// How [`write_scanline`] produced its file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Streamed {
+    /// Occupied voxels.
+    pub occupied: u64,
+    /// The planes could not be finished (a row met the surface an odd number of times),
+    /// so the whole volume was computed by [`scanline::voxelize`] and written instead.
+    pub whole_volume: bool,
+}
+
+/// The scanline volume of `solid` on `grid`, written as a binvox file (atomically)
+/// while it is computed, x plane by x plane ([`scanline::x_planes`]), so memory holds a
+/// few planes instead of the N³ bits. The bytes are those [`write`] gives for
+/// [`scanline::voxelize`]'s volume.
+pub fn write_scanline(path: impl AsRef<Path>, grid: &Grid, solid: &Solid) -> Result<Streamed> {
+    use rayon::prelude::*;
+    let path = path.as_ref();
+    let mut occupied = 0;
+    let streamed = crate::output::write_with(path, |out| {
+        header(out, grid)?;
+        let mut runs = Runs::new(out);
+        occupied = scanline::x_planes(solid, grid, |planes| {
+            let n = planes.n();
+            // Planes are encoded in parallel, their runs joined in order.
+            let lists: Vec<RunList> = (0..planes.len())
+                .into_par_iter()
+                .map(|p| {
+                    let mut list = RunList::default();
+                    for k in 0..n {
+                        for (w, &bits) in planes.row(p, k).iter().enumerate() {
+                            list.bits(bits, (n - 64 * w).min(64));
+                        }
+                    }
+                    list
+                })
+                .collect();
+            for list in lists {
+                for (value, count) in list.runs {
+                    runs.add(value, count as usize)?;
+                }
+            }
+            Ok(())
+        })?;
+        runs.finish()
+    });
+    match streamed {
+        Ok(()) => Ok(Streamed { occupied, whole_volume: false }),
+        Err(e) if e.error.get_ref().is_some_and(|inner| inner.is::<scanline::OddRow>()) => {
+            let volume = scanline::voxelize(solid, grid)?;
+            write(path, grid, &volume)?;
+            Ok(Streamed { occupied: volume.count(), whole_volume: true })
+        }
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// The runs of the voxels with x in 64·w0 .. 64·(w0 + gw), in binvox order.
@@ -181,7 +239,11 @@ struct Runs<'a, W: Write> {
     count: usize,
 }
 
-impl<W: Write> Runs<'_, W> {
+impl<'a, W: Write> Runs<'a, W> {
+    fn new(out: &'a mut W) -> Self {
+        Runs { out, buf: Vec::with_capacity(1 << 16), value: 0, count: 0 }
+    }
+
     /// Appends `count` voxels of `value`.
     fn add(&mut self, value: u8, count: usize) -> std::io::Result<()> {
         if value != self.value {

@@ -48,40 +48,66 @@ fn crossings_into(
     out: &mut Vec<(RowId, Crossing)>,
 ) {
     let n = grid.n;
-    let h = grid.h();
-    let wanted = |row: usize| filter.is_none_or(|bits| bits[row / 64] >> (row % 64) & 1 == 1);
+    let wanted = |j: usize, k: usize| {
+        let row = j * n + k;
+        filter.is_none_or(|bits| bits[row / 64] >> (row % 64) & 1 == 1)
+    };
     for t in triangles {
-        let tri = &solid.triangles[t as usize];
-        let [a, b, c] = *tri;
-        let nx = exact::orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
-        if nx == 0 {
-            continue;
-        }
-        let (ylo, yhi) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
-        let js = index_range(grid.min.y, h, n, ylo, yhi);
-        for j in js.start.max(slices.start)..js.end.min(slices.end) {
-            let y = grid.centre_coord(grid.min.y, j);
-            if y < ylo || y > yhi {
-                continue;
-            }
-            let Some((zlo, zhi)) = z_extent_at(tri, y) else { continue };
-            let margin = 1e-9 * (zlo.abs() + zhi.abs() + h);
-            for k in index_range(grid.min.z, h, n, zlo - margin, zhi + margin) {
-                let row = j * n + k;
-                if !wanted(row) {
-                    continue;
-                }
-                let p = DVec3::new(0.0, y, grid.centre_coord(grid.min.z, k));
-                if exact::inside_yz(a, b, c, p, nx) {
-                    let (x, err) = x_crossing(a, b, c, y, p.z);
-                    out.push((row as RowId, Crossing { x, err, triangle: t, nx }));
-                }
-            }
-        }
+        triangle_crossings(solid, grid, t, slices.clone(), 0..n, wanted, |j, k, c| {
+            out.push(((j * n + k) as RowId, c))
+        });
     }
     out.sort_unstable_by(|(r0, c0), (r1, c1)| {
         r0.cmp(r1).then(c0.x.total_cmp(&c1.x)).then(c0.triangle.cmp(&c1.triangle))
     });
+}
+
+/// Calls `each(j, k, crossing)` for every row (j, k) with j in `slices`, k in `columns`
+/// and `wanted(j, k)` whose line meets covering triangle `t` (decided exactly, under the
+/// tie rule).
+fn triangle_crossings(
+    solid: &Solid,
+    grid: &Grid,
+    t: u32,
+    slices: std::ops::Range<usize>,
+    columns: std::ops::Range<usize>,
+    wanted: impl Fn(usize, usize) -> bool,
+    mut each: impl FnMut(usize, usize, Crossing),
+) {
+    let (n, h) = (grid.n, grid.h());
+    let tri = &solid.triangles[t as usize];
+    let [a, b, c] = *tri;
+    let (ylo, yhi) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
+    let js = index_range(grid.min.y, h, n, ylo, yhi);
+    let (js, ks) = (js.start.max(slices.start)..js.end.min(slices.end), columns);
+    let (zlo, zhi) = (a.z.min(b.z).min(c.z), a.z.max(b.z).max(c.z));
+    let all_ks = index_range(grid.min.z, h, n, zlo, zhi);
+    if js.is_empty() || all_ks.end <= ks.start || all_ks.start >= ks.end {
+        return;
+    }
+    let nx = exact::orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
+    if nx == 0 {
+        return;
+    }
+    for j in js {
+        let y = grid.centre_coord(grid.min.y, j);
+        if y < ylo || y > yhi {
+            continue;
+        }
+        let Some((zlo, zhi)) = z_extent_at(tri, y) else { continue };
+        let margin = 1e-9 * (zlo.abs() + zhi.abs() + h);
+        let row_ks = index_range(grid.min.z, h, n, zlo - margin, zhi + margin);
+        for k in row_ks.start.max(ks.start)..row_ks.end.min(ks.end) {
+            if !wanted(j, k) {
+                continue;
+            }
+            let p = DVec3::new(0.0, y, grid.centre_coord(grid.min.z, k));
+            if exact::inside_yz(a, b, c, p, nx) {
+                let (x, err) = x_crossing(a, b, c, y, p.z);
+                each(j, k, Crossing { x, err, triangle: t, nx });
+            }
+        }
+    }
 }
 
 /// Indices i (clamped to 0..n) whose centres may lie in [lo, hi], with one index of
@@ -157,24 +183,48 @@ fn first_index(grid: &Grid, pred: impl Fn(f64) -> bool) -> usize {
     lo
 }
 
+/// The centres (indices along x) a crossing's f64 abscissa cannot place: those before
+/// the range certainly see it ahead, those after certainly behind.
+fn doubt(grid: &Grid, c: &Crossing) -> std::ops::Range<usize> {
+    let certain_end = first_index(grid, |x| x >= c.x - c.err);
+    let doubt_end = if c.err.is_finite() { first_index(grid, |x| x > c.x + c.err) } else { grid.n };
+    certain_end..doubt_end.max(certain_end)
+}
+
+/// The first centre of row (j, k) that crossing `c` is not ahead of, searched in
+/// `doubt` (from [`doubt`]) with the exact predicate: the crossing flips the parity of
+/// centres 0..f and no other. (Seen from a centre moving along +x, a crossing is ahead
+/// until it is passed, so the predicate is monotone and a bisection finds the change.)
+fn first_behind(
+    solid: &Solid,
+    grid: &Grid,
+    j: usize,
+    k: usize,
+    c: &Crossing,
+    doubt: std::ops::Range<usize>,
+) -> usize {
+    let (y, z) = (grid.centre_coord(grid.min.y, j), grid.centre_coord(grid.min.z, k));
+    let [a, b, t] = solid.triangles[c.triangle as usize];
+    let (mut lo, mut hi) = (doubt.start, doubt.end);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if exact::crossing_ahead(a, b, t, DVec3::new(grid.centre_coord(grid.min.x, mid), y, z), c.nx) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// Writes the exact occupancy of row (j, k) into `row` (its words, cleared first), from
 /// the row's crossings.
 pub fn classify_row(solid: &Solid, grid: &Grid, j: usize, k: usize, crossings: &[Crossing], row: &mut [u64]) {
     row.fill(0);
-    let (y, z) = (grid.centre_coord(grid.min.y, j), grid.centre_coord(grid.min.z, k));
     for c in crossings {
-        // Centres certainly before the crossing see it ahead: flip them all at once.
-        let certain_end = first_index(grid, |x| x >= c.x - c.err);
-        if certain_end > 0 {
-            xor_bits(row, 0, certain_end);
-        }
-        let doubt_end = if c.err.is_finite() { first_index(grid, |x| x > c.x + c.err) } else { grid.n };
-        let [a, b, t] = solid.triangles[c.triangle as usize];
-        for i in certain_end..doubt_end {
-            let p = DVec3::new(grid.centre_coord(grid.min.x, i), y, z);
-            if exact::crossing_ahead(a, b, t, p, c.nx) {
-                row[i / 64] ^= 1 << (i % 64);
-            }
+        let f = first_behind(solid, grid, j, k, c, doubt(grid, c));
+        if f > 0 {
+            xor_bits(row, 0, f);
         }
     }
 }
@@ -210,3 +260,175 @@ pub fn voxelize(solid: &Solid, grid: &Grid) -> Result<Volume> {
     });
     Ok(volume)
 }
+
+/// x planes per batch of [`x_planes`]: 16 planes of 1024² bits are 2 MiB, and a
+/// triangle only spans a second batch when it is wider than a few voxels.
+const BATCH: usize = 16;
+
+/// Planes of the scanline volume handed out by [`x_planes`]: plane p is the voxels with
+/// x = x0 + p, row k of a plane holds z = k, bit j of the row y = j.
+pub struct Planes<'a> {
+    n: usize,
+    wpr: usize,
+    planes: usize,
+    /// Planes stored per row: `planes` and room for more.
+    stride: usize,
+    /// Words by row k, then plane, then word: one task owns a band of rows in every plane.
+    words: &'a [u64],
+}
+
+impl Planes<'_> {
+    /// Number of planes.
+    pub fn len(&self) -> usize {
+        self.planes
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.planes == 0
+    }
+
+    /// Row k of plane p: the voxels (x0 + p, j, k) as bits j.
+    pub fn row(&self, p: usize, k: usize) -> &[u64] {
+        let s = (k * self.stride + p) * self.wpr;
+        &self.words[s..s + self.wpr]
+    }
+
+    /// Voxels per row (N).
+    pub fn n(&self) -> usize {
+        self.n
+    }
+}
+
+/// The scanline volume in binvox's order, x plane by x plane, without the whole volume
+/// in memory: `emit` gets the planes in order, a batch at a time, and the count of
+/// occupied voxels is returned.
+///
+/// Here a centre's parity counts the crossings *behind* it (those it is not ahead of), so
+/// x planes can be finished in increasing x: each row carries its parity from batch to
+/// batch, and a crossing only flips the row at the first centre it is behind. For a
+/// closed, consistently oriented covering every row line meets the surface an even
+/// number of times (the tie rule perturbs lines off edges and vertices), so that parity is
+/// the one [`voxelize`] computes from the crossings ahead. The last batch checks it: a
+/// row whose crossings are odd in number makes this return [`OddRow`] (as the error's
+/// inner error), so the caller can fall back to [`voxelize`].
+///
+/// Each batch is computed by tasks that own bands of rows (rayon's global pool) and whose
+/// flips commute, so the planes do not depend on the number of threads.
+pub fn x_planes(
+    solid: &Solid,
+    grid: &Grid,
+    mut emit: impl FnMut(&Planes<'_>) -> std::io::Result<()>,
+) -> std::io::Result<u64> {
+    use rayon::prelude::*;
+    let (n, h) = (grid.n, grid.h());
+    let wpr = n.div_ceil(64);
+    // The centres a triangle's crossings can first be behind: its x range with the margin
+    // of `index_range` (the centre before it is ahead of any crossing, the one after
+    // behind); crossings beyond the last centre are counted at N.
+    let behind = |t: u32| {
+        let [a, b, c] = solid.triangles[t as usize];
+        let (lo, hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
+        let first = ((lo - grid.min.x) / h - 0.5).ceil() - 1.0;
+        let last = ((hi - grid.min.x) / h - 0.5).floor() + 1.0;
+        (first.clamp(0.0, n as f64) as usize, last.clamp(0.0, n as f64) as usize)
+    };
+    // Triangles in order of their first centre (a counting sort).
+    let mut start = vec![0u32; n + 2];
+    for t in 0..solid.triangles.len() as u32 {
+        start[behind(t).0 + 2] += 1;
+    }
+    for i in 2..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut order = vec![0u32; solid.triangles.len()];
+    for t in 0..solid.triangles.len() as u32 {
+        let slot = &mut start[behind(t).0 + 1];
+        order[*slot as usize] = t;
+        *slot += 1;
+    }
+    let mut next = 0;
+    let mut active: Vec<u32> = Vec::new();
+    let stride = BATCH + 1;
+    let mut words = vec![0u64; n * stride * wpr];
+    let mut carry = vec![0u64; n * wpr];
+    // Bands of rows: enough for every thread to stay busy when bands differ in work.
+    let band = n.div_ceil(8 * rayon::current_num_threads()).max(1);
+    let mut occupied = 0;
+    for x0 in (0..n).step_by(BATCH) {
+        let x1 = (x0 + BATCH).min(n);
+        // Crossings first behind a centre in x0..=last belong to this batch; in the last
+        // batch, those behind no centre (f = N) go to plane x1 - x0, for the parity check.
+        let last = if x1 == n { n } else { x1 - 1 };
+        while next < order.len() && behind(order[next]).0 <= last {
+            active.push(order[next]);
+            next += 1;
+        }
+        active.retain(|&t| behind(t).1 >= x0);
+        // Which band of rows each active triangle reaches (its z range).
+        let lists = slab_lists(
+            n,
+            band,
+            active.iter().map(|&t| {
+                let [a, b, c] = solid.triangles[t as usize];
+                index_range(grid.min.z, h, n, a.z.min(b.z).min(c.z), a.z.max(b.z).max(c.z))
+            }),
+        );
+        let planes = x1 - x0;
+        let odd = words
+            .par_chunks_mut(band * stride * wpr)
+            .zip(carry.par_chunks_mut(band * wpr))
+            .enumerate()
+            .map(|(b, (rows, carry))| {
+                rows.fill(0);
+                let ks = b * band..(b * band + band).min(n);
+                for &t in lists[b].iter().map(|&i| &active[i as usize]) {
+                    triangle_crossings(
+                        solid,
+                        grid,
+                        t,
+                        0..n,
+                        ks.clone(),
+                        |_, _| true,
+                        |j, k, c| {
+                            let d = doubt(grid, &c);
+                            if d.end < x0 || d.start > last {
+                                return;
+                            }
+                            let f = first_behind(solid, grid, j, k, &c, d);
+                            if (x0..=last).contains(&f) {
+                                rows[((k - ks.start) * stride + f - x0) * wpr + j / 64] ^= 1 << (j % 64);
+                            }
+                        },
+                    );
+                }
+                let mut odd = false;
+                let mut count = 0u64;
+                for (row, carry) in rows.chunks_exact_mut(stride * wpr).zip(carry.chunks_exact_mut(wpr)) {
+                    for p in 0..planes {
+                        for (w, c) in row[p * wpr..(p + 1) * wpr].iter_mut().zip(carry.iter_mut()) {
+                            *c ^= *w;
+                            *w = *c;
+                            count += c.count_ones() as u64;
+                        }
+                    }
+                    if x1 == n {
+                        odd |= row[planes * wpr..(planes + 1) * wpr] != *carry;
+                    }
+                }
+                (odd, count)
+            })
+            .reduce(|| (false, 0), |a, b| (a.0 | b.0, a.1 + b.1));
+        if odd.0 {
+            return Err(std::io::Error::other(OddRow));
+        }
+        occupied += odd.1;
+        emit(&Planes { n, wpr, planes, stride, words: &words })?;
+    }
+    Ok(occupied)
+}
+
+/// A row line met the covering an odd number of times: [`x_planes`] cannot finish its
+/// volume (the covering is not closed where the tie rule looks).
+#[derive(Debug, thiserror::Error)]
+#[error("a row of voxel centres meets the surface an odd number of times")]
+pub struct OddRow;

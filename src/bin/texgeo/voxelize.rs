@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use texgeo::mesh::solidity::Policy;
 use texgeo::voxel::aspect::{self, Aspect, Material};
 use texgeo::voxel::auto::{self as plan, Counts, Plan};
-use texgeo::voxel::{Choice, Grid, Solid, Voxelizer, Zone, binvox, pictures};
+use texgeo::voxel::{Choice, Grid, Method, Solid, Voxelizer, Zone, binvox, pictures};
 
 /// Aspect functions (Fig. 5-9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -106,6 +106,26 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     };
     if let Some(ctx) = &ctx {
         say!("device: {}", ctx.info().label());
+    }
+    if method == Method::Scanline && args.slices.is_none() && args.aspect.is_none() {
+        // Only the file is wanted: it is written while the volume is computed, a few x
+        // planes in memory at a time instead of N³ bits.
+        let t = std::time::Instant::now();
+        let streamed = binvox::write_scanline(&args.output, &grid, &solid)?;
+        say!(
+            "{}: {}³ voxels, {} occupied, method scanline in {:.1} ms, written to {} as computed{}",
+            args.mesh,
+            args.res,
+            streamed.occupied,
+            t.elapsed().as_secs_f64() * 1e3,
+            args.output.display(),
+            if streamed.whole_volume {
+                " (a row met the surface an odd number of times: whole volume)"
+            } else {
+                ""
+            }
+        );
+        return Ok(());
     }
     let mut voxelizer = Voxelizer::new(ctx.clone());
     voxelizer.zone = args.zone;
