@@ -270,9 +270,10 @@ fn real_x_input_resizes_orbits_unmaps_and_closes() {
         xdo(&["mousemove", "--window", wid, "100", "100"]);
     };
     focus(&wid);
-    xdo(&["key", "plus"]);
+    // `=` is the unshifted `+`: no modifier for xdotool to press and release around it.
+    xdo(&["key", "equal"]);
     wait_for(limit, "level 1", || stdout().contains("level 1: 26 vertices, 24 faces").then_some(()));
-    xdo(&["key", "plus"]);
+    xdo(&["key", "equal"]);
     wait_for(limit, "level 2", || stdout().contains("level 2: 98 vertices, 96 faces").then_some(()));
     let title = wait_for(limit, "the title to show level 2", || {
         let t = xdo(&["getwindowname", &wid]);

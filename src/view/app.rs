@@ -422,10 +422,11 @@ impl ApplicationHandler for App {
                 Ok(())
             }
             WindowEvent::RedrawRequested => self.on_redraw(event_loop),
-            // A held key's auto-repeats are ignored: one press is one step (a level change
-            // reruns the fragment passes; a late release must not add a level).
-            WindowEvent::KeyboardInput { event, .. }
-                if event.state == ElementState::Pressed && !event.repeat =>
+            // A held key's auto-repeats are ignored, and so are the presses winit makes up
+            // for keys held while the window takes the focus: one press is one step (a
+            // level change reruns the fragment passes; a late release must not add a level).
+            WindowEvent::KeyboardInput { event, is_synthetic, .. }
+                if event.state == ElementState::Pressed && !event.repeat && !is_synthetic =>
             {
                 match event.logical_key.as_ref() {
                     Key::Named(NamedKey::Escape) => {
