@@ -328,6 +328,9 @@ impl TetraGrid {
             });
         }
         check("lists", total as u64 * 4)?;
+        // `start[c + 1]` first counts cell c's entries, then (summed) is where its list
+        // ends; items placed last to first, each one slot down, leave `start[c]` at the
+        // list's beginning and the lists in increasing order, with no second array.
         let mut start = vec![0u32; num_cells + 1];
         for &c in parts.iter().flat_map(|p| &p.0) {
             start[c as usize + 1] += 1;
@@ -335,18 +338,20 @@ impl TetraGrid {
         for c in 0..num_cells {
             start[c + 1] += start[c];
         }
-        let mut fill = start.clone();
         let mut ids = vec![0u32; total];
-        for (k, (entries, ends)) in parts.iter().enumerate() {
-            let mut from = 0;
-            for (t, &end) in (k * CHUNK..).zip(ends) {
-                for &c in &entries[from..end] {
-                    ids[fill[c as usize] as usize] = t as u32;
-                    fill[c as usize] += 1;
+        for (k, (entries, ends)) in parts.iter().enumerate().rev() {
+            for i in (0..ends.len()).rev() {
+                let from = if i == 0 { 0 } else { ends[i - 1] };
+                for &c in &entries[from..ends[i]] {
+                    let slot = &mut start[c as usize + 1];
+                    *slot -= 1;
+                    ids[*slot as usize] = (k * CHUNK + i) as u32;
                 }
-                from = end;
             }
         }
+        // Each list now begins at `start[c + 1]`: shift by one to make it `start[c]`.
+        start.copy_within(1.., 0);
+        start[num_cells] = total as u32;
         Ok(TetraGrid { cells, start, ids })
     }
 
@@ -381,5 +386,34 @@ impl TetraGrid {
     /// Heap bytes of the lists.
     pub fn memory_bytes(&self) -> usize {
         4 * (self.start.capacity() + self.ids.capacity())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Rng;
+
+    #[test]
+    fn lists_hold_every_item_of_their_cells_in_increasing_order() {
+        // More items than one parallel chunk, random covers of 0–5 distinct cells.
+        let cells = Cells::new(DVec3::ZERO, 1.0, 6);
+        let mut rng = Rng::new(5);
+        let covers: Vec<Vec<u32>> = (0..10_000)
+            .map(|_| {
+                let mut c: Vec<u32> = (0..rng.below(6)).map(|_| rng.below(216) as u32).collect();
+                c.sort_unstable();
+                c.dedup();
+                c
+            })
+            .collect();
+        let grid = TetraGrid::build(cells, covers.len(), |t, out| out.extend(&covers[t])).unwrap();
+        for c in 0..216 {
+            let expected: Vec<u32> =
+                (0..covers.len() as u32).filter(|&t| covers[t as usize].contains(&(c as u32))).collect();
+            assert_eq!(grid.cell(c), &expected[..], "cell {c}");
+        }
+        let (start, ids) = grid.lists();
+        assert_eq!((start.len(), start[216] as usize), (217, ids.len()));
     }
 }

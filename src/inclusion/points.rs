@@ -43,11 +43,14 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<DVec3>, MeshError> {
     Ok(points)
 }
 
-/// Bytes of text read per block by [`PointReader`].
-const BLOCK: usize = 1 << 22;
+/// Bytes of text read per block by [`PointReader`]: two parallel chunks per thread (one
+/// block is parsed while the next is read, so two are held), between 1 and 4 MiB.
+fn block_size() -> usize {
+    (2 * CHUNK * rayon::current_num_threads()).clamp(1 << 20, 1 << 22)
+}
 
 /// The points of a file a block at a time, so that classifying a file of any size takes
-/// bounded memory: text in blocks of whole lines ([`BLOCK`] bytes), `.npy` in one block.
+/// bounded memory: text in blocks of whole lines ([`block_size`] bytes), `.npy` in one block.
 pub struct PointReader {
     path: std::path::PathBuf,
     source: Source,
@@ -76,7 +79,7 @@ enum Source {
 
 impl PointReader {
     pub fn open(path: impl AsRef<Path>) -> Result<PointReader, MeshError> {
-        PointReader::with_block(path, BLOCK)
+        PointReader::with_block(path, block_size())
     }
 
     /// With blocks of about `block` bytes of text.
@@ -106,7 +109,7 @@ impl PointReader {
 
     /// Points already in memory (random ones), handed out as one block; `name` names them.
     pub fn from_points(points: Vec<DVec3>, name: &str) -> PointReader {
-        PointReader { path: name.into(), source: Source::Whole(Some(points)), read: 0, block: BLOCK }
+        PointReader { path: name.into(), source: Source::Whole(Some(points)), read: 0, block: block_size() }
     }
 
     /// About how many points the file holds: exact for `.npy` and for a text file read
