@@ -1,4 +1,10 @@
-"""texgeo inclusion vs open3d's occupancy query; run through tools/open3d-compare.
+"""texgeo inclusion and voxelize vs open3d's occupancy query; run through tools/open3d-compare.
+
+--voxels MESH RES... [--runs N]: `texgeo voxelize MESH --res N -o V.binvox` (defaults, whole
+process) against open3d's occupancy query over the same N³ voxel centres (texgeo's grid: the
+bounding cube, centres at min + (i + ½)·side/N), one x slice of centres per call so memory
+stays bounded; open3d's time is its RaycastingScene build plus the queries (making the
+centres is left out), and the voxels where the two differ are counted.
 
 --open3d MESH POINTS [-o LABELS]: one open3d run (read, RaycastingScene build, compute_occupancy,
 write), its phase times on stderr. Otherwise: for each points file, `texgeo inclusion MESH
@@ -60,6 +66,77 @@ def run_open3d(mesh_path, points_path, out):
     )
 
 
+def grid_of(mesh):
+    import numpy as np
+
+    v = np.asarray(mesh.vertices)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    side = float((hi - lo).max())
+    return (lo + hi) * 0.5 - side * 0.5, side
+
+
+def run_open3d_voxels(mesh_path, n, binvox):
+    """open3d's occupancy of the N³ centres, slice by slice; compared with texgeo's binvox
+    (x-major, then z, then y) when one is given."""
+    import numpy as np
+    import open3d as o3d
+
+    mesh = o3d.io.read_triangle_mesh(mesh_path)
+    lo, side = grid_of(mesh)
+    h = side / n
+    c = lambda axis: (lo[axis] + (np.arange(n) + 0.5) * h)
+    zz, yy = np.meshgrid(c(2), c(1), indexing="ij")
+    yz = np.empty((n * n, 3), dtype=np.float32)
+    yz[:, 1], yz[:, 2] = yy.ravel(), zz.ravel()
+    ours = None
+    if binvox:
+        with open(binvox, "rb") as f:
+            data = f.read()
+        runs = np.frombuffer(data[data.index(b"data\n") + 5 :], dtype=np.uint8).reshape(-1, 2)
+        ours = np.repeat(runs[:, 0], runs[:, 1].astype(np.int64))
+    spent, occupied, differ = 0.0, 0, 0
+    t = time.perf_counter()
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
+    spent += time.perf_counter() - t
+    for i, x in enumerate(c(0)):
+        yz[:, 0] = x
+        t = time.perf_counter()
+        occ = scene.compute_occupancy(o3d.core.Tensor(yz, dtype=o3d.core.Dtype.Float32)).numpy()
+        spent += time.perf_counter() - t
+        occupied += int(occ.sum())
+        if ours is not None:
+            differ += int((ours[i * n * n : (i + 1) * n * n] != occ.astype(np.uint8)).sum())
+    print(
+        f"open3d: build+query {1e3 * spent:.1f} ms, {n}^3 centres, {occupied} inside, {differ} differ",
+        file=sys.stderr,
+    )
+
+
+def compare_voxels(args):
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    texgeo = args.texgeo or os.path.join(root, "target", "release", "texgeo")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "v.binvox")
+        for n in args.res:
+            t_cmd = [texgeo, *args.texgeo_args.split(), "voxelize", args.mesh, "--res", str(n), "-o", out]
+            t_runs = [measured(t_cmd) for _ in range(args.runs)]
+            o_cmd = [sys.executable, os.path.abspath(__file__), "--open3d-voxels", args.mesh, str(n), out]
+            o_runs = [measured(o_cmd) for _ in range(args.open3d_runs)]
+            med = lambda runs, i: statistics.median(r[i] for r in runs)
+            inner = statistics.median(float(r[2].split("build+query ")[1].split(" ms")[0]) / 1e3 for r in o_runs)
+            differ = o_runs[-1][2].split(" inside, ")[1].split(" differ")[0]
+            rows.append((n, med(t_runs, 0), inner, med(t_runs, 1), os.path.getsize(out) / 2**20, differ))
+            print(f"texgeo: {t_runs[-1][2].strip()}", file=sys.stderr)
+            print(o_runs[-1][2].strip(), file=sys.stderr)
+    print(f"\n{args.mesh}: texgeo {args.runs} runs (median), open3d {args.open3d_runs}; whole texgeo processes\n")
+    print("| N | texgeo s | open3d build+query s | ratio | texgeo peak MiB | binvox MiB | voxels that differ |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for n, tt, inner, tm, out, differ in rows:
+        print(f"| {n} | {tt:.3f} | {inner:.2f} | {tt / inner:.4f} | {tm:.1f} | {out:.2f} | {differ} |")
+
+
 def measured(cmd):
     """(wall seconds, peak RSS MiB) of one process."""
     t = time.perf_counter()
@@ -112,6 +189,20 @@ def compare(args):
 
 
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--open3d-voxels":
+        run_open3d_voxels(sys.argv[2], int(sys.argv[3]), sys.argv[4] if len(sys.argv) > 4 else None)
+        return
+    if len(sys.argv) > 1 and sys.argv[1] == "--voxels":
+        p = argparse.ArgumentParser(prog="tools/open3d-compare --voxels")
+        p.add_argument("--voxels", action="store_true")
+        p.add_argument("mesh")
+        p.add_argument("res", nargs="+", type=int)
+        p.add_argument("--runs", type=int, default=5)
+        p.add_argument("--open3d-runs", type=int, default=1, help="open3d runs per size (slow: one by default)")
+        p.add_argument("--texgeo", help="texgeo binary (default target/release/texgeo)")
+        p.add_argument("--texgeo-args", default="")
+        compare_voxels(p.parse_args())
+        return
     if len(sys.argv) > 1 and sys.argv[1] == "--open3d":
         p = argparse.ArgumentParser(prog="tools/open3d-compare --open3d")
         p.add_argument("--open3d", action="store_true")
