@@ -308,14 +308,16 @@ impl TetraGrid {
         // Cells of every item (in parallel chunks, in order), then a counting sort into
         // per-cell lists.
         const CHUNK: usize = 4096;
-        let parts: Vec<(Vec<u32>, Vec<usize>)> = (0..count.div_ceil(CHUNK))
+        let parts: Vec<(Vec<u32>, Vec<u32>)> = (0..count.div_ceil(CHUNK))
             .into_par_iter()
             .map(|k| {
                 let (mut entries, mut ends) = (Vec::new(), Vec::with_capacity(CHUNK));
                 for t in k * CHUNK..((k + 1) * CHUNK).min(count) {
                     cover(t, &mut entries);
-                    ends.push(entries.len());
+                    ends.push(entries.len() as u32);
                 }
+                // Held with the lists until they are filled: no spare capacity.
+                entries.shrink_to_fit();
                 (entries, ends)
             })
             .collect();
@@ -341,8 +343,8 @@ impl TetraGrid {
         let mut ids = vec![0u32; total];
         for (k, (entries, ends)) in parts.iter().enumerate().rev() {
             for i in (0..ends.len()).rev() {
-                let from = if i == 0 { 0 } else { ends[i - 1] };
-                for &c in &entries[from..ends[i]] {
+                let from = if i == 0 { 0 } else { ends[i - 1] as usize };
+                for &c in &entries[from..ends[i] as usize] {
                     let slot = &mut start[c as usize + 1];
                     *slot -= 1;
                     ids[*slot as usize] = (k * CHUNK + i) as u32;
