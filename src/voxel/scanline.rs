@@ -53,7 +53,8 @@ fn crossings_into(
         filter.is_none_or(|bits| bits[row / 64] >> (row % 64) & 1 == 1)
     };
     for t in triangles {
-        triangle_crossings(solid, grid, t, slices.clone(), 0..n, wanted, |j, k, c| {
+        let all = (f64::NEG_INFINITY, f64::INFINITY);
+        triangle_crossings(solid, grid, t, slices.clone(), 0..n, all, wanted, |j, k, c| {
             out.push(((j * n + k) as RowId, c))
         });
     }
@@ -64,13 +65,16 @@ fn crossings_into(
 
 /// Calls `each(j, k, crossing)` for every row (j, k) with j in `slices`, k in `columns`
 /// and `wanted(j, k)` whose line meets covering triangle `t` (decided exactly, under the
-/// tie rule).
+/// tie rule) at an abscissa that may lie in `window` (rows whose crossing is certainly
+/// outside it may be left out).
+#[allow(clippy::too_many_arguments)]
 fn triangle_crossings(
     solid: &Solid,
     grid: &Grid,
     t: u32,
     slices: std::ops::Range<usize>,
     columns: std::ops::Range<usize>,
+    window: (f64, f64),
     wanted: impl Fn(usize, usize) -> bool,
     mut each: impl FnMut(usize, usize, Crossing),
 ) {
@@ -89,12 +93,40 @@ fn triangle_crossings(
     if nx == 0 {
         return;
     }
+    // With a window, a triangle that is not too steep along x is only visited on the
+    // strip of rows where its plane's abscissa, x = a.x − (ny·(y − a.y) + nz·(z − a.z))/nx,
+    // is within the window grown by two voxels: far more than the f64 error of that
+    // formula (|n.x| ≥ 10⁻³·|n|₁) or of any crossing's own bound. A steep triangle has
+    // few rows anyway: its (y, z) projection is small.
+    let normal = (b - a).cross(c - a);
+    let strip =
+        (window.0.is_finite() || window.1.is_finite()) && normal.x.abs() >= 1e-3 * normal.abs().element_sum();
+    let grown = 2.0 * h + 1e-9 * (grid.min.x.abs() + grid.side);
+    let (wlo, whi) = (window.0 - grown, window.1 + grown);
     for j in js {
         let y = grid.centre_coord(grid.min.y, j);
         if y < ylo || y > yhi {
             continue;
         }
-        let Some((zlo, zhi)) = z_extent_at(tri, y) else { continue };
+        let Some((mut zlo, mut zhi)) = z_extent_at(tri, y) else { continue };
+        if strip {
+            let u = normal.y * (y - a.y);
+            if normal.z.abs() <= 1e-12 * normal.abs().element_sum() {
+                // x does not depend on z along this row.
+                let x = a.x - u / normal.x;
+                if x < wlo || x > whi {
+                    continue;
+                }
+            } else {
+                let z_at = |x: f64| a.z + ((a.x - x) * normal.x - u) / normal.z;
+                let (z0, z1) = (z_at(wlo), z_at(whi));
+                zlo = zlo.max(z0.min(z1));
+                zhi = zhi.min(z0.max(z1));
+                if zlo > zhi {
+                    continue;
+                }
+            }
+        }
         let margin = 1e-9 * (zlo.abs() + zhi.abs() + h);
         let row_ks = index_range(grid.min.z, h, n, zlo - margin, zhi + margin);
         for k in row_ks.start.max(ks.start)..row_ks.end.min(ks.end) {
@@ -374,6 +406,11 @@ pub fn x_planes(
             }),
         );
         let planes = x1 - x0;
+        // Crossings this batch takes lie between the centre before x0 and centre `last`.
+        let window = (
+            if x0 == 0 { f64::NEG_INFINITY } else { grid.centre_coord(grid.min.x, x0 - 1) },
+            if last == n { f64::INFINITY } else { grid.centre_coord(grid.min.x, last) },
+        );
         let odd = words
             .par_chunks_mut(band * stride * wpr)
             .zip(carry.par_chunks_mut(band * wpr))
@@ -388,6 +425,7 @@ pub fn x_planes(
                         t,
                         0..n,
                         ks.clone(),
+                        window,
                         |_, _| true,
                         |j, k, c| {
                             let d = doubt(grid, &c);
