@@ -71,10 +71,8 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
                 list
             })
             .collect();
-        for list in lists {
-            for (value, count) in list.runs {
-                runs.add(value, count as usize)?;
-            }
+        for list in &lists {
+            runs.add_list(list)?;
         }
     }
     runs.finish()
@@ -114,17 +112,13 @@ pub fn write_scanline(path: impl AsRef<Path>, grid: &Grid, solid: &Solid) -> Res
                 .map(|p| {
                     let mut list = RunList::default();
                     for k in 0..n {
-                        for (w, &bits) in planes.row(p, k).iter().enumerate() {
-                            list.bits(bits, (n - 64 * w).min(64));
-                        }
+                        list.column(planes.row(p, k), n);
                     }
                     list
                 })
                 .collect();
-            for list in lists {
-                for (value, count) in list.runs {
-                    runs.add(value, count as usize)?;
-                }
+            for list in &lists {
+                runs.add_list(list)?;
             }
             Ok(())
         })?;
@@ -186,9 +180,7 @@ fn encode_group(volume: &Volume, w0: usize, gw: usize, runs: &mut RunList) {
         for xl in 0..xs(g) {
             for z in 0..n {
                 let at = ((g * 64 + xl) * n + z) * ybs;
-                for (yb, &c) in columns[at..at + ybs].iter().enumerate() {
-                    runs.bits(c, (n - 64 * yb).min(64));
-                }
+                runs.column(&columns[at..at + ybs], n);
             }
         }
     }
@@ -206,6 +198,13 @@ impl RunList {
             Some((v, c)) if *v == value => *c += count,
             _ if count > 0 => self.runs.push((value, count)),
             _ => {}
+        }
+    }
+
+    /// Appends the N voxels of a column along y held in `words` (64 per word, bit 0 first).
+    fn column(&mut self, words: &[u64], n: usize) {
+        for (w, &bits) in words.iter().enumerate() {
+            self.bits(bits, (n - 64 * w).min(64));
         }
     }
 
@@ -251,6 +250,14 @@ impl<'a, W: Write> Runs<'a, W> {
             self.value = value;
         }
         self.count += count;
+        Ok(())
+    }
+
+    /// Appends a list of runs.
+    fn add_list(&mut self, list: &RunList) -> std::io::Result<()> {
+        for &(value, count) in &list.runs {
+            self.add(value, count as usize)?;
+        }
         Ok(())
     }
 

@@ -145,12 +145,17 @@ fn triangle_crossings(
 /// Indices i (clamped to 0..n) whose centres may lie in [lo, hi], with one index of
 /// margin on each side; callers decide each one exactly.
 fn index_range(min: f64, h: f64, n: usize, lo: f64, hi: f64) -> std::ops::Range<usize> {
-    let first = ((lo - min) / h - 0.5).ceil() - 1.0;
-    let last = ((hi - min) / h - 0.5).floor() + 1.0;
+    let (first, last) = index_bounds(min, h, lo, hi);
     if last.is_nan() || first.is_nan() || last < 0.0 || first >= n as f64 || first > last {
         return 0..0;
     }
     (first.max(0.0) as usize)..((last + 1.0).min(n as f64) as usize)
+}
+
+/// The unclamped first and last indices of [`index_range`]: the centre of `first` is
+/// certainly below `lo`, that of `last` certainly above `hi`.
+fn index_bounds(min: f64, h: f64, lo: f64, hi: f64) -> (f64, f64) {
+    (((lo - min) / h - 0.5).ceil() - 1.0, ((hi - min) / h - 0.5).floor() + 1.0)
 }
 
 /// The z extent of the triangle's (y, z) projection on the line y = `y` (approximate).
@@ -359,25 +364,12 @@ pub fn x_planes(
     // behind); crossings beyond the last centre are counted at N.
     let behind = |t: u32| {
         let [a, b, c] = solid.triangles[t as usize];
-        let (lo, hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
-        let first = ((lo - grid.min.x) / h - 0.5).ceil() - 1.0;
-        let last = ((hi - grid.min.x) / h - 0.5).floor() + 1.0;
+        let (first, last) = index_bounds(grid.min.x, h, a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
         (first.clamp(0.0, n as f64) as usize, last.clamp(0.0, n as f64) as usize)
     };
-    // Triangles in order of their first centre (a counting sort).
-    let mut start = vec![0u32; n + 2];
-    for t in 0..solid.triangles.len() as u32 {
-        start[behind(t).0 + 2] += 1;
-    }
-    for i in 2..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut order = vec![0u32; solid.triangles.len()];
-    for t in 0..solid.triangles.len() as u32 {
-        let slot = &mut start[behind(t).0 + 1];
-        order[*slot as usize] = t;
-        *slot += 1;
-    }
+    // Triangles in order of their first centre (ties in index order).
+    let mut order: Vec<u32> = (0..solid.triangles.len() as u32).collect();
+    order.sort_by_cached_key(|&t| behind(t).0);
     let mut next = 0;
     let mut active: Vec<u32> = Vec::new();
     let stride = BATCH + 1;
@@ -411,7 +403,7 @@ pub fn x_planes(
             if x0 == 0 { f64::NEG_INFINITY } else { grid.centre_coord(grid.min.x, x0 - 1) },
             if last == n { f64::INFINITY } else { grid.centre_coord(grid.min.x, last) },
         );
-        let odd = words
+        let (odd, count) = words
             .par_chunks_mut(band * stride * wpr)
             .zip(carry.par_chunks_mut(band * wpr))
             .enumerate()
@@ -456,10 +448,10 @@ pub fn x_planes(
                 (odd, count)
             })
             .reduce(|| (false, 0), |a, b| (a.0 | b.0, a.1 + b.1));
-        if odd.0 {
+        if odd {
             return Err(std::io::Error::other(OddRow));
         }
-        occupied += odd.1;
+        occupied += count;
         emit(&Planes { n, wpr, planes, stride, words: &words })?;
     }
     Ok(occupied)
