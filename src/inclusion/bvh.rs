@@ -71,7 +71,8 @@ impl Node {
         if ray.norm <= w || !w.is_finite() {
             return true;
         }
-        let m = w * (1.0 + (ray.diag + 2.0 * w) / (ray.norm - w)) + ray.slack;
+        // The rounding of the slab test below: a few ulps of coordinates within D.
+        let m = w * (1.0 + (ray.diag + 2.0 * w) / (ray.norm - w)) + 1e-14 * ray.diag;
         let (lo, hi) = (self.base_lo - m, self.base_hi + m);
         let (mut a, mut b) = (1.0f64, f64::INFINITY);
         for axis in 0..3 {
@@ -95,7 +96,6 @@ impl Node {
 struct Ray {
     norm: f64,
     diag: f64,
-    slack: f64,
 }
 
 /// The largest shift of a regular tetra's vertices when its four planes (unit normals)
@@ -221,7 +221,7 @@ impl Bvh {
     /// the apex may meet, leaf by leaf.
     pub fn candidates(&self, p: DVec3) -> Candidates<'_> {
         let q = p - self.ft.apex();
-        let ray = Ray { norm: q.length(), diag: self.diag, slack: 1e-14 * self.diag };
+        let ray = Ray { norm: q.length(), diag: self.diag };
         let mut stack = [0u32; 64];
         let mut depth = 0;
         if !self.order.is_empty() {
@@ -290,6 +290,8 @@ impl Classifier for Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::inclusion::cpu::APEX_BALL;
+    use crate::inclusion::tetra::{Verdict, octant_bit};
     use crate::mesh::procedural;
     use crate::random::Rng;
 
@@ -321,21 +323,16 @@ mod tests {
                     // Near a vertex.
                     3 => [a, b, c][rng.below(3) as usize] + DVec3::splat(off),
                     // Just outside the apex ball, towards the base.
-                    4 => {
-                        o + (a - o).normalize()
-                            * ft.surface().scale()
-                            * crate::inclusion::cpu::APEX_BALL
-                            * 1.5
-                    }
+                    4 => o + (a - o).normalize() * ft.surface().scale() * APEX_BALL * 1.5,
                     _ => o + ((a + b + c) / 3.0 - o) * rng.range_f64(0.0, 1.2),
                 };
                 let p = p + DVec3::new(off, -off, off * 0.5);
                 let q = p - o;
-                let octant = crate::inclusion::tetra::octant_bit(q);
+                let octant = octant_bit(q);
                 let candidates: std::collections::HashSet<u32> = bvh.candidates(p).collect();
                 kept += candidates.len();
                 for (t, tp) in ft.tetras().iter().enumerate() {
-                    if !matches!(tp.verdict(q, octant, eps), super::super::tetra::Verdict::Outside) {
+                    if !matches!(tp.verdict(q, octant, eps), Verdict::Outside) {
                         counted += 1;
                         assert!(candidates.contains(&(t as u32)), "tetra {t} dropped for point {p}");
                     }

@@ -18,6 +18,7 @@ use crate::inclusion::{Class, InclusionError, Method, Options, points};
 use crate::mesh::{Mesh, MeshError};
 use crate::random::Rng;
 use crate::report::{Environment, Report, Samples, Table};
+use crate::scratch::ScratchDir;
 use crate::voxel::{Grid, Solid, VoxelError, Voxelizer};
 
 pub const DEFAULT_POINTS: &[usize] = &[1_000, 100_000, 1_000_000];
@@ -239,9 +240,9 @@ fn io_table(model: &Model, cfg: &Config) -> Result<Table, ScaleError> {
     let n = cfg.points.iter().copied().max().unwrap_or(1_000_000);
     let pts = query_points(&model.mesh, n);
     let io = |e: std::io::Error| ScaleError::Other(e.to_string());
-    let dir = TempDir::new().map_err(io)?;
-    let text_path = dir.0.join("points.xyz");
-    let npy_path = dir.0.join("points.npy");
+    let dir = ScratchDir::new("bench-scale").map_err(|e| ScaleError::Other(e.to_string()))?;
+    let text_path = dir.join("points.xyz");
+    let npy_path = dir.join("points.npy");
     {
         use std::io::Write as _;
         let mut w = std::io::BufWriter::new(std::fs::File::create(&text_path).map_err(io)?);
@@ -271,7 +272,7 @@ fn io_table(model: &Model, cfg: &Config) -> Result<Table, ScaleError> {
             throughput_row(&mut table, threads, step, bytes, m.time);
         }
         for (step, name) in [("write text labels", "labels.txt"), ("write .npy labels", "labels.npy")] {
-            let path = dir.0.join(name);
+            let path = dir.join(name);
             let m = measure(cfg.runs, || -> Result<_, ScaleError> {
                 let t = Instant::now();
                 if points::is_npy(&path) {
@@ -300,8 +301,20 @@ fn voxel_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, Scal
     )
     .named("voxelize");
     let solid = Solid::new(&model.mesh)?;
-    let dir = TempDir::new().map_err(|e| ScaleError::Other(e.to_string()))?;
+    let dir = ScratchDir::new("bench-scale").map_err(|e| ScaleError::Other(e.to_string()))?;
     let mut voxelizer = Voxelizer::new(Some(ctx.clone()));
+    let row = |table: &mut Table, n: usize, method: &str, threads: usize, m: &Measured<u64>| {
+        eprintln!("bench scale: {n}³ {method}, {threads} thread(s): {} ms", ms(m.time));
+        table.row(vec![
+            n.to_string(),
+            method.to_string(),
+            threads.to_string(),
+            ms(m.time),
+            mib(m.peak_kib),
+            mib(m.before_kib),
+            m.last.to_string(),
+        ]);
+    };
     let mut skipped = Vec::new();
     let mut last: std::collections::HashMap<(crate::voxel::Method, usize), (usize, Duration)> =
         Default::default();
@@ -325,23 +338,14 @@ fn voxel_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, Scal
                         Ok((r.timings.total, r.volume.count()))
                     })
                 })?;
-                eprintln!("bench scale: {n}³ {method}, {threads} thread(s): {} ms", ms(m.time));
                 last.insert((method, threads), (n, m.time));
-                table.row(vec![
-                    n.to_string(),
-                    method.to_string(),
-                    threads.to_string(),
-                    ms(m.time),
-                    mib(m.peak_kib),
-                    mib(m.before_kib),
-                    m.last.to_string(),
-                ]);
+                row(&mut table, n, &method.to_string(), threads, &m);
             }
         }
         // What `texgeo voxelize` does when only the file is wanted: the scanline volume
         // streamed to a binvox file in x planes, never held whole.
         if cfg.voxel_methods.contains(&crate::voxel::Method::Scanline) {
-            let file = dir.0.join("v.binvox");
+            let file = dir.join("v.binvox");
             for &threads in &cfg.threads {
                 let m = pool(threads)?.install(|| {
                     measure(cfg.runs, || -> Result<_, VoxelError> {
@@ -350,19 +354,7 @@ fn voxel_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, Scal
                         Ok((t.elapsed(), written.occupied))
                     })
                 })?;
-                eprintln!(
-                    "bench scale: {n}³ scanline streamed to binvox, {threads} thread(s): {} ms",
-                    ms(m.time)
-                );
-                table.row(vec![
-                    n.to_string(),
-                    "scanline → binvox file (streamed)".into(),
-                    threads.to_string(),
-                    ms(m.time),
-                    mib(m.peak_kib),
-                    mib(m.before_kib),
-                    m.last.to_string(),
-                ]);
+                row(&mut table, n, "scanline → binvox file (streamed)", threads, &m);
             }
         }
     }
@@ -376,21 +368,4 @@ fn voxel_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, Scal
         table.note(format!("Skipped (over the {} s budget): {}.", cfg.budget.as_secs(), skipped.join("; ")));
     }
     Ok(table)
-}
-
-/// A scratch folder removed on drop.
-struct TempDir(std::path::PathBuf);
-
-impl TempDir {
-    fn new() -> std::io::Result<TempDir> {
-        let path = std::env::temp_dir().join(format!("texgeo-bench-scale-{}", std::process::id()));
-        std::fs::create_dir_all(&path)?;
-        Ok(TempDir(path))
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
