@@ -19,9 +19,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::refine::{Refined, Refinement, Side, edge_key};
+use crate::exact::{orient2d, orient3d};
 use crate::inclusion;
 use crate::mesh::disjoint_sets::UnionFind;
-use crate::mesh::intersect::{TriangleSoup, orient2d, orient3d, segment_meets_triangle, triangle_projection};
+use crate::mesh::intersect::{TriangleSoup, segment_meets_triangle, triangle_projection};
 
 /// Where a refined triangle lies relative to the other solid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -209,8 +210,8 @@ fn on_status(
             let x = proj.apply(centroid(refined, points, t));
             for &(_, u, same) in partners {
                 let tri = other.triangle(u as usize).map(|p| proj.apply(p));
-                let s = orient2d(tri[0], tri[1], tri[2]).signum();
-                if (0..3).all(|k| s * orient2d(tri[k], tri[(k + 1) % 3], x) > 0.0) {
+                let s = orient2d(tri[0], tri[1], tri[2]);
+                if (0..3).all(|k| s * orient2d(tri[k], tri[(k + 1) % 3], x) > 0) {
                     return Some(if same { Class::OnSame } else { Class::OnOpposite });
                 }
             }
@@ -387,10 +388,10 @@ pub fn exact_parity(p: DVec3, soup: &TriangleSoup) -> Option<bool> {
             let [a, b, c] = soup.triangle(t);
             let sp = orient3d(a, b, c, p);
             let sq = orient3d(a, b, c, q);
-            if (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
+            if sp * sq > 0 {
                 continue;
             }
-            if sp == 0.0 && sq == 0.0 {
+            if sp == 0 && sq == 0 {
                 // The whole segment lies in the triangle's plane.
                 if segment_meets_triangle(p, p, [a, b, c]) {
                     return None;
@@ -401,15 +402,15 @@ pub fn exact_parity(p: DVec3, soup: &TriangleSoup) -> Option<bool> {
                 continue;
             }
             let e = [orient3d(p, q, a, b), orient3d(p, q, b, c), orient3d(p, q, c, a)];
-            let mixed = e.iter().any(|&x| x > 0.0) && e.iter().any(|&x| x < 0.0);
+            let mixed = e.contains(&1) && e.contains(&-1);
             if mixed {
                 continue;
             }
-            if sp == 0.0 {
+            if sp == 0 {
                 // p itself lies on the closed triangle.
                 return None;
             }
-            if sq == 0.0 || e.contains(&0.0) {
+            if sq == 0 || e.contains(&0) {
                 // Through an edge or a vertex: cast again.
                 continue 'direction;
             }

@@ -17,7 +17,8 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::intersect::{orient2d, orient3d, triangle_projection};
+use crate::exact::{orient2d, orient2d_approx, orient3d, orient3d_approx};
+use crate::mesh::intersect::triangle_projection;
 use crate::mesh::triangulate::Projection;
 
 /// The smallest simplex of one mesh that holds a point (vertex ids are position-welded
@@ -98,8 +99,8 @@ impl Key {
 
 /// Where segment pq crosses the plane of t (p, q strictly on opposite sides).
 fn edge_plane(p: DVec3, q: DVec3, t: [DVec3; 3]) -> DVec3 {
-    let dp = orient3d(t[0], t[1], t[2], p);
-    let dq = orient3d(t[0], t[1], t[2], q);
+    let dp = orient3d_approx(t[0], t[1], t[2], p);
+    let dq = orient3d_approx(t[0], t[1], t[2], q);
     let l = (dp / (dp - dq)).clamp(0.0, 1.0);
     if l.is_finite() { p + (q - p) * l } else { p }
 }
@@ -109,15 +110,10 @@ fn edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> DVec3 {
     let n = (q - p).cross(s - r);
     let Some(proj) = Projection::along(n) else { return (p + q) * 0.5 };
     let [p2, q2, r2, s2] = [p, q, r, s].map(|x| proj.apply(x));
-    let dp = orient2d(r2, s2, p2);
-    let dq = orient2d(r2, s2, q2);
+    let dp = orient2d_approx(r2, s2, p2);
+    let dq = orient2d_approx(r2, s2, q2);
     let l = (dp / (dp - dq)).clamp(0.0, 1.0);
     if l.is_finite() { p + (q - p) * l } else { p }
-}
-
-#[inline]
-fn sign(x: f64) -> i8 {
-    (x > 0.0) as i8 - (x < 0.0) as i8
 }
 
 /// How one candidate pair meets.
@@ -137,8 +133,8 @@ pub enum Meeting {
 /// The minimal simplex of triangle `tri` (ids `ids`) holding the coplanar point x, in the
 /// projection `proj` of that plane; `None` when x lies outside.
 fn locate_2d(tri: [DVec2; 3], ids: [u32; 3], face: u32, x: DVec2) -> Option<Simplex> {
-    let s = sign(orient2d(tri[0], tri[1], tri[2]));
-    let o = [0, 1, 2].map(|k| s * sign(orient2d(tri[k], tri[(k + 1) % 3], x)));
+    let s = orient2d(tri[0], tri[1], tri[2]);
+    let o = [0, 1, 2].map(|k| s * orient2d(tri[k], tri[(k + 1) % 3], x));
     if o.contains(&-1) {
         return None;
     }
@@ -165,7 +161,7 @@ fn simplex_of_signs(o: [i8; 3], ids: [u32; 3], face: u32) -> Simplex {
 /// The minimal simplex of triangle `tri` (ids `ids`) where the segment pq, which
 /// reaches its plane at one point, crosses it; `None` when it passes outside.
 fn locate_crossing(p: DVec3, q: DVec3, tri: [DVec3; 3], ids: [u32; 3], face: u32) -> Option<Simplex> {
-    let o = [0, 1, 2].map(|k| sign(orient3d(p, q, tri[k], tri[(k + 1) % 3])));
+    let o = [0, 1, 2].map(|k| orient3d(p, q, tri[k], tri[(k + 1) % 3]));
     if o.contains(&1) && o.contains(&-1) {
         return None;
     }
@@ -206,11 +202,11 @@ impl Ends {
 pub fn meet(ops: &Operands, t: u32, u: u32) -> Meeting {
     let (ta, tb) = (ops.a_tri(t), ops.b_tri(u));
     let (ia, ib) = (ops.a_triangles[t as usize], ops.b_triangles[u as usize]);
-    let sa = ta.map(|p| sign(orient3d(tb[0], tb[1], tb[2], p)));
+    let sa = ta.map(|p| orient3d(tb[0], tb[1], tb[2], p));
     if sa == [1, 1, 1] || sa == [-1, -1, -1] {
         return Meeting::Apart;
     }
-    let sb = tb.map(|p| sign(orient3d(ta[0], ta[1], ta[2], p)));
+    let sb = tb.map(|p| orient3d(ta[0], ta[1], ta[2], p));
     if sb == [1, 1, 1] || sb == [-1, -1, -1] {
         return Meeting::Apart;
     }
@@ -263,7 +259,7 @@ fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
     let Some(proj) = triangle_projection(ta[0], ta[1], ta[2]) else { return Meeting::Apart };
     let a2 = ta.map(|p| proj.apply(p));
     let b2 = tb.map(|p| proj.apply(p));
-    let same = sign(orient2d(a2[0], a2[1], a2[2])) == sign(orient2d(b2[0], b2[1], b2[2]));
+    let same = orient2d(a2[0], a2[1], a2[2]) == orient2d(b2[0], b2[1], b2[2]);
     let mut in_a = Vec::new();
     let mut in_b = Vec::new();
     let mut points = Vec::new();
@@ -326,13 +322,13 @@ fn clip(
     let own_edge = Simplex::edge(ip, ir);
     for k in 0..3 {
         let (a, b) = (tri[k], tri[(k + 1) % 3]);
-        let oa = sign(orient2d(p, r, a));
-        let ob = sign(orient2d(p, r, b));
-        let op = sign(orient2d(a, b, p));
-        let or = sign(orient2d(a, b, r));
+        let oa = orient2d(p, r, a);
+        let ob = orient2d(p, r, b);
+        let op = orient2d(a, b, p);
+        let or = orient2d(a, b, r);
         if oa * ob < 0 && op * or < 0 {
             // Proper crossing of the two edges' interiors.
-            let l = orient2d(a, b, p) / (orient2d(a, b, p) - orient2d(a, b, r));
+            let l = orient2d_approx(a, b, p) / (orient2d_approx(a, b, p) - orient2d_approx(a, b, r));
             push(l, key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
         }
         // A corner of the triangle on the segment's interior.

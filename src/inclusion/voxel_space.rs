@@ -44,9 +44,10 @@ use rayon::prelude::*;
 use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::{InclusionError, Result};
 use super::surface::Surface;
+use crate::exact::orient2d;
 use crate::mesh::Mesh;
 use crate::tetragrid::{Cells, TetraGrid};
-use crate::voxel::exact::{crossing_ahead, inside_yz, orient2d};
+use crate::voxel::exact::{crossing_ahead, inside_yz};
 
 /// Resolutions the method accepts (n³ cells).
 pub const RESOLUTIONS: std::ops::RangeInclusive<usize> = 2..=512;

@@ -1,9 +1,9 @@
 //! Exact triangle–triangle intersection and self-intersection detection.
 //!
-//! Every decision is a sign of an exact predicate on the f64 input coordinates:
-//! [`orient3d`] (Shewchuk's adaptive determinant, the `robust` crate) in space, and
-//! [`orient2d`] for coplanar pairs, projected along an axis the triangle's exact normal
-//! does not vanish on (projection keeps coordinates as they are, so it adds no rounding).
+//! Every decision is a sign of an exact predicate on the f64 input coordinates
+//! ([`crate::exact`]): `orient3d` in space, and `orient2d` for coplanar pairs, projected
+//! along an axis the triangle's exact normal does not vanish on (projection keeps
+//! coordinates as they are, so it adds no rounding).
 //! No point is constructed, so nothing here depends on a tolerance.
 //!
 //! [`self_intersections`] finds the face pairs of a mesh whose intersection is more than
@@ -22,17 +22,7 @@ use rayon::prelude::*;
 use super::Mesh;
 use super::boxgrid::box_pairs;
 use super::triangulate::{self, Projection, TriangulateError};
-
-/// Exact orientation of d relative to the plane through a, b, c: positive when d lies on
-/// the side the normal (b − a) × (c − a) points to, zero when the four are coplanar.
-#[inline]
-pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
-    let k = |p: DVec3| robust::Coord3D { x: p.x, y: p.y, z: p.z };
-    // Shewchuk's sign is positive when d lies *below* (a, b, c counter-clockwise from above).
-    -robust::orient3d(k(a), k(b), k(c), k(d))
-}
-
-pub use super::triangulate::orient2d;
+use crate::exact::{Sign, orient2d, orient2d_approx, orient3d};
 
 /// An exact projection for the plane of triangle (a, b, c): along the axis where its
 /// normal is largest, judged by exact 2D orientations, so the chosen component is
@@ -42,12 +32,12 @@ pub fn triangle_projection(a: DVec3, b: DVec3, c: DVec3) -> Option<Projection> {
     Projection::along(n)
 }
 
-/// The normal's components as exact 2D orientations in the yz, zx and xy planes (their
-/// signs are exact; their sizes are the determinants' approximate values).
+/// The normal's components as 2D determinants in the yz, zx and xy planes (their signs
+/// are exact; their sizes are the determinants' approximate values).
 fn exact_normal_signs(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let o = |u: usize, v: usize| {
         let q = |p: DVec3| glam::DVec2::new(p[u], p[v]);
-        orient2d(q(a), q(b), q(c))
+        orient2d_approx(q(a), q(b), q(c))
     };
     DVec3::new(o(1, 2), o(2, 0), o(0, 1))
 }
@@ -57,17 +47,12 @@ pub fn is_degenerate(t: [DVec3; 3]) -> bool {
     exact_normal_signs(t[0], t[1], t[2]) == DVec3::ZERO
 }
 
-#[inline]
-fn sign(x: f64) -> i8 {
-    (x > 0.0) as i8 - (x < 0.0) as i8
-}
-
 /// Closed 2D segments [p, q] and [r, s] share a point.
 fn segments_meet_2d(p: glam::DVec2, q: glam::DVec2, r: glam::DVec2, s: glam::DVec2) -> bool {
-    let d1 = sign(orient2d(r, s, p));
-    let d2 = sign(orient2d(r, s, q));
-    let d3 = sign(orient2d(p, q, r));
-    let d4 = sign(orient2d(p, q, s));
+    let d1 = orient2d(r, s, p);
+    let d2 = orient2d(r, s, q);
+    let d3 = orient2d(p, q, r);
+    let d4 = orient2d(p, q, s);
     if d1 * d2 < 0 && d3 * d4 < 0 {
         return true;
     }
@@ -82,15 +67,15 @@ fn segments_meet_2d(p: glam::DVec2, q: glam::DVec2, r: glam::DVec2, s: glam::DVe
 
 /// Closed 2D triangle (any orientation, non-degenerate) holds x.
 fn triangle_holds_2d(t: [glam::DVec2; 3], x: glam::DVec2) -> bool {
-    let s = [0, 1, 2].map(|k| sign(orient2d(t[k], t[(k + 1) % 3], x)));
+    let s = [0, 1, 2].map(|k| orient2d(t[k], t[(k + 1) % 3], x));
     !(s.contains(&1) && s.contains(&-1))
 }
 
 /// The closed segment [p, q] and the closed, non-degenerate triangle t share a point.
 pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
     let [a, b, c] = t;
-    let sp = sign(orient3d(a, b, c, p));
-    let sq = sign(orient3d(a, b, c, q));
+    let sp = orient3d(a, b, c, p);
+    let sq = orient3d(a, b, c, q);
     if sp * sq > 0 {
         return false;
     }
@@ -104,7 +89,7 @@ pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
     }
     // The segment reaches the plane at one point; the line pq passes through the closed
     // triangle iff the three edge orientations do not disagree.
-    let s = [sign(orient3d(p, q, a, b)), sign(orient3d(p, q, b, c)), sign(orient3d(p, q, c, a))];
+    let s = [orient3d(p, q, a, b), orient3d(p, q, b, c), orient3d(p, q, c, a)];
     !(s.contains(&1) && s.contains(&-1))
 }
 
@@ -115,7 +100,7 @@ pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
 /// rejection when one lies strictly on one side of the other's plane.
 pub fn triangles_meet(t: [DVec3; 3], u: [DVec3; 3]) -> bool {
     let side = |plane: [DVec3; 3], pts: [DVec3; 3]| {
-        let s = pts.map(|p| sign(orient3d(plane[0], plane[1], plane[2], p)));
+        let s = pts.map(|p| orient3d(plane[0], plane[1], plane[2], p));
         s == [1, 1, 1] || s == [-1, -1, -1]
     };
     if side(u, t) || side(t, u) {
@@ -130,8 +115,8 @@ pub fn triangles_meet(t: [DVec3; 3], u: [DVec3; 3]) -> bool {
 fn ray_in_angle(a: DVec3, d: DVec3, e: DVec3, x: DVec3) -> bool {
     let Some(proj) = triangle_projection(a, d, e) else { return false };
     let [a2, d2, e2, x2] = [a, d, e, x].map(|p| proj.apply(p));
-    let s = sign(orient2d(a2, d2, e2)) as f64;
-    s * orient2d(a2, d2, x2) >= 0.0 && s * orient2d(a2, x2, e2) >= 0.0
+    let s: Sign = orient2d(a2, d2, e2);
+    s * orient2d(a2, d2, x2) >= 0 && s * orient2d(a2, x2, e2) >= 0
 }
 
 /// Triangles (a, b, c) and (a, d, e), sharing only the vertex a, meet elsewhere too.
@@ -144,7 +129,7 @@ pub fn meet_beyond_vertex(a: DVec3, [b, c]: [DVec3; 2], [d, e]: [DVec3; 2]) -> b
     // What is left: the common part runs from a along an edge at a of one triangle that
     // lies in the other's plane, inside the other's angle at a (this also covers
     // coplanar pairs, whose angles at a overlap iff a side of one lies in the other).
-    let in_plane = |plane: [DVec3; 3], x: DVec3| orient3d(plane[0], plane[1], plane[2], x) == 0.0;
+    let in_plane = |plane: [DVec3; 3], x: DVec3| orient3d(plane[0], plane[1], plane[2], x) == 0;
     [b, c].into_iter().any(|x| in_plane(u, x) && ray_in_angle(a, d, e, x))
         || [d, e].into_iter().any(|x| in_plane(t, x) && ray_in_angle(a, b, c, x))
 }
@@ -152,12 +137,12 @@ pub fn meet_beyond_vertex(a: DVec3, [b, c]: [DVec3; 2], [d, e]: [DVec3; 2]) -> b
 /// Triangles (a, b, c) and (a, b, d), sharing the edge ab, meet beyond it: they are
 /// coplanar and fold onto the same side of ab.
 pub fn meet_beyond_edge(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
-    if orient3d(a, b, c, d) != 0.0 {
+    if orient3d(a, b, c, d) != 0 {
         return false;
     }
     let Some(proj) = triangle_projection(a, b, c) else { return false };
     let [a2, b2, c2, d2] = [a, b, c, d].map(|p| proj.apply(p));
-    sign(orient2d(a2, b2, c2)) * sign(orient2d(a2, b2, d2)) > 0
+    orient2d(a2, b2, c2) * orient2d(a2, b2, d2) > 0
 }
 
 /// The faces of a mesh as non-overlapping triangles over position-welded vertices.
@@ -288,10 +273,8 @@ fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
             // Quick exit: one triangle's free corners strictly on one side of the other's
             // plane, so it touches that plane at the shared corner only.
             let side = |plane: [DVec3; 3], x: DVec3, y: DVec3| {
-                let (sx, sy) = (
-                    sign(orient3d(plane[0], plane[1], plane[2], x)),
-                    sign(orient3d(plane[0], plane[1], plane[2], y)),
-                );
+                let (sx, sy) =
+                    (orient3d(plane[0], plane[1], plane[2], x), orient3d(plane[0], plane[1], plane[2], y));
                 sx * sy > 0
             };
             if side(q, pb, pc) || side(p, qd, qe) {
@@ -366,13 +349,6 @@ mod tests {
 
     fn v(x: f64, y: f64, z: f64) -> DVec3 {
         DVec3::new(x, y, z)
-    }
-
-    #[test]
-    fn orient3d_sign_convention() {
-        assert!(orient3d(DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z) > 0.0);
-        assert!(orient3d(DVec3::ZERO, DVec3::Y, DVec3::X, DVec3::Z) < 0.0);
-        assert_eq!(orient3d(DVec3::ZERO, DVec3::X, DVec3::Y, v(3.0, -7.0, 0.0)), 0.0);
     }
 
     #[test]

@@ -12,12 +12,13 @@
 //! Projection drops the coordinate axis along which the face's normal is largest and
 //! keeps the other two *as they are* (no rotation), so points exactly in the plane keep
 //! their exact f64 coordinates and spade's exact orientation predicates decide on the
-//! input values. The two kept axes are ordered so that the face's own orientation is
+//! input values ([`crate::exact`]). The two kept axes are ordered so that the face's own orientation is
 //! counter-clockwise in 2D.
 
 use glam::{DVec2, DVec3};
 
 use super::Mesh;
+use crate::exact::orient2d;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 /// Why a polygon or a constrained point set could not be triangulated.
@@ -84,16 +85,6 @@ pub fn newell_normal(points: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
     n
 }
 
-/// Exact 2D orientation: positive when a, b, c turn counter-clockwise.
-#[inline]
-pub fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    robust::orient2d(
-        robust::Coord { x: a.x, y: a.y },
-        robust::Coord { x: b.x, y: b.y },
-        robust::Coord { x: c.x, y: c.y },
-    )
-}
-
 /// Triangulates one polygon face (corners in order, counter-clockwise about its normal):
 /// triangles as index triples into `corners`, oriented like the face. Triangles and
 /// convex or simply non-convex quads are split directly; larger polygons and awkward
@@ -107,7 +98,7 @@ pub fn polygon(corners: &[DVec3]) -> Result<Vec<[u32; 3]>, TriangulateError> {
     let proj = Projection::along(normal).ok_or(TriangulateError::Degenerate)?;
     let p: Vec<DVec2> = corners.iter().map(|&c| proj.apply(c)).collect();
     if n == 4 {
-        let ccw = |a: usize, b: usize, c: usize| orient2d(p[a], p[b], p[c]) > 0.0;
+        let ccw = |a: usize, b: usize, c: usize| orient2d(p[a], p[b], p[c]) > 0;
         if ccw(0, 1, 2) && ccw(0, 2, 3) {
             return Ok(vec![[0, 1, 2], [0, 2, 3]]);
         }
@@ -139,7 +130,7 @@ pub fn polygon_or_fan(corners: &[DVec3]) -> Vec<[u32; 3]> {
     };
     let p: Vec<DVec2> = corners.iter().map(|&c| proj.apply(c)).collect();
     let m = p.len();
-    if (0..m).all(|i| orient2d(p[i], p[(i + 1) % m], p[(i + 2) % m]) >= 0.0) {
+    if (0..m).all(|i| orient2d(p[i], p[(i + 1) % m], p[(i + 2) % m]) >= 0) {
         return fan();
     }
     polygon(corners).unwrap_or_else(|_| fan())
@@ -281,6 +272,7 @@ pub fn cdt(points: &[DVec2], outline: &[u32], constraints: &[[u32; 2]]) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::exact::orient2d_approx;
     use crate::mesh::covering::Covering;
     use crate::mesh::procedural;
 
@@ -371,7 +363,7 @@ mod tests {
         assert!(has_edge(1, 6) || has_edge(6, 1));
         assert!(has_edge(6, 4) || has_edge(4, 6));
         let total: f64 =
-            tris.iter().map(|t| orient2d(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize])).sum();
+            tris.iter().map(|t| orient2d_approx(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize])).sum();
         assert_eq!(total, 2.0);
         // Crossing diagonals conflict; through a vertex exactly on both, they are split there.
         assert_eq!(cdt(&p[..6], &[0, 1, 2, 3, 4, 5], &[[0, 3], [2, 5]]), Err(TriangulateError::Crossing));

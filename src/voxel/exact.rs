@@ -1,63 +1,17 @@
-//! Exact geometric predicates on f64 inputs, and the tie rule they decide.
-//!
-//! `orient2d` / `orient3d` come from [`crate::exact`] (a filtered floating-point
-//! determinant, recomputed exactly with expansions when its sign is in doubt).
+//! The voxelizers' tie rule, decided with the shared exact predicates
+//! ([`crate::exact`]).
 //!
 //! **The tie rule.** A voxel centre p on the surface is decided as the point
-//! p + (ε, ε³, ε²) for an infinitesimal ε > 0: pushed first along +x, then +z, then +y.
-//! In a slice (x across, z down, like Vulkan's framebuffer) that is the top-left rule —
-//! a centre on a left edge, or on a horizontal top edge, is in — and along y it is the
-//! half-open interval A.y > y_s ≥ D.y of SPEC §4.2 (a centre on a horizontal face
-//! belongs to what lies above it). Every method, and every exact test, follows it.
+//! p + (ε, ε³, ε²) for an infinitesimal ε > 0: pushed first along +x, then +z, then +y
+//! ([`orient3d_perturbed`], [`orient_yz_perturbed`]). In a slice (x across, z down, like
+//! Vulkan's framebuffer) that is the top-left rule — a centre on a left edge, or on a
+//! horizontal top edge, is in — and along y it is the half-open interval A.y > y_s ≥ D.y
+//! of SPEC §4.2 (a centre on a horizontal face belongs to what lies above it). Every
+//! method, and every exact test, follows it.
 
 use glam::DVec3;
 
-pub use crate::exact::{Sign, orient2d, orient3d};
-
-fn sign_of(x: f64) -> Sign {
-    crate::exact::sign_of(x)
-}
-
-/// The normal (b − a) × (c − a) of a triangle, as exact signs of its components.
-pub fn normal_signs(a: DVec3, b: DVec3, c: DVec3) -> [Sign; 3] {
-    [
-        orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]),
-        orient2d([a.z, a.x], [b.z, b.x], [c.z, c.x]),
-        orient2d([a.x, a.y], [b.x, b.y], [c.x, c.y]),
-    ]
-}
-
-/// Sign of ((b − a) × (c − a)) · (p' − a) for the perturbed point p' = p + (ε, ε³, ε²)
-/// (the tie rule): zero only when the triangle is degenerate.
-pub fn orient3d_perturbed(a: DVec3, b: DVec3, c: DVec3, p: DVec3) -> Sign {
-    match orient3d(a, b, c, p) {
-        0 => {
-            // n·(ε, ε³, ε²): the x component decides, then z, then y.
-            let [nx, ny, nz] = normal_signs(a, b, c);
-            if nx != 0 {
-                nx
-            } else if nz != 0 {
-                nz
-            } else {
-                ny
-            }
-        }
-        s => s,
-    }
-}
-
-/// Sign of (v − u) × (p' − u) in the (y, z) plane for p' = p + (ε³, ε²) in (y, z), the
-/// perturbation of the tie rule seen along x.
-pub fn orient_yz_perturbed(u: DVec3, v: DVec3, p: DVec3) -> Sign {
-    match orient2d([u.y, u.z], [v.y, v.z], [p.y, p.z]) {
-        0 => {
-            // (v.y − u.y)·ε² − (v.z − u.z)·ε³
-            let dy = sign_of(v.y - u.y);
-            if dy != 0 { dy } else { -sign_of(v.z - u.z) }
-        }
-        s => s,
-    }
-}
+use crate::exact::{Sign, orient_yz_perturbed, orient2d, orient3d, orient3d_perturbed};
 
 /// Whether the line through the perturbed p along +x meets triangle abc, and if so
 /// whether the crossing lies ahead (x greater than p's, after perturbation).
@@ -130,33 +84,6 @@ pub fn inside_by_tetras(triangles: &[[DVec3; 3]], apex: DVec3, p: DVec3) -> bool
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::Rng;
-
-    #[test]
-    fn near_degenerate_floats_are_exact() {
-        // d = a + s(b − a) + t(c − a) with dyadic s, t: exactly coplanar, though the
-        // points have full 53-bit mantissas; moving d by one ulp along x gives the sign of n_x.
-        let mut rng = Rng::new(5);
-        for _ in 0..2000 {
-            // Coordinates in [1, 1.25) with full mantissas; every sum below stays in
-            // [0.5, 2), so it is exact, and d − a = ½(b − a) + ¼(c − a) exactly.
-            let a = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 0.25 + 1.0;
-            let b = a + DVec3::new(0.25, 0.5, -0.125);
-            let c = a + DVec3::new(-0.5, 0.125, 0.75);
-            let d = a + DVec3::new(0.0, 0.28125, 0.125);
-            assert_eq!(orient3d(a, b, c, d), 0);
-            let nx = normal_signs(a, b, c)[0];
-            let up = DVec3::new(d.x.next_up(), d.y, d.z);
-            let down = DVec3::new(d.x.next_down(), d.y, d.z);
-            assert_eq!(orient3d(a, b, c, up), nx);
-            assert_eq!(orient3d(a, b, c, down), -nx);
-            assert_eq!(orient3d_perturbed(a, b, c, d), nx);
-        }
-        // Collinear in exact arithmetic despite the rounding of every difference.
-        let t = 1.0 + 1e-3;
-        assert_eq!(orient2d([t, 3.0 * t], [2.0 * t, 6.0 * t], [4.0 * t, 12.0 * t]), 0);
-        assert_eq!(orient2d([t, 3.0 * t], [2.0 * t, 6.0 * t], [4.0 * t, (12.0 * t).next_up()]), 1);
-    }
 
     #[test]
     fn ray_and_tetra_parity_agree_on_a_cube_with_ties() {

@@ -9,10 +9,11 @@
 use glam::DVec3;
 
 use super::error::Result;
-use super::exact::{self, Sign};
+use super::exact;
 use super::grid::Grid;
 use super::solid::Solid;
 use super::volume::{Volume, slab_height, slab_lists, xor_bits};
+use crate::exact::{Sign, orient2d};
 
 /// A row of voxel centres, id j·N + k.
 pub type RowId = u32;
@@ -89,7 +90,7 @@ fn triangle_crossings(
     if js.is_empty() || all_ks.end <= ks.start || all_ks.start >= ks.end {
         return;
     }
-    let nx = exact::orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
+    let nx = orient2d([a.y, a.z], [b.y, b.z], [c.y, c.z]);
     if nx == 0 {
         return;
     }
