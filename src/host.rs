@@ -9,12 +9,60 @@ pub fn available_memory() -> Option<u64> {
     Some(kib * 1024)
 }
 
-/// `Err((need MiB, have MiB))` when `bytes` exceed the available memory.
-pub fn check_available(bytes: u64) -> Result<(), (u64, u64)> {
+/// `Err((need, have MiB))` when `bytes` exceed the available memory. Estimates are
+/// computed with saturating arithmetic: `u64::MAX` bytes means "at least that much" and
+/// prints as such ([`Mib`]).
+pub fn check_available(bytes: u64) -> Result<(), (Mib, u64)> {
     match available_memory() {
-        Some(have) if bytes > have => Err((bytes.div_ceil(1 << 20), have / (1 << 20))),
+        Some(have) if bytes > have => Err((Mib::of(bytes), have / (1 << 20))),
         _ => Ok(()),
     }
+}
+
+/// The estimate-and-refuse check run before anything large is allocated: `Err` saying
+/// "WHAT need(s) about N MiB, but only M MiB are available" when `bytes` (a saturating
+/// estimate) exceed the available memory.
+pub fn check_memory(what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
+    check_available(Mib::saturate(bytes))
+        .map_err(|(need, have)| format!("{what} need about {need} MiB, but only {have} MiB are available"))
+}
+
+/// A memory estimate for messages, in MiB (rounded up). An estimate that reached the
+/// largest byte count (`u64::MAX`, where saturating arithmetic stops) prints as "more
+/// than …" instead of a number that wrapped around.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mib {
+    mib: u64,
+    saturated: bool,
+}
+
+impl Mib {
+    /// `bytes` in MiB; `u64::MAX` means "at least".
+    pub fn of(bytes: u64) -> Mib {
+        Mib { mib: bytes.div_ceil(1 << 20), saturated: bytes == u64::MAX }
+    }
+
+    /// A wide estimate, saturated at `u64::MAX` bytes.
+    pub fn of_wide(bytes: u128) -> Mib {
+        Mib::of(Mib::saturate(bytes))
+    }
+
+    /// A wide byte count as a `u64`, `u64::MAX` when larger.
+    pub fn saturate(bytes: u128) -> u64 {
+        u64::try_from(bytes).unwrap_or(u64::MAX)
+    }
+}
+
+impl std::fmt::Display for Mib {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.saturated { write!(f, "more than {}", self.mib - 1) } else { write!(f, "{}", self.mib) }
+    }
+}
+
+/// `n` for a message, or "more than LIMIT" when an estimate reached `limit`, where
+/// saturating arithmetic stopped counting.
+pub fn count_text(n: u128, limit: u128) -> String {
+    if n >= limit { format!("more than {}", limit - 1) } else { n.to_string() }
 }
 
 /// The CPU's model name, for reports.

@@ -1,5 +1,6 @@
 //! A private temporary folder for the files a helper process reads and writes (the
-//! OpenSubdiv and CGAL helpers), removed with everything in it when dropped.
+//! OpenSubdiv and CGAL helpers), removed with everything in it when dropped — or when
+//! SIGINT, SIGTERM or SIGHUP ends the process ([`crate::output`] keeps the list).
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -17,7 +18,11 @@ impl ScratchDir {
         static COUNTER: AtomicU64 = AtomicU64::new(0);
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
         let path = std::env::temp_dir().join(format!("texgeo-{prefix}-{}-{n}", std::process::id()));
-        std::fs::create_dir_all(&path).map_err(|e| crate::output::Error::new(&path, e))?;
+        crate::output::register(&path, true);
+        if let Err(e) = std::fs::create_dir_all(&path) {
+            crate::output::unregister(&path);
+            return Err(crate::output::Error::new(&path, e));
+        }
         Ok(ScratchDir { path })
     }
 
@@ -35,6 +40,7 @@ impl Drop for ScratchDir {
     fn drop(&mut self) {
         // Best effort: a leftover folder in the temp dir is harmless.
         let _ = std::fs::remove_dir_all(&self.path);
+        crate::output::unregister(&self.path);
     }
 }
 

@@ -274,7 +274,7 @@ pub fn tetra_box_overlap(t: &[DVec3; 4], lo: DVec3, hi: DVec3) -> bool {
 #[error("the TetraGrid's {what} need {need_mib} MiB, but only {have_mib} MiB are available")]
 pub struct TooLarge {
     pub what: &'static str,
-    pub need_mib: u64,
+    pub need_mib: crate::host::Mib,
     pub have_mib: u64,
 }
 
@@ -325,7 +325,7 @@ impl TetraGrid {
         if total >= u32::MAX as usize {
             return Err(TooLarge {
                 what: "lists (more than 2^32 entries)",
-                need_mib: (total as u64 * 4) >> 20,
+                need_mib: crate::host::Mib::of(total as u64 * 4),
                 have_mib: 0,
             });
         }

@@ -171,7 +171,7 @@ impl Drop for Device {
                 let report = allocator.generate_report();
                 if !report.allocations.is_empty() {
                     let names: Vec<_> = report.allocations.iter().map(|a| a.name.as_str()).collect();
-                    eprintln!(
+                    crate::note!(
                         "gpu-allocator: {} allocation(s) leaked at teardown: {}",
                         names.len(),
                         names.join(", ")
@@ -188,7 +188,7 @@ impl Drop for Device {
         if let Some(log) = &self.log {
             let errors = log.take();
             if !errors.is_empty() {
-                eprintln!("Vulkan validation errors at teardown:\n{}", errors.join("\n"));
+                crate::note!("Vulkan validation errors at teardown:\n{}", errors.join("\n"));
                 if !std::thread::panicking() {
                     panic!("{} Vulkan validation error(s) were never reported", errors.len());
                 }
@@ -196,7 +196,7 @@ impl Drop for Device {
         }
         // Leaks and failed frees are bugs: loud under validation (tests), a warning otherwise.
         if !leaks.is_empty() {
-            eprintln!("texgeo: GPU memory problems at teardown:\n{}", leaks.join("\n"));
+            crate::note!("texgeo: GPU memory problems at teardown:\n{}", leaks.join("\n"));
             if self.log.is_some() && !std::thread::panicking() {
                 panic!("{} GPU memory problem(s) at teardown: {}", leaks.len(), leaks.join("; "));
             }
@@ -219,7 +219,7 @@ impl Device {
     pub fn report_problem(&self, problem: String) {
         match self.problems.lock() {
             Ok(mut p) => p.push(problem),
-            Err(_) => eprintln!("texgeo: GPU problem: {problem}"),
+            Err(_) => crate::note!("texgeo: GPU problem: {problem}"),
         }
     }
 

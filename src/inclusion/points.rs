@@ -17,6 +17,7 @@ use rayon::prelude::*;
 
 use crate::mesh::MeshError;
 use crate::mesh::error::Location;
+use crate::mesh::formats::bounded;
 use crate::mesh::formats::text::{Lines, fast, parse_coord};
 
 /// Whether `path` names a NumPy file (by extension).
@@ -24,11 +25,63 @@ pub fn is_npy(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// Reads a point file (`.npy` by extension, text otherwise).
+/// Reads a point file (`.npy` by extension, text otherwise), in bounded blocks that stop
+/// at the first byte the format cannot hold ([`bounded`]).
 pub fn read(path: impl AsRef<Path>) -> Result<Vec<DVec3>, MeshError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
-    if is_npy(path) { parse_npy(&bytes, path) } else { parse(&bytes, path) }
+    if is_npy(path) {
+        let bytes = bounded::read(path, &mut NpyGuard::default())?;
+        parse_npy(&bytes, path)
+    } else {
+        let bytes = bounded::read(path, &mut bounded::Text::new("point-file"))?;
+        parse(&bytes, path)
+    }
+}
+
+/// What [`bounded`] lets through of a `.npy` file: the magic, a text header within
+/// [`bounded::MAX_HEADER`] bytes, then no more data than its shape takes.
+#[derive(Default)]
+struct NpyGuard {
+    /// The file's size once the header is read.
+    size: Option<u64>,
+}
+
+impl bounded::Guard for NpyGuard {
+    fn check(&mut self, bytes: &[u8], _from: usize) -> Result<(), bounded::Stop> {
+        let stop = |at: usize, why: String| bounded::Stop { at: at as u64, why };
+        let magic = b"\x93NUMPY";
+        if !magic.starts_with(&bytes[..bytes.len().min(magic.len())]) {
+            return Err(stop(0, "not a NumPy .npy file (no \\x93NUMPY magic)".into()));
+        }
+        if self.size.is_none() {
+            // Magic, version, header length (2 or 4 bytes), header.
+            let Some(&[major, _]) = bytes.get(6..8) else { return Ok(()) };
+            let (len, start) = match major {
+                1 => (bytes.get(8..10).map(|b| u16::from_le_bytes([b[0], b[1]]) as usize), 10),
+                _ => (bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize), 12),
+            };
+            let Some(len) = len else { return Ok(()) };
+            if len > bounded::MAX_HEADER {
+                return Err(stop(8, format!("a .npy header of {len} bytes (at most {} MiB)", bounded::MAX_HEADER >> 20)));
+            }
+            if bytes.len() < start + len {
+                return Ok(());
+            }
+            let h = npy_header(&bytes[..start + len], Path::new("")).map_err(|e| {
+                stop(start, e.to_string().trim_start_matches(": ").to_string())
+            })?;
+            let items = h.shape.iter().try_fold(1u64, |n, &d| n.checked_mul(d));
+            let size = items.and_then(|n| n.checked_mul(h.size as u64)).and_then(|n| n.checked_add(h.data as u64));
+            self.size = Some(size.ok_or_else(|| stop(start, "the .npy shape is too large".into()))?);
+        }
+        match self.size {
+            Some(size) if bytes.len() as u64 > size => Err(stop(
+                size as usize,
+                format!("more bytes than the .npy shape takes ({size} bytes in all)"),
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Parses point-file text; `path` only names the source in errors.
@@ -73,6 +126,8 @@ enum Source {
         lines_before: usize,
         bytes_before: usize,
         eof: bool,
+        /// Stops at a byte no point file holds, or at an endless line.
+        guard: bounded::Text,
     },
     Whole(Option<Vec<DVec3>>),
 }
@@ -102,6 +157,7 @@ impl PointReader {
                 lines_before: 0,
                 bytes_before: 0,
                 eof: false,
+                guard: bounded::Text::new("point-file"),
             }
         };
         Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1) })
@@ -148,14 +204,19 @@ impl PointReader {
                 }
                 None => (Vec::new(), 0),
             },
-            Source::Text { file, len, buf, filled, spare, lines_before, bytes_before, eof } => loop {
+            Source::Text { file, len, buf, filled, spare, lines_before, bytes_before, eof, guard } => loop {
+                let stopped = |s: bounded::Stop| {
+                    MeshError::parse(path, Location::Byte(s.at), format!("{}; stopped reading", s.why))
+                };
                 if *eof && *filled == 0 {
                     break (Vec::new(), 0);
                 }
                 // A whole line at least (or the end of the file) before parsing.
                 let last_end = buf[..*filled].iter().rposition(|&b| b == b'\n');
                 if !*eof && last_end.is_none() {
+                    let before = *filled;
                     *filled = fill(file, buf, *filled, block_size, *len, *bytes_before, eof).map_err(io)?;
+                    guard.check_at(&buf[..*filled], before, *bytes_before as u64).map_err(stopped)?;
                     continue;
                 }
                 let cut = if *eof { *filled } else { last_end.map_or(*filled, |at| at + 1) };
@@ -182,6 +243,10 @@ impl PointReader {
                         (vec![f(points)], count, lines)
                     }
                 };
+                // The new bytes, after this block's own errors (which come first in the file).
+                let kept = rest.len();
+                guard.shift(cut);
+                guard.check_at(&spare[..next], kept, next_at as u64).map_err(stopped)?;
                 *lines_before += lines;
                 *bytes_before += cut;
                 std::mem::swap(buf, spare);

@@ -152,6 +152,8 @@ impl std::fmt::Display for Solidity {
         }
         writeln!(f)?;
         match self.defects.first() {
+            // No faces: the empty solid, inside nowhere.
+            None if self.shells.is_empty() => write!(f, "solid: yes (empty)"),
             None => write!(f, "solid: yes (inside = winding number 1)"),
             Some(d) => {
                 write!(f, "solid: no: {d}")?;

@@ -53,23 +53,13 @@ impl Picture {
         Some(self.rgba.iter().zip(&other.rgba).map(|(a, b)| a.abs_diff(*b)).max().unwrap_or(0))
     }
 
-    /// Writes the picture as a PNG: to a temporary file beside `path`, then renamed, so
-    /// `path` never holds half a picture.
+    /// Writes the picture as a PNG atomically ([`crate::output`]): `path` never holds
+    /// half a picture.
     pub fn save_png(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
-        let io = |source: std::io::Error| RenderError::Io { path: path.to_path_buf(), source };
-        let name = path.file_name().ok_or_else(|| io(std::io::Error::other("not a file name")))?;
-        let tmp = path.with_file_name(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
         let image = image::RgbaImage::from_raw(self.width, self.height, self.rgba.clone())
             .ok_or_else(|| RenderError::Usage("picture size".into()))?;
-        let written = image
-            .save_with_format(&tmp, image::ImageFormat::Png)
-            .map_err(|e| io(std::io::Error::other(e)))
-            .and_then(|()| std::fs::rename(&tmp, path).map_err(io));
-        if written.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        written
+        crate::output::write_png(path, &image)
+            .map_err(|e| RenderError::Io { path: e.path, source: e.error })
     }
 
     /// Reads a PNG (any colour type) as RGBA8.

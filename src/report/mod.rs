@@ -25,7 +25,7 @@ pub struct Log(pub &'static str);
 
 impl Progress for Log {
     fn step(&mut self, what: &str) {
-        eprintln!("{}: {what}", self.0);
+        crate::note!("{}: {what}", self.0);
     }
 }
 

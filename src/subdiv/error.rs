@@ -20,7 +20,7 @@ pub enum SubdivError {
     #[error(
         "level {level} needs about {need_mib} MiB but only {have_mib} MiB are available; use a lower level"
     )]
-    Memory { level: u32, need_mib: u64, have_mib: u64 },
+    Memory { level: u32, need_mib: crate::host::Mib, have_mib: u64 },
     /// The fragment-mesh path cannot represent this input or stream (SPEC §5.2).
     #[error("fragment mesh: {0}")]
     Fragment(String),

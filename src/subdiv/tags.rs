@@ -87,7 +87,7 @@ pub fn read(path: impl AsRef<Path>) -> Result<Tagged> {
             ignored: Vec::new(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
+    let bytes = formats::read_file(path, formats::Format::Obj)?;
     read_obj(&bytes, path)
 }
 
@@ -97,9 +97,6 @@ pub fn read_obj(bytes: &[u8], path: &Path) -> Result<Tagged> {
         return Err(MeshError::parse(path, Location::File, "the file is empty").into());
     }
     let (mesh, map) = formats::obj::read_mapped(bytes, path)?;
-    if mesh.num_faces() == 0 {
-        return Err(MeshError::parse(path, Location::File, "the file holds no faces").into());
-    }
     // The reader has checked the text is UTF-8.
     let text = String::from_utf8_lossy(bytes);
     let mut parser = Parser::new(path, &mesh, &map);

@@ -68,21 +68,8 @@ impl SweepError {
     }
 }
 
-/// Writes `bytes` to `path` whole or not at all: a temporary file in the same folder,
-/// synced, then renamed over `path`.
+/// Writes `bytes` to `path` whole or not at all, synced to the disk
+/// ([`crate::output::write_bytes_durable`]).
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    use std::io::Write as _;
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(|e| SweepError::io(path, e))
+    crate::output::write_bytes_durable(path, bytes).map_err(|e| SweepError::Io { path: e.path, source: e.error })
 }

@@ -146,7 +146,7 @@ impl App {
         let handle = window.window_handle().map_err(|e| ViewError::Window(e.to_string()))?.as_raw();
         let (ctx, surface) = Context::for_window(&self.options.context, display, handle)?;
         self.window = Some(window);
-        println!("device: {}", ctx.info().label());
+        crate::say!("device: {}", ctx.info().label());
         let content = self.content.take().ok_or_else(|| ViewError::Usage("nothing to show".into()))?;
         let model = Model::new(&ctx, content, self.options.level, self.options.look, self.options.aspect)?;
         let renderer = Renderer::new(&ctx, self.options.samples)?;
@@ -185,18 +185,18 @@ impl App {
                 if level != model.level {
                     match model.set_level(&gfx.ctx, level) {
                         Ok(line) => {
-                            println!("{line}");
+                            crate::say!("{line}");
                             self.dirty = true;
                         }
                         // A level that does not fit is a message, not the end of the session.
                         Err(e @ (RenderError::Usage(_) | RenderError::Subdiv(_))) => {
-                            eprintln!("texgeo view: {e}")
+                            crate::note!("texgeo view: {e}")
                         }
                         Err(e) => return Err(e.into()),
                     }
                 }
             }
-            '+' | '-' => println!("no subdivision levels for this content"),
+            '+' | '-' => crate::say!("no subdivision levels for this content"),
             'v' if !model.is_voxels() => {
                 model.look.valence = !model.look.valence;
                 self.dirty = true;
@@ -332,11 +332,11 @@ impl App {
                     self.shots += 1;
                 };
                 picture.save_png(&path)?;
-                println!("wrote {}", path.display());
+                crate::say!("wrote {}", path.display());
             }
             if let (true, Some(path)) = (last, &self.options.screenshot) {
                 picture.save_png(path)?;
-                println!("wrote {} ({w}×{h})", path.display());
+                crate::say!("wrote {} ({w}×{h})", path.display());
             }
         }
         Ok(true)
@@ -388,7 +388,7 @@ impl App {
         }
         teardown?;
         if let Some(path) = saved? {
-            println!("wrote {}", path.display());
+            crate::say!("wrote {}", path.display());
         }
         Ok(())
     }

@@ -11,6 +11,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::error::{Result, VoxelError};
+use crate::mesh::MeshError;
+use crate::mesh::formats::bounded;
 use super::grid::{Grid, MAX_RES};
 use super::scanline;
 use super::solid::Solid;
@@ -298,11 +300,66 @@ fn transpose64(a: &mut [u64; 64]) {
     }
 }
 
-/// Reads a binvox file (cubic, N ≤ [`MAX_RES`]).
+/// Reads a binvox file (cubic, N ≤ [`MAX_RES`]), in bounded blocks that stop at the
+/// first byte a binvox file cannot hold ([`bounded`]).
 pub fn read(path: impl AsRef<Path>) -> Result<(Grid, Volume)> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| VoxelError::io(path, e))?;
+    let bytes = bounded::read(path, &mut Guard::default()).map_err(|e| match e {
+        MeshError::Io { path, error } => VoxelError::io(path, error),
+        other => VoxelError::Binvox { path: path.to_path_buf(), message: other.to_string() },
+    })?;
     from_bytes(&bytes, path)
+}
+
+/// What [`bounded`] lets through of a binvox file: a text header starting with `#binvox`
+/// and ending with the line `data`, then (value, count) runs with value 0 or 1 and count
+/// at least 1 that cover no more than the dim³ voxels.
+struct Guard {
+    header: bounded::Header,
+    /// Voxels of the volume (from the `dim` line) and voxels covered by the runs so far.
+    voxels: u64,
+    covered: u64,
+    /// The next run to check starts here.
+    run: usize,
+}
+
+impl Default for Guard {
+    fn default() -> Guard {
+        Guard { header: bounded::Header::new("a binvox header's", b"data"), voxels: 0, covered: 0, run: 0 }
+    }
+}
+
+impl bounded::Guard for Guard {
+    fn check(&mut self, bytes: &[u8], from: usize) -> std::result::Result<(), bounded::Stop> {
+        let stop = |at: usize, why: String| bounded::Stop { at: at as u64, why };
+        if self.header.header_end.is_none() {
+            if !b"#binvox".starts_with(&bytes[..bytes.len().min(7)]) {
+                return Err(stop(0, "not a binvox file (it must start with '#binvox')".into()));
+            }
+            self.header.check(bytes, from)?;
+            let Some(end) = self.header.header_end else { return Ok(()) };
+            let dim = bytes[..end].split(|&b| b == b'\n').find_map(|l| {
+                let l = std::str::from_utf8(l).ok()?.trim();
+                l.strip_prefix("dim")?.split_whitespace().next()?.parse::<u64>().ok()
+            });
+            self.voxels = dim.filter(|&d| d <= MAX_RES as u64).map_or(0, |d| d * d * d);
+            self.run = end;
+        }
+        while let Some(&[value, count]) = bytes.get(self.run..self.run + 2) {
+            if value > 1 || count == 0 {
+                return Err(stop(
+                    self.run,
+                    format!("a run of value {value} and count {count} (runs are a value 0 or 1 and a count ≥ 1)"),
+                ));
+            }
+            self.covered += u64::from(count);
+            if self.covered > self.voxels {
+                return Err(stop(self.run, format!("the runs cover more than the {} voxels of its dim", self.voxels)));
+            }
+            self.run += 2;
+        }
+        Ok(())
+    }
 }
 
 /// Decodes a binvox file held in memory; `path` only names it in errors.

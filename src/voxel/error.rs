@@ -15,7 +15,7 @@ pub enum VoxelError {
     Resolution { res: usize, max: usize, why: String },
     /// The request needs more memory than is available (checked before allocating).
     #[error("{what} at resolution {res} needs {need_mib} MiB, but only {have_mib} MiB are available")]
-    Memory { what: String, res: usize, need_mib: u64, have_mib: u64 },
+    Memory { what: String, res: usize, need_mib: crate::host::Mib, have_mib: u64 },
     /// The mesh cannot be voxelized (empty, flat, not closed).
     #[error("cannot voxelize this mesh: {0}")]
     Mesh(String),

@@ -27,13 +27,14 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// The grid over the bounding cube of `mesh`.
+    /// The grid over the bounding cube of `mesh`. A mesh without faces (an empty solid)
+    /// gets the unit cube at its lowest corner: every cube holds none of it.
     pub fn for_mesh(mesh: &Mesh, n: usize) -> Result<Grid> {
         check_resolution(n)?;
-        if mesh.num_faces() == 0 {
-            return Err(VoxelError::Mesh("the mesh has no faces".into()));
-        }
         let (lo, hi) = mesh.bounds();
+        if mesh.num_faces() == 0 {
+            return Ok(Grid { n, min: lo, side: 1.0 });
+        }
         let side = (hi - lo).max_element();
         if side.is_nan() || side <= 0.0 || !side.is_finite() {
             return Err(VoxelError::Mesh(format!("its bounding box {lo} .. {hi} has no extent")));
@@ -89,7 +90,9 @@ pub fn check_resolution(n: usize) -> Result<()> {
             res: n,
             max: MAX_RES,
             why: if n > MAX_RES {
-                format!(" (a {n}³ bit volume alone would take {} MiB)", (n as u64).pow(3) / 8 / (1 << 20))
+                // n³ / 8 bytes, saturated: n can be as large as usize::MAX.
+                let bytes = (n as u128).saturating_mul(n as u128).saturating_mul(n as u128) / 8;
+                format!(" (a {n}³ bit volume alone would take {} MiB)", crate::host::Mib::of_wide(bytes))
             } else {
                 String::new()
             },

@@ -240,6 +240,12 @@ impl Voxelizer {
     pub fn run(&mut self, solid: &Solid, grid: &Grid, method: Method) -> Result<Voxelization> {
         let start = Instant::now();
         let mut timings = Timings::default();
+        if solid.triangles.is_empty() {
+            // The empty solid: no voxel is inside, whatever the method (nothing to draw).
+            let volume = Volume::new(grid.n)?;
+            timings.total = start.elapsed();
+            return Ok(Voxelization { grid: *grid, volume, band: BandReport::default(), timings });
+        }
         let (volume, band) = match method {
             Method::Cpu => {
                 let t = Instant::now();

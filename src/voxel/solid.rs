@@ -26,11 +26,8 @@ pub struct Solid {
 impl Solid {
     /// The covering of `mesh`, which must be closed and consistently oriented: every
     /// directed edge a→b needs a twin b→a (non-manifold edges are fine as long as they
-    /// pair up).
+    /// pair up). A mesh without faces is the empty solid (no triangles).
     pub fn new(mesh: &Mesh) -> Result<Solid> {
-        if mesh.num_faces() == 0 {
-            return Err(VoxelError::Mesh("the mesh has no faces".into()));
-        }
         let covering = Covering::new(mesh);
         if let Some(e) = covering.unbalanced_edge() {
             return Err(VoxelError::Mesh(format!(

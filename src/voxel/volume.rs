@@ -32,7 +32,7 @@ impl Volume {
         words.try_reserve_exact(len).map_err(|_| VoxelError::Memory {
             what: "the bit volume".into(),
             res: n,
-            need_mib: (len as u64 * 8).div_ceil(1 << 20),
+            need_mib: crate::host::Mib::of(len as u64 * 8),
             have_mib: 0,
         })?;
         words.resize(len, 0);

@@ -28,6 +28,30 @@ pub fn positive_u32(s: &str) -> Result<u32, String> {
     }
 }
 
+/// The most worker threads `--threads` (and `bench scale --thread-counts`) take: starting
+/// a pool costs more than linear time in its size, and beyond a few threads per core
+/// nothing is gained.
+pub const MAX_THREADS: usize = 1024;
+
+/// A thread count: 1 ..= [`MAX_THREADS`].
+pub fn threads(s: &str) -> Result<usize, String> {
+    match s.parse::<u128>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(v) if v > MAX_THREADS as u128 => Err(format!("{s} is more than the {MAX_THREADS} threads texgeo starts")),
+        Ok(v) => Ok(v as usize),
+        Err(_) => Err(format!("'{s}' is not a whole number of threads (1 to {MAX_THREADS})")),
+    }
+}
+
+/// Seconds as a duration: a finite number in `0 < s ≤ max` (so it always converts).
+pub fn seconds(s: &str, max: f64) -> Result<std::time::Duration, String> {
+    let v: f64 = s.parse().map_err(|_| format!("'{s}' is not a number of seconds"))?;
+    if !(v > 0.0 && v <= max) {
+        return Err(format!("{s} is outside 0 < seconds ≤ {max}"));
+    }
+    Ok(std::time::Duration::from_secs_f64(v))
+}
+
 /// `--threads N`: the size of the global pool every parallel step runs in (default: every
 /// core). Results never depend on it.
 pub fn use_threads(threads: Option<usize>) -> anyhow::Result<()> {

@@ -64,7 +64,7 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
-    /// Issue 13 at scale: inclusion at 1 k / 100 k / 1 M points (every method, `auto`
+    /// Inclusion and voxelization at scale: inclusion at 1 k / 100 k / 1 M points (every method, `auto`
     /// included) and voxelization at 128³ … 1024³, time and peak memory per method and
     /// thread count; point-file and label throughput.
     Scale {
@@ -89,12 +89,12 @@ pub enum Command {
         /// Voxelization methods (default: all).
         #[arg(long, value_delimiter = ',', value_enum)]
         voxel_methods: Vec<texgeo::voxel::Method>,
-        /// Pool sizes to measure (default: 1 and every core).
-        #[arg(long, value_delimiter = ',', value_parser = crate::args::positive_usize)]
+        /// Pool sizes to measure (default: 1 and every core; at most 1024).
+        #[arg(long, value_delimiter = ',', value_parser = crate::args::threads)]
         thread_counts: Vec<usize>,
-        /// Skip a measurement predicted to take longer than this many seconds.
-        #[arg(long, default_value_t = 60)]
-        budget: u64,
+        /// Skip a measurement predicted to take longer than this many seconds (at most 10⁶).
+        #[arg(long, default_value = "60", value_parser = |s: &str| crate::args::seconds(s, 1e6))]
+        budget: std::time::Duration,
         #[arg(long, default_value_t = 3, value_parser = crate::args::positive_usize)]
         /// Timed runs per measurement (the median is reported).
         runs: usize,
@@ -183,7 +183,7 @@ impl Models {
             if spec.starts_with("builtin:") || std::path::Path::new(&path).exists() {
                 out.push((thesis, spec.to_string(), crate::mesh::load(&path)?));
             } else {
-                eprintln!(
+                note!(
                     "texgeo: {path} not found (run tools/fetch-models); skipping the {thesis} stand-in"
                 );
             }
@@ -202,12 +202,60 @@ pub struct Common {
     out: PathBuf,
 }
 
+/// Bytes per triangle of a Boolean in the scaling series (both operands, their
+/// intersections, classification and result), generously.
+const BOOLEAN_BYTES_PER_TRIANGLE: u128 = 4096;
+
+/// Refuses, before the device opens, a size whose memory the machine does not have (the
+/// same estimate-and-refuse check as the commands').
+fn check_memory(what: String, bytes: u128) -> anyhow::Result<()> {
+    texgeo::host::check_memory(what, bytes).map_err(anyhow::Error::msg)
+}
+
 fn finish(report: Report, common: &Common) -> anyhow::Result<()> {
     say!("{}", report.to_markdown());
     for f in report.write(&common.out)? {
-        eprintln!("wrote {}", f.display());
+        note!("wrote {}", f.display());
     }
     Ok(())
+}
+
+/// Every size that drives an allocation, checked before anything is measured.
+fn check_sizes(cmd: &Command) -> anyhow::Result<()> {
+    match cmd {
+        Command::Inclusion { sets, points, .. } => {
+            crate::inclusion::check_size((*sets as u64).saturating_mul(*points as u64), false, false)
+        }
+        Command::Scale { points, .. } => {
+            points.iter().try_for_each(|&n| crate::inclusion::check_size(n as u64, false, false))
+        }
+        Command::Boolean { scaling, .. } => scaling.iter().try_for_each(|&n| {
+            // Sphere operands: about n/8 vertices each, indexed by 32 bits.
+            anyhow::ensure!(
+                n as u128 / 8 < u128::from(u32::MAX),
+                "--scaling {n}: more triangles than 32-bit vertex indices allow"
+            );
+            check_memory(format!("--scaling {n}: two {n}-triangle operands"), n as u128 * BOOLEAN_BYTES_PER_TRIANGLE)
+        }),
+        Command::Xor { sizes, triangles, .. } => {
+            anyhow::ensure!(
+                (*triangles as u128) * 3 <= u128::from(u32::MAX),
+                "--triangles {triangles}: more vertices than one draw takes (at most {} triangles)",
+                u32::MAX / 3
+            );
+            sizes.iter().try_for_each(|&n| {
+                // Triangles twice (list and vertex buffer) and three n² words (the CPU
+                // reference, the target, its readback).
+                let bytes = *triangles as u128 * 48 + 12 * u128::from(n) * u128::from(n);
+                check_memory(format!("{triangles} triangles into a {n}² target"), bytes)
+            })
+        }
+        Command::Reduce { sizes, .. } => sizes.iter().try_for_each(|&n| {
+            // An RGBA32F texture, its data and the ping-pong targets (a third of it).
+            check_memory(format!("a {n}² reduction"), 16 * u128::from(n) * u128::from(n) * 3)
+        }),
+        Command::Voxelize { .. } | Command::Subdivide { .. } => Ok(()),
+    }
 }
 
 pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
@@ -220,6 +268,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
         | Command::Boolean { common, .. } => &common.out,
     };
     texgeo::output::check_dir(out)?;
+    check_sizes(&cmd)?;
     let ctx = crate::open_context(device)?;
     match cmd {
         Command::Inclusion { models, sets, points, resolutions, out } => {
@@ -296,7 +345,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
                 voxel_methods,
                 threads: thread_counts,
                 runs,
-                budget: std::time::Duration::from_secs(budget),
+                budget,
             };
             finish(bench::scale::run(&ctx, &inclusion, &voxel, &cfg)?, &Common { runs, out })
         }

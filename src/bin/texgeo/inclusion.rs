@@ -72,7 +72,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
     let mesh = solid.mesh;
     if solid.flipped {
-        eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
+        note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     let mut source = match (&args.points, args.random) {
         (Some(file), _) => points::PointReader::open(file)?,
@@ -95,7 +95,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let t = Instant::now();
     let (method, options, choice) = resolve(args.method, &mesh, &options);
     if let Some(choice) = &choice {
-        eprintln!(
+        note!(
             "texgeo: --method auto: {choice} for {} faces and {} points",
             mesh.num_faces(),
             options.points
@@ -105,7 +105,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
     let build = t.elapsed();
     if solid.open {
-        eprintln!(
+        note!(
             "texgeo: warning: {} is not closed; points are classified by the generalized winding number",
             args.mesh
         );
@@ -196,13 +196,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
 }
 
 /// Refuses, before any work, a point count whose memory exceeds what is available; the
-/// message gives the estimate and the size of the output text.
-fn check_size(count: u64, from_file: bool, to_file: bool) -> anyhow::Result<()> {
+/// message gives the estimate and the size of the output text. Also what `bench
+/// inclusion` and `bench scale` check their point counts with.
+pub fn check_size(count: u64, from_file: bool, to_file: bool) -> anyhow::Result<()> {
     let bytes = count.saturating_mul(BYTES_PER_POINT);
     if let Err((need, have)) = texgeo::host::check_available(bytes) {
         let what = if from_file { "the points of that file (at most)" } else { "that many points" };
-        let text =
-            if to_file { format!("; -o would be {} MiB of text", (count * 2) >> 20) } else { String::new() };
+        let text = if to_file {
+            format!("; -o would be {} MiB of text", texgeo::host::Mib::of(count.saturating_mul(2)))
+        } else {
+            String::new()
+        };
         anyhow::bail!(
             "{count} points: {what} need about {need} MiB of memory, but only {have} MiB are available{text}"
         );

@@ -34,7 +34,7 @@ fn print(d: &DeviceInfo) {
         yes(d.push_descriptor)
     );
     if !d.masked.is_empty() {
-        println!("masked by TEXGEO_MASK_FEATURES: {}", d.masked.join(", "));
+        say!("masked by TEXGEO_MASK_FEATURES: {}", d.masked.join(", "));
     }
 }
 

@@ -1,16 +1,13 @@
 //! The `texgeo` command line. Errors print one message and exit with status 2 (a failed
 //! `--validate` comparison exits with status 1). Every output file is written atomically
-//! ([`texgeo::output`]) after its path was checked, before any work; a closed stdout
-//! (`texgeo … | head`) only loses the printed lines.
+//! ([`texgeo::output`]) after its path was checked, before any work; SIGINT, SIGTERM and
+//! SIGHUP remove the temporary files of unfinished outputs. Every message goes through
+//! [`texgeo::terminal`]: control bytes from files are escaped, and a closed stdout or
+//! stderr (`texgeo … 2>&1 | head`) only loses the printed lines.
 
-/// `println!` that tolerates a closed stdout: printing is a courtesy, the work and the
-/// output files still get done.
-macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
-}
+// `say!` (stdout) and `note!` (stderr): see `texgeo::terminal`.
+#[macro_use]
+extern crate texgeo;
 
 mod args;
 mod bench;
@@ -40,9 +37,9 @@ struct Cli {
     /// Default: TEXGEO_DEVICE, else the first GPU, else lavapipe.
     #[arg(long, global = true, value_name = "NAME|INDEX")]
     device: Option<String>,
-    /// Worker threads for every command's CPU work (default: every core); the output is the
-    /// same for any count.
-    #[arg(long, global = true, value_name = "N", value_parser = args::positive_usize)]
+    /// Worker threads for every command's CPU work (default: every core; at most 1024); the
+    /// output is the same for any count.
+    #[arg(long, global = true, value_name = "N", value_parser = args::threads)]
     threads: Option<usize>,
     #[command(subcommand)]
     command: Command,
@@ -116,14 +113,19 @@ fn main() {
                 .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
                 .filter(|l| !l.is_empty())
                 .collect();
-            eprintln!("texgeo: error: {} (see --help)", parts.join(" ").trim_start_matches("error: "));
+            note!("texgeo: error: {} (see --help)", parts.join(" ").trim_start_matches("error: "));
             std::process::exit(2);
         }
     };
     let device = cli.device.as_deref();
     if let Err(e) = args::use_threads(cli.threads) {
-        eprintln!("texgeo: error: {}", one_line(&e));
+        note!("texgeo: error: {}", one_line(&e));
         std::process::exit(2);
+    }
+    // Without it an interrupted write leaves its temporary file (removed by the next run
+    // of the same output, which is all that is lost).
+    if let Err(e) = texgeo::output::remove_temporaries_on_signals() {
+        note!("texgeo: warning: no signal handler ({e}); Ctrl-C may leave temporary files");
     }
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
@@ -140,7 +142,7 @@ fn main() {
         Command::Boolean(a) => boolean::run(device, a),
     };
     if let Err(e) = result {
-        eprintln!("texgeo: error: {}", one_line(&e));
+        note!("texgeo: error: {}", one_line(&e));
         std::process::exit(2);
     }
 }

@@ -107,8 +107,9 @@ fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
     let c = Covering::new(m);
     let (lo, hi) = m.bounds();
     say!("bounding box           {lo} .. {hi}");
-    say!("area                   {}", solidity.area);
-    match solidity.volume {
+    // + 0.0: an empty sum is −0.
+    say!("area                   {}", solidity.area + 0.0);
+    match solidity.volume.map(|v| v + 0.0) {
         Some(v) => {
             say!("volume                 {v} (signed tetrahedra, Alg. 3-1)");
             if let Some(g) = c.centroid() {

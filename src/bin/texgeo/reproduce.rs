@@ -112,7 +112,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         outcome.verdicts[2]
     );
     for d in &outcome.disagreements {
-        eprintln!("texgeo: warning: answers differ from the reference: {d}");
+        note!("texgeo: warning: answers differ from the reference: {d}");
     }
     if !outcome.failures.is_empty() {
         let list: Vec<String> = outcome.failures.iter().map(|(k, e)| format!("{k}: {e}")).collect();

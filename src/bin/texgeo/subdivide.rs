@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use texgeo::host::{Mib, count_text};
 use texgeo::mesh::{Mesh, formats};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::gpu::{Options, Run, Subdivider};
@@ -136,18 +137,24 @@ fn describe_gpu(run: &Run) {
     );
 }
 
+/// Counts at or above this are "more than 2^64 − 1" (the estimate stops there).
+const COUNT_LIMIT: u128 = 1 << 64;
+
 /// Exact vertex, face and edge counts after `level` Catmull-Clark steps: one step makes
 /// V + E + F vertices, Σ degrees quads and 2E + Σ degrees edges, whatever the mesh.
+/// Counts stop at [`COUNT_LIMIT`].
 fn refined_counts(mesh: &Mesh, level: u32) -> (u128, u128, u128) {
     let r = mesh.report();
     let corners: usize = mesh.faces().map(<[u32]>::len).sum();
     let (mut v, mut f, mut e) = ((r.vertices - r.unused_vertices) as u128, r.faces as u128, r.edges as u128);
     let mut c = corners as u128;
     for _ in 0..level {
-        (v, f, e, c) = (v + e + f, c, 2 * e + c, 4 * c);
-        if v > u64::MAX as u128 {
+        let next = [v + e + f, c, 2 * e + c, 4 * c].map(|x| x.min(COUNT_LIMIT));
+        // Saturated or unchanged (no faces): every further level is the same.
+        if next == [v, f, e, c] {
             break;
         }
+        [v, f, e, c] = next;
     }
     (v, f, e)
 }
@@ -163,21 +170,20 @@ fn check_size(
 ) -> anyhow::Result<()> {
     let (v, f, e) = refined_counts(mesh, level);
     let text = match output {
-        Some(p) => format!("; {} would be about {} MiB", p.display(), (60 * v + 30 * f) >> 20),
+        Some(p) => format!("; {} would be about {} MiB", p.display(), Mib::of_wide(60 * v + 30 * f)),
         None => String::new(),
     };
+    let (vs, fs) = (count_text(v, COUNT_LIMIT), count_text(f, COUNT_LIMIT));
     if v >= u64::from(u32::MAX) as u128 || 4 * f >= u64::from(u32::MAX) as u128 {
-        anyhow::bail!(
-            "level {level} would have {v} vertices and {f} faces, more than 32-bit indices hold{text}"
-        );
+        anyhow::bail!("level {level} would have {vs} vertices and {fs} faces, more than 32-bit indices hold{text}");
     }
     // The last level and the mesh built from it (as `cpu::refine` counts them), and for
     // the GPU two RGBA32F targets and a readback, fragments overlapping by up to 2×.
     let gpu = if method == Method::Gpu { 3 * 16 * 2 * v } else { 0 };
     let bytes = 48 * v + 64 * f + 9 * e + gpu;
-    if let Err((need, have)) = texgeo::host::check_available(bytes.min(u64::MAX as u128) as u64) {
+    if let Err((need, have)) = texgeo::host::check_available(Mib::saturate(bytes)) {
         anyhow::bail!(
-            "level {level} ({v} vertices, {f} faces) needs about {need} MiB, but only {have} MiB are available{text}; \
+            "level {level} ({vs} vertices, {fs} faces) needs about {need} MiB, but only {have} MiB are available{text}; \
              use a lower level"
         );
     }

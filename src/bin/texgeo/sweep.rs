@@ -50,9 +50,10 @@ struct RunArgs {
     /// Worker processes running meshes in parallel.
     #[arg(long, short, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=256))]
     jobs: u16,
-    /// Seconds one mesh may take before its worker is killed and the mesh recorded as a timeout.
-    #[arg(long, value_name = "SECONDS", default_value_t = 600.0)]
-    timeout: f64,
+    /// Seconds one mesh may take before its worker is killed and the mesh recorded as a
+    /// timeout (more than 0, at most 10⁷: about four months).
+    #[arg(long, value_name = "SECONDS", default_value = "600", value_parser = |s: &str| crate::args::seconds(s, 1e7))]
+    timeout: Duration,
     /// Address-space limit of each worker, MiB (a mesh that needs more is recorded as out of memory).
     #[arg(long, value_name = "MIB")]
     memory_limit: Option<u64>,
@@ -124,8 +125,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
 
 fn run_merge(dir: &std::path::Path) -> anyhow::Result<()> {
     let (merged, out) = merge::merge(dir)?;
-    println!("{}", counts_line(&merged));
-    println!("wrote {}, {}, {}", out.csv.display(), out.summary.display(), out.plot.display());
+    say!("{}", counts_line(&merged));
+    say!("wrote {}, {}, {}", out.csv.display(), out.summary.display(), out.plot.display());
     Ok(())
 }
 
@@ -170,9 +171,6 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
     let (Some(manifest_path), Some(task), Some(dir)) = (&a.manifest, a.task, &a.output) else {
         anyhow::bail!("give MANIFEST, --task and -o DIR");
     };
-    if !(a.timeout.is_finite() && a.timeout > 0.0) {
-        anyhow::bail!("--timeout must be a positive number of seconds");
-    }
     let manifest = Manifest::read(manifest_path)?;
     let options = task.options(&options(&a)?).map_err(SweepError::Options)?;
     let program = std::env::current_exe().context("finding the texgeo binary for the workers")?;
@@ -180,7 +178,7 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
         task,
         options: options.clone(),
         device: device.map(str::to_string),
-        timeout: Duration::from_secs_f64(a.timeout),
+        timeout: a.timeout,
         jobs: usize::from(a.jobs),
         memory_limit_mib: a.memory_limit,
         program,
@@ -203,7 +201,7 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
     let mine: Vec<_> = manifest.shard(a.shard).collect();
     let pending: Vec<_> = mine.iter().copied().filter(|e| !done.contains(&e.index)).collect();
     let jobs = plan.jobs_for(pending.iter().copied()).map_err(|(_, m)| SweepError::Options(m))?;
-    println!(
+    say!(
         "sweep {task} over {}: shard {} has {} meshes, {} already recorded, {} to run on {} worker(s)",
         manifest_path.display(),
         a.shard,
@@ -219,10 +217,10 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
         results.append(&r)?;
         n += 1;
         let why = if r.reason.is_empty() { String::new() } else { format!(" ({})", r.reason) };
-        println!("[{n}/{total}] {}: {}{why} {:.1} ms", r.mesh, r.outcome, r.total_ms().unwrap_or(0.0));
+        say!("[{n}/{total}] {}: {}{why} {:.1} ms", r.mesh, r.outcome, r.total_ms().unwrap_or(0.0));
         Ok(())
     })?;
-    println!(
+    say!(
         "shard {} done in {:.1} s; results in {}",
         a.shard,
         start.elapsed().as_secs_f64(),

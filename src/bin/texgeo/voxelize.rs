@@ -71,7 +71,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let policy = Policy { flip_inverted: args.flip_inverted, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--flip-inverted"])?;
     if solid.flipped {
-        eprintln!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
+        note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     let mesh = solid.mesh;
     let grid = Grid::for_mesh(&mesh, args.res)?;
@@ -91,7 +91,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                 choice = Plan::choose(counts, kind, threads);
                 opened = Some(ctx);
             }
-            eprintln!("texgeo: --method auto: {}", choice.describe());
+            note!("texgeo: --method auto: {}", choice.describe());
             choice.method
         }
     };

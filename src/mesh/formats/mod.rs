@@ -1,7 +1,12 @@
 //! Mesh file formats. Readers never panic and never return a half-read mesh: a file is
 //! either read whole and checked, or rejected with an error naming file, line (or byte
 //! offset) and the problem. No allocation is sized from a count the file claims before
-//! the data behind it has been seen.
+//! the data behind it has been seen, and a file is read in bounded blocks that stop at the
+//! first byte the format cannot hold ([`bounded`]): a pipe or a device that never ends is
+//! refused, not read forever.
+//!
+//! A well-formed file without faces is a valid empty mesh (texgeo writes one for an empty
+//! result in every format); only a file without any bytes is refused.
 //!
 //! | format | read | write |
 //! |---|---|---|
@@ -14,6 +19,7 @@ use std::path::Path;
 
 use super::{Mesh, MeshError, Result, error::Location};
 
+pub mod bounded;
 pub mod obj;
 pub mod off;
 pub mod ply;
@@ -54,28 +60,35 @@ impl Format {
 pub fn read(path: impl AsRef<Path>) -> Result<Mesh> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
+    let bytes = read_file(path, format)?;
     read_bytes(&bytes, format, path)
+}
+
+/// The bytes of a mesh file, read in bounded blocks that stop where the format cannot go
+/// on ([`bounded`]).
+pub fn read_file(path: &Path, format: Format) -> Result<Vec<u8>> {
+    match format {
+        Format::Obj => bounded::read(path, &mut bounded::Text::new("OBJ")),
+        Format::Off => bounded::read(path, &mut bounded::Text::new("OFF")),
+        Format::Ply => bounded::read(path, &mut ply::Guard::default()),
+        Format::Stl => bounded::read(path, &mut stl::Guard::default()),
+    }
 }
 
 /// Reads a mesh from memory; `path` is only used to name the source in errors.
 ///
-/// An empty file, and a file that holds no faces, are errors: every texgeo algorithm
-/// needs faces, and a mesh without them almost always means the wrong file.
+/// An empty file is an error (no format allows it); a file that holds no faces is a
+/// valid empty mesh (no faces, any unused vertices it lists).
 pub fn read_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<Mesh> {
     if bytes.is_empty() {
         return Err(MeshError::parse(path, Location::File, "the file is empty"));
     }
-    let mesh = match format {
+    match format {
         Format::Obj => obj::read(bytes, path),
         Format::Off => off::read(bytes, path),
         Format::Ply => ply::read(bytes, path),
         Format::Stl => stl::read(bytes, path),
-    }?;
-    if mesh.num_faces() == 0 {
-        return Err(MeshError::parse(path, Location::File, "the file holds no faces"));
     }
-    Ok(mesh)
 }
 
 /// Writes a mesh, choosing the format from the file extension. The file is written

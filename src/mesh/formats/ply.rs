@@ -517,6 +517,52 @@ fn layout(header: &Header, path: &Path) -> Result<Layout> {
     Ok(Layout { vertex, xyz, face })
 }
 
+/// What [`super::bounded`] lets through of a PLY file: a text header that starts with
+/// the line `ply` and ends with `end_header` within [`super::bounded::MAX_HEADER`] bytes,
+/// then text again for `format ascii` (binary data is bounded by the memory only).
+pub(crate) struct Guard {
+    header: super::bounded::Header,
+    body: Option<super::bounded::Text>,
+}
+
+impl Default for Guard {
+    fn default() -> Guard {
+        Guard { header: super::bounded::Header::new("a PLY header's", b"end_header"), body: None }
+    }
+}
+
+impl super::bounded::Guard for Guard {
+    fn check(&mut self, bytes: &[u8], from: usize) -> Result<(), super::bounded::Stop> {
+        if let Some(body) = &mut self.body {
+            return body.check(bytes, from);
+        }
+        if self.header.header_end.is_some() {
+            return Ok(());
+        }
+        let (text, skipped) = super::text::strip_bom(bytes);
+        if let Some(n) = text.iter().position(|&b| b == b'\n')
+            && text[..n].trim_ascii() != b"ply"
+        {
+            return Err(super::bounded::Stop {
+                at: skipped as u64,
+                why: "not a PLY file (the first line must be 'ply')".into(),
+            });
+        }
+        self.header.check(bytes, from)?;
+        if let Some(end) = self.header.header_end {
+            let ascii = bytes[..end]
+                .split(|&b| b == b'\n')
+                .any(|l| l.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).take(2).eq([&b"format"[..], b"ascii"]));
+            if ascii {
+                let mut body = super::bounded::Text::starting_at("ASCII PLY", end);
+                body.check(bytes, end)?;
+                self.body = Some(body);
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Reads a PLY file; `path` only names the source in errors.
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let header = parse_header(bytes, path)?;

@@ -69,6 +69,76 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
     read_ascii(bytes, path)
 }
 
+/// What [`super::bounded`] lets through of an STL file: bytes that can still be ASCII STL
+/// (text starting with `solid`) or binary STL (no more bytes than the header's triangle
+/// count takes, every vertex coordinate finite so far). Reading stops when neither holds.
+#[derive(Default)]
+pub(crate) struct Guard {
+    /// Why it cannot be ASCII STL (`None`: it still can).
+    not_text: Option<super::bounded::Stop>,
+    text: Option<super::bounded::Text>,
+    /// Why it cannot be binary STL.
+    not_binary: Option<super::bounded::Stop>,
+    /// Triangles whose coordinates were checked.
+    checked: usize,
+}
+
+impl super::bounded::Guard for Guard {
+    fn check(&mut self, bytes: &[u8], from: usize) -> Result<(), super::bounded::Stop> {
+        use super::bounded::Stop;
+        if self.not_text.is_none() {
+            let (text, skipped) = super::text::strip_bom(bytes);
+            let start = text.len() - text.trim_ascii_start().len();
+            if let Some(first) = text.get(start..start + 5)
+                && !first.eq_ignore_ascii_case(b"solid")
+            {
+                self.not_text =
+                    Some(Stop { at: (skipped + start) as u64, why: "as ASCII STL it must start with 'solid'".into() });
+            } else if let Err(stop) =
+                self.text.get_or_insert_with(|| super::bounded::Text::new("ASCII STL")).check(bytes, from)
+            {
+                self.not_text = Some(stop);
+            }
+        }
+        if self.not_binary.is_none()
+            && let Some(&[a, b, c, d]) = bytes.get(HEADER..HEADER + 4)
+        {
+            let n = u32::from_le_bytes([a, b, c, d]) as usize;
+            let size = (HEADER + 4) as u64 + TRIANGLE as u64 * n as u64;
+            if bytes.len() as u64 > size {
+                self.not_binary = Some(Stop {
+                    at: size,
+                    why: format!("as binary STL its header's {n} triangles end at byte {size}, but more bytes follow"),
+                });
+            }
+            while self.not_binary.is_none() && self.checked < n {
+                let base = HEADER + 4 + TRIANGLE * self.checked;
+                let Some(record) = bytes.get(base..base + TRIANGLE) else { break };
+                let bad = (12..48).step_by(4).find(|&k| {
+                    !f32::from_le_bytes([record[k], record[k + 1], record[k + 2], record[k + 3]]).is_finite()
+                });
+                if let Some(k) = bad {
+                    self.not_binary = Some(Stop {
+                        at: (base + k) as u64,
+                        why: format!("as binary STL triangle {} has a coordinate that is not finite", self.checked),
+                    });
+                }
+                self.checked += 1;
+            }
+        }
+        match (self.not_text.take(), self.not_binary.take()) {
+            (Some(t), Some(b)) => Err(Stop {
+                at: t.at.max(b.at),
+                why: format!("not an STL file: {} (byte {}), and {} (byte {})", t.why, t.at, b.why, b.at),
+            }),
+            (t, b) => {
+                (self.not_text, self.not_binary) = (t, b);
+                Ok(())
+            }
+        }
+    }
+}
+
 /// Welds vertices by their coordinates' bits.
 struct Welder {
     map: HashMap<[u64; 3], u32>,

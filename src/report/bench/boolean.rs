@@ -145,7 +145,7 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         let grouped = measure(pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs);
         let (p1, p2, asm, ev) = match grouped {
             Err(e @ boolean::BooleanError::Input { .. }) => {
-                eprintln!("texgeo: skipping {}: {e}", pair.name);
+                crate::note!("texgeo: skipping {}: {e}", pair.name);
                 refused.push(format!("{} ({e})", pair.name));
                 continue;
             }
@@ -165,7 +165,7 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
             match cgal::reference(&pair.a, &pair.b, Some(cfg.runs.max(1) as u32)) {
                 Ok(r) => Some(r),
                 Err(e) => {
-                    eprintln!("texgeo: CGAL on {}: {e}", pair.name);
+                    crate::note!("texgeo: CGAL on {}: {e}", pair.name);
                     None
                 }
             }
@@ -200,7 +200,7 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                 thesis,
             ]);
         }
-        eprintln!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
+        crate::note!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
     }
     table.note(format!(
         "Medians of {} runs after a warm-up (plain: one run). triangles = both operands; cut = input \

@@ -188,7 +188,7 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
                 if method == Method::Auto && reference.is_none() {
                     reference = Some(classes);
                 }
-                eprintln!(
+                crate::note!(
                     "bench scale: {n} points, {method} ({ran}), {threads} thread(s): {} ms",
                     ms(m.time)
                 );
@@ -304,7 +304,7 @@ fn voxel_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, Scal
     let dir = ScratchDir::new("bench-scale").map_err(|e| ScaleError::Other(e.to_string()))?;
     let mut voxelizer = Voxelizer::new(Some(ctx.clone()));
     let row = |table: &mut Table, n: usize, method: &str, threads: usize, m: &Measured<u64>| {
-        eprintln!("bench scale: {n}³ {method}, {threads} thread(s): {} ms", ms(m.time));
+        crate::note!("bench scale: {n}³ {method}, {threads} thread(s): {} ms", ms(m.time));
         table.row(vec![
             n.to_string(),
             method.to_string(),
