@@ -146,15 +146,13 @@ fn git_commit(root: &Path) {
     };
     let commit = git(&["rev-parse", "--short=12", "HEAD"]).unwrap_or_else(|| "unknown".to_string());
     println!("cargo:rustc-env=TEXGEO_GIT_COMMIT={commit}");
-    // HEAD, the branch it points to and packed refs: where a new commit shows up.
-    if let Some(dir) = git(&["rev-parse", "--absolute-git-dir"]) {
-        println!("cargo:rerun-if-changed={dir}/HEAD");
-    }
-    if let (Some(common), Some(branch)) = (
-        git(&["rev-parse", "--path-format=absolute", "--git-common-dir"]),
-        git(&["symbolic-ref", "-q", "HEAD"]),
-    ) {
-        println!("cargo:rerun-if-changed={common}/{branch}");
-        println!("cargo:rerun-if-changed={common}/packed-refs");
+    let dir = git(&["rev-parse", "--absolute-git-dir"]).map(PathBuf::from);
+    let common = git(&["rev-parse", "--path-format=absolute", "--git-common-dir"]).map(PathBuf::from);
+    let branch = git(&["symbolic-ref", "-q", "HEAD"]);
+    for path in git_watch::watched(dir.as_deref(), common.as_deref(), branch.as_deref()) {
+        println!("cargo:rerun-if-changed={}", path.display());
     }
 }
+
+#[path = "build/git_watch.rs"]
+mod git_watch;

@@ -5,6 +5,8 @@ use std::path::PathBuf;
 use texgeo::mesh::Mesh;
 use texgeo::report::{Report, bench};
 
+use crate::mesh::MeshArg;
+
 #[derive(clap::Subcommand)]
 pub enum Command {
     /// Point in solid: the thesis' Tables 4-4 to 4-9 for every method.
@@ -70,10 +72,10 @@ pub enum Command {
     Scale {
         /// The inclusion solid (default: armadillo.off in --models-dir, else builtin:knot).
         #[arg(long)]
-        mesh: Option<String>,
+        mesh: Option<MeshArg>,
         /// The voxelization solid (default: the inclusion one).
         #[arg(long)]
-        voxel_mesh: Option<String>,
+        voxel_mesh: Option<MeshArg>,
         /// Where `tools/fetch-models` put the meshes.
         #[arg(long, default_value = "models")]
         models_dir: PathBuf,
@@ -129,7 +131,7 @@ pub enum Command {
         level: u32,
         /// Extra mesh files (or `builtin:NAME`) to measure after the default models.
         #[arg(long = "mesh", value_name = "MESH")]
-        meshes: Vec<String>,
+        meshes: Vec<MeshArg>,
         /// Folder of fetched models (tools/fetch-models); those of the default set found
         /// there are measured.
         #[arg(long, default_value = "models")]
@@ -158,7 +160,7 @@ pub enum Command {
 pub struct Models {
     /// Meshes to use (files or `builtin:NAME`), instead of the thesis stand-ins.
     #[arg(long, value_delimiter = ',')]
-    models: Vec<String>,
+    models: Vec<MeshArg>,
     /// Where `tools/fetch-models` put the CGAL meshes.
     #[arg(long, default_value = "models")]
     models_dir: PathBuf,
@@ -171,21 +173,19 @@ impl Models {
         stand_ins: &[(&'static str, &'static str)],
     ) -> anyhow::Result<Vec<(&'static str, String, Mesh)>> {
         if !self.models.is_empty() {
-            return self.models.iter().map(|m| Ok(("–", m.clone(), crate::mesh::load(m)?))).collect();
+            return self.models.iter().map(|m| Ok(("–", m.to_string(), crate::mesh::load(m)?))).collect();
         }
         let mut out = Vec::new();
         for &(thesis, spec) in stand_ins {
-            let path = if spec.starts_with("builtin:") {
-                spec.to_string()
+            let arg = if spec.starts_with("builtin:") {
+                MeshArg::from(spec)
             } else {
-                self.models_dir.join(spec).display().to_string()
+                MeshArg::from(self.models_dir.join(spec))
             };
-            if spec.starts_with("builtin:") || std::path::Path::new(&path).exists() {
-                out.push((thesis, spec.to_string(), crate::mesh::load(&path)?));
+            if arg.file().is_none_or(std::path::Path::exists) {
+                out.push((thesis, spec.to_string(), crate::mesh::load(&arg)?));
             } else {
-                note!(
-                    "texgeo: {path} not found (run tools/fetch-models); skipping the {thesis} stand-in"
-                );
+                note!("texgeo: {arg} not found (run tools/fetch-models); skipping the {thesis} stand-in");
             }
         }
         Ok(out)
@@ -311,15 +311,15 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             use texgeo::inclusion::Method;
             let mesh = mesh.unwrap_or_else(|| {
                 let armadillo = models_dir.join("armadillo.off");
-                if armadillo.exists() { armadillo.display().to_string() } else { "builtin:knot".into() }
+                if armadillo.exists() { armadillo.into() } else { "builtin:knot".into() }
             });
             let inclusion = Model {
-                name: mesh.clone(),
+                name: mesh.to_string(),
                 mesh: crate::mesh::load_solid(&mesh, Default::default(), &[])?.mesh,
             };
             let voxel = match voxel_mesh {
                 Some(v) => Model {
-                    name: v.clone(),
+                    name: v.to_string(),
                     mesh: crate::mesh::load_solid(&v, Default::default(), &[])?.mesh,
                 },
                 None => Model { name: inclusion.name.clone(), mesh: inclusion.mesh.clone() },
@@ -388,7 +388,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
                 anyhow::ensure!((0.0..=180.0).contains(&crease_angle), "--crease-angle must be in 0..=180");
                 let mut list = if only { Vec::new() } else { crease_models(&models)? };
                 for m in &meshes {
-                    list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+                    list.push(Model { name: m.to_string(), mesh: crate::mesh::load(m)? });
                 }
                 anyhow::ensure!(!list.is_empty(), "no models to measure");
                 let settings = CreaseSettings {
@@ -401,7 +401,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             }
             let mut list = if only { Vec::new() } else { default_models(&models)? };
             for m in &meshes {
-                list.push(Model { name: m.clone(), mesh: crate::mesh::load(m)? });
+                list.push(Model { name: m.to_string(), mesh: crate::mesh::load(m)? });
             }
             anyhow::ensure!(!list.is_empty(), "no models to measure");
             let settings = Settings { level, runs: common.runs, validate };

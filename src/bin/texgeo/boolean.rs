@@ -11,12 +11,14 @@ use texgeo::mesh::formats::{self, Format};
 use texgeo::mesh::{Mesh, covering::Covering, solidity};
 use texgeo::render::{self, Look, Model, Renderer, View};
 
+use crate::mesh::MeshArg;
+
 #[derive(clap::Args)]
 pub struct Args {
     /// The first solid: a closed mesh file or `builtin:NAME`.
-    a: String,
+    a: MeshArg,
     /// The second solid.
-    b: String,
+    b: MeshArg,
     /// union, intersection, difference (A − B) or symmetric-difference.
     #[arg(long, required_unless_present = "all")]
     op: Option<String>,
@@ -94,7 +96,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let tb = args.transform_b.as_deref().map(Transform::parse).transpose().map_err(anyhow::Error::msg)?;
 
     let read = Instant::now();
-    let load = |spec: &str, t: Option<Transform>| -> anyhow::Result<Mesh> {
+    let load = |spec: &MeshArg, t: Option<Transform>| -> anyhow::Result<Mesh> {
         let m = crate::mesh::load(spec)?;
         let m = match t {
             Some(t) => t.apply(&m).with_context(|| format!("transforming {spec}"))?,
@@ -114,7 +116,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         allow_self_intersections: args.allow_self_intersections,
         ..Options::default()
     };
-    let names = Names { a: &args.a, b: &args.b };
+    let (a_name, b_name) = (args.a.to_string(), args.b.to_string());
+    let names = Names { a: &a_name, b: &b_name };
     let ev = boolean::evaluate(&a, &b, names, &options, ctx.as_ref())?;
 
     let assemble = Instant::now();

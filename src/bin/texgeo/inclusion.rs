@@ -13,7 +13,7 @@ use texgeo::random::Rng;
 #[derive(clap::Args)]
 pub struct Args {
     /// The solid: a mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
-    mesh: String,
+    mesh: crate::mesh::MeshArg,
     /// Query points: one `x y z` per line (`#` comments allowed), or a NumPy `.npy` N×3
     /// array of float64 or float32.
     #[arg(long, value_name = "FILE", conflicts_with = "random", required_unless_present = "random")]

@@ -1,6 +1,7 @@
 //! `texgeo mesh stats|convert|builtins`, and how every command reads its mesh.
 
-use std::path::PathBuf;
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
@@ -15,12 +16,12 @@ pub enum Command {
     /// shells and whether it is a solid (and why not), area, volume, centroids.
     Stats {
         /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
-        mesh: String,
+        mesh: MeshArg,
     },
     /// Convert between formats (chosen by extension); polygons are triangulated for STL.
     Convert {
         /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
-        input: String,
+        input: MeshArg,
         /// The output file (.obj .off .ply .stl), written atomically.
         output: PathBuf,
     },
@@ -28,14 +29,56 @@ pub enum Command {
     Builtins,
 }
 
-/// Reads a mesh file, or a built-in model given as `builtin:NAME`.
-pub fn load(spec: &str) -> anyhow::Result<Mesh> {
-    if let Some(name) = spec.strip_prefix("builtin:") {
-        return procedural::by_name(name).with_context(|| {
-            format!("no built-in model '{name}' (built-ins: {})", procedural::BUILTIN_NAMES.join(", "))
-        });
+/// A mesh on the command line: a file path (any bytes, as the system allows: not only
+/// UTF-8) or `builtin:NAME`.
+#[derive(Clone, Debug)]
+pub struct MeshArg(PathBuf);
+
+impl From<OsString> for MeshArg {
+    fn from(s: OsString) -> MeshArg {
+        MeshArg(s.into())
     }
-    Ok(formats::read(spec)?)
+}
+
+impl From<PathBuf> for MeshArg {
+    fn from(p: PathBuf) -> MeshArg {
+        MeshArg(p)
+    }
+}
+
+impl From<&str> for MeshArg {
+    fn from(s: &str) -> MeshArg {
+        MeshArg(s.into())
+    }
+}
+
+impl std::fmt::Display for MeshArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.display().fmt(f)
+    }
+}
+
+impl MeshArg {
+    /// The NAME of `builtin:NAME`.
+    pub fn builtin(&self) -> Option<&str> {
+        self.0.to_str()?.strip_prefix("builtin:")
+    }
+
+    /// The file, unless it is a built-in model.
+    pub fn file(&self) -> Option<&Path> {
+        self.builtin().is_none().then_some(self.0.as_path())
+    }
+}
+
+/// Reads a mesh file, or a built-in model given as `builtin:NAME`.
+pub fn load(spec: &MeshArg) -> anyhow::Result<Mesh> {
+    match (spec.builtin(), spec.file()) {
+        (Some(name), _) => procedural::by_name(name).with_context(|| {
+            format!("no built-in model '{name}' (built-ins: {})", procedural::BUILTIN_NAMES.join(", "))
+        }),
+        (None, Some(path)) => Ok(formats::read(path)?),
+        (None, None) => anyhow::bail!("{spec}: neither a file nor builtin:NAME"),
+    }
 }
 
 /// Reads a mesh and lets it through only if it is a solid ([`solidity::require_solid`]),
@@ -43,19 +86,19 @@ pub fn load(spec: &str) -> anyhow::Result<Mesh> {
 /// own), the one that would accept it.
 /// Reads a mesh with its sharp-feature tags (OpenSubdiv's `t crease`, … in an OBJ file;
 /// other formats and built-in models have none).
-pub fn load_tagged(spec: &str) -> anyhow::Result<Tagged> {
-    if spec.starts_with("builtin:") {
+pub fn load_tagged(spec: &MeshArg) -> anyhow::Result<Tagged> {
+    let Some(path) = spec.file() else {
         return Ok(Tagged {
             mesh: load(spec)?,
             features: Features::default(),
             options: TaggedOptions::default(),
             ignored: Vec::new(),
         });
-    }
-    Ok(tags::read(spec)?)
+    };
+    Ok(tags::read(path)?)
 }
 
-pub fn load_solid(spec: &str, policy: Policy, flags: &[&str]) -> anyhow::Result<Accepted> {
+pub fn load_solid(spec: &MeshArg, policy: Policy, flags: &[&str]) -> anyhow::Result<Accepted> {
     let mesh = load(spec)?;
     solidity::require_solid(mesh, policy).map_err(|e| {
         let hint = match e.defect.remedy().filter(|f| flags.contains(f)) {

@@ -10,6 +10,8 @@ use texgeo::render::{Camera, Content, Look, Model, Renderer, Scene, Shading, Vie
 use texgeo::voxel::aspect::{Aspect, Material};
 use texgeo::voxel::binvox;
 
+use crate::mesh::MeshArg;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ShadingArg {
     Flat,
@@ -31,9 +33,9 @@ impl From<ShadingArg> for Shading {
 #[derive(clap::Args, Clone, Debug)]
 pub struct Show {
     /// A mesh (.obj .off .ply .stl, or `builtin:NAME`) or a voxel volume (.binvox).
-    pub input: String,
+    pub input: MeshArg,
     /// More meshes shown with the first, each in its own colour (no subdivision levels).
-    pub others: Vec<String>,
+    pub others: Vec<MeshArg>,
     /// Catmull-Clark level (GPU fragment passes, as `texgeo subdivide`).
     #[arg(short, long, default_value_t = 0)]
     pub level: u32,
@@ -73,7 +75,7 @@ pub struct Show {
     /// operands with their cut curve and, beside them, the result coloured by operand
     /// (2006 thesis, Figs. 6-9 … 6-12).
     #[arg(long, value_name = "B", requires = "op")]
-    pub boolean: Option<String>,
+    pub boolean: Option<MeshArg>,
     /// The operation for --boolean: union, intersection, difference, symmetric-difference.
     #[arg(long, requires = "boolean", value_parser = parse_operation)]
     pub op: Option<Operation>,
@@ -116,7 +118,7 @@ impl Show {
     }
 
     pub fn is_binvox(&self) -> bool {
-        self.input.to_ascii_lowercase().ends_with(".binvox")
+        self.input.file().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("binvox")))
     }
 
     /// Checks option combinations before anything is loaded.
@@ -145,8 +147,8 @@ impl Show {
 
     /// What to show: a .binvox volume, a mesh (voxelized with --voxels), or several meshes.
     pub fn content(&self) -> anyhow::Result<Content> {
-        if self.is_binvox() {
-            let (grid, volume) = binvox::read(&self.input)?;
+        if let (true, Some(path)) = (self.is_binvox(), self.input.file()) {
+            let (grid, volume) = binvox::read(path)?;
             return Ok(Content::Voxels(grid, volume));
         }
         if !self.voxels && self.boolean.is_none() && self.others.is_empty() {
@@ -157,7 +159,8 @@ impl Show {
         let mesh = crate::mesh::load(&self.input)?;
         if let (Some(b), Some(op)) = (&self.boolean, self.op) {
             let other = crate::mesh::load(b)?;
-            let names = texgeo::boolean::Names { a: &self.input, b };
+            let (a, b) = (self.input.to_string(), b.to_string());
+            let names = texgeo::boolean::Names { a: &a, b: &b };
             let ev = texgeo::boolean::evaluate(&mesh, &other, names, &Default::default(), None)?;
             return Ok(texgeo::render::boolean::content(&ev, op, true)?);
         }
@@ -181,7 +184,7 @@ impl Show {
         if let (Some(b), Some(op)) = (&self.boolean, self.op) {
             return format!("{} {} {b}", self.input, op.symbol());
         }
-        std::iter::once(&self.input).chain(&self.others).cloned().collect::<Vec<_>>().join(" + ")
+        std::iter::once(&self.input).chain(&self.others).map(MeshArg::to_string).collect::<Vec<_>>().join(" + ")
     }
 
     pub fn camera(&self, scene: &Scene) -> anyhow::Result<Camera> {

@@ -54,7 +54,7 @@ pub struct Args {
     /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
     /// An OBJ file's tags (OpenSubdiv's `t crease`, `t corner`, `t hole`,
     /// `t interpolateboundary`, `t creasemethod`, `t smoothtriangles`) are applied.
-    input: String,
+    input: crate::mesh::MeshArg,
     /// Subdivision level (each level splits every quad into four).
     #[arg(short, long)]
     level: u32,

@@ -18,7 +18,7 @@ pub enum AspectKind {
 #[derive(clap::Args)]
 pub struct Args {
     /// The solid: a mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
-    mesh: String,
+    mesh: crate::mesh::MeshArg,
     /// Voxels per side (N×N×N over the mesh's bounding cube), 1..=1024.
     #[arg(long, short)]
     res: usize,
