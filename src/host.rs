@@ -20,11 +20,11 @@ pub fn check_available(bytes: u64) -> Result<(), (Mib, u64)> {
 }
 
 /// The estimate-and-refuse check run before anything large is allocated: `Err` saying
-/// "WHAT need(s) about N MiB, but only M MiB are available" when `bytes` (a saturating
+/// "WHAT need N MiB, but only M MiB are available" when `bytes` (a saturating
 /// estimate) exceed the available memory.
 pub fn check_memory(what: impl std::fmt::Display, bytes: u128) -> Result<(), String> {
     check_available(Mib::saturate(bytes))
-        .map_err(|(need, have)| format!("{what} need about {need} MiB, but only {have} MiB are available"))
+        .map_err(|(need, have)| format!("{what} need {need} MiB, but only {have} MiB are available"))
 }
 
 /// A memory estimate for messages, in MiB (rounded up). An estimate that reached the

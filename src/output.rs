@@ -383,6 +383,13 @@ pub fn check_not_input(path: impl AsRef<Path>, inputs: &[&Path]) -> Result<()> {
     Ok(())
 }
 
+/// [`check_file`] and [`check_not_input`]: what every command runs on each output path
+/// before any work (after checking the extension against what it writes there).
+pub fn check_output(path: impl AsRef<Path>, inputs: &[&Path]) -> Result<()> {
+    check_file(&path)?;
+    check_not_input(path, inputs)
+}
+
 /// Creates the folder `dir` (and its parents) if needed and checks that files can be
 /// created in it.
 pub fn check_dir(dir: impl AsRef<Path>) -> Result<()> {

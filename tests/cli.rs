@@ -358,3 +358,109 @@ fn sizes_that_do_not_fit_are_refused_before_any_work() {
     let o = texgeo(&["voxelize", "builtin:cube", "--res", "100000", "-o", "/tmp/x.binvox"]);
     assert_refused(&o, &["resolution 100000", "1024"]);
 }
+
+#[test]
+fn thread_counts_above_the_cap_are_refused() {
+    for n in ["1025", "100000", "9223372036854775808", "0"] {
+        let o = texgeo(&["--threads", n, "mesh", "builtins"]);
+        assert_refused(&o, &["--threads"]);
+    }
+    let o = texgeo(&["--threads", "3", "mesh", "stats", "builtin:cube"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn option_values_that_would_overflow_are_refused_up_front() {
+    let dir = TempDir::new("cli-overflow");
+    let out = dir.arg("bench");
+    for (args, needles) in [
+        (vec!["sweep", "m.txt", "--task", "inclusion", "-o", &out, "--timeout", "1e20"], vec!["--timeout", "1e20"]),
+        (vec!["sweep", "m.txt", "--task", "inclusion", "-o", &out, "--timeout", "nan"], vec!["--timeout"]),
+        (vec!["bench", "scale", "--budget", "1e30", "-o", &out], vec!["--budget"]),
+        (vec!["bench", "xor", "--triangles", "18446744073709551615", "-o", &out], vec!["at most 1431655765 triangles"]),
+        (vec!["bench", "xor", "--triangles", "1000000000", "-o", &out], vec!["1000000000 triangles", "MiB"]),
+        (vec!["bench", "inclusion", "--points", "18446744073709551615", "-o", &out], vec!["more than", "MiB"]),
+        (vec!["bench", "scale", "--points", "100000000000", "-o", &out], vec!["100000000000 points", "MiB"]),
+        (vec!["bench", "boolean", "--scaling", "100000000000", "-o", &out], vec!["--scaling 100000000000"]),
+        (vec!["bench", "boolean", "--scaling", "2000000000", "-o", &out], vec!["--scaling 2000000000", "MiB"]),
+        (vec!["voxelize", "builtin:cube", "--res", "9223372036854775808", "-o", "a.binvox"], vec!["more than"]),
+        (vec!["subdivide", "builtin:cube", "-l", "4000000000"], vec!["more than 18446744073709551615 vertices"]),
+    ] {
+        let started = std::time::Instant::now();
+        let o = texgeo(&args);
+        assert_refused(&o, &needles);
+        assert!(!stderr(&o).contains(" 0 MiB"), "{args:?}: {}", stderr(&o));
+        // Refused from the numbers, not after trying (a generous bound on a loaded machine).
+        assert!(started.elapsed().as_secs() < 60, "{args:?}");
+    }
+    // Levels past 2^64 faces are "more than", not a count that stopped or wrapped.
+    let a = stderr(&texgeo(&["subdivide", "builtin:cube", "-l", "32"]));
+    let b = stderr(&texgeo(&["subdivide", "builtin:cube", "-l", "64"]));
+    assert!(a.contains("more than") && b.contains("more than"), "{a}{b}");
+}
+
+#[test]
+fn mesh_paths_need_not_be_utf8() {
+    use std::os::unix::ffi::OsStrExt as _;
+    let dir = TempDir::new("cli-os-path");
+    let path = dir.path().join(std::ffi::OsStr::from_bytes(b"t\xffe.off"));
+    assert!(texgeo(&["mesh", "convert", "builtin:tetrahedron", dir.arg("t.off").as_str()]).status.success());
+    std::fs::rename(dir.join("t.off"), &path).unwrap();
+    for (before, after) in [(&["mesh", "stats"][..], &[][..]), (&["inclusion"][..], &["--random", "10"][..])] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(before)
+            .arg(&path)
+            .args(after)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{before:?}: {}", stderr(&o));
+        assert!(stdout(&o).contains("t\u{fffd}e.off"), "{}", stdout(&o));
+    }
+}
+
+#[test]
+fn an_empty_mesh_is_a_solid_that_holds_nothing() {
+    let dir = TempDir::new("cli-empty");
+    std::fs::write(dir.join("empty.off"), "OFF\n0 0 0\n").unwrap();
+    let empty = dir.arg("empty.off");
+    let o = texgeo(&["mesh", "stats", &empty]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    for needle in ["faces                  0", "volume                 0 ", "area                   0\n", "solid: yes (empty)"] {
+        assert!(out.contains(needle), "'{needle}' in {out}");
+    }
+    for method in ["auto", "cpu", "bvh", "jordan", "winding", "gpu"] {
+        let labels = dir.arg(&format!("{method}.txt"));
+        let o = texgeo(&["inclusion", &empty, "--random", "20", "--method", method, "-o", &labels]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert_eq!(std::fs::read_to_string(&labels).unwrap(), "0\n".repeat(20), "{method}");
+    }
+    for method in ["scanline", "cpu", "zoned"] {
+        let out = dir.join(&format!("{method}.binvox"));
+        let o = texgeo(&["voxelize", &empty, "--res", "8", "--method", method, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert!(stdout(&o).contains("8³ voxels, 0 occupied"), "{method}: {}", stdout(&o));
+        let (_, volume) = texgeo::voxel::binvox::read(&out).unwrap();
+        assert_eq!(volume.count(), 0);
+    }
+}
+
+#[test]
+fn an_all_holes_subdivision_is_written_readable_and_validates() {
+    let dir = TempDir::new("cli-holes");
+    let cube = dir.join("cube.obj");
+    assert!(texgeo(&["mesh", "convert", "builtin:cube", cube.to_str().unwrap()]).status.success());
+    let mut text = std::fs::read_to_string(&cube).unwrap();
+    text.push_str("t hole 6/0/0 0 1 2 3 4 5\n");
+    std::fs::write(&cube, text).unwrap();
+    for ext in ["obj", "off"] {
+        let out = dir.arg(&format!("out.{ext}"));
+        // --validate reads OpenSubdiv's result, a file without faces, back too.
+        let o = texgeo(&["subdivide", cube.to_str().unwrap(), "-l", "1", "--method", "cpu", "--validate", "-o", &out]);
+        assert!(o.status.success(), "{ext}: {}{}", stdout(&o), stderr(&o));
+        assert!(stdout(&o).contains("level 1: ") && stdout(&o).contains("validation passed"), "{}", stdout(&o));
+        let o = texgeo(&["mesh", "stats", &out]);
+        assert!(o.status.success(), "{ext}: {}", stderr(&o));
+        assert!(stdout(&o).contains("faces                  0") && stdout(&o).contains("solid: yes (empty)"));
+    }
+}

@@ -228,3 +228,138 @@ fn an_interrupted_run_leaves_the_previous_file() {
         assert_eq!(grid.n, 512);
     }
 }
+
+#[test]
+fn a_closed_stderr_is_not_a_panic_and_outputs_are_still_written() {
+    let dir = TempDir::new("outputs-stderr");
+    let bench = dir.join("bench");
+    let classes = dir.join("classes.txt");
+    let volume = dir.join("knot.binvox");
+    for args in [
+        // `auto` names its choice on stderr; bench says which files it wrote there.
+        vec!["inclusion", "builtin:knot", "--random", "100", "-o", classes.to_str().unwrap()],
+        vec!["voxelize", "builtin:knot", "--res", "16", "-o", volume.to_str().unwrap()],
+        vec!["bench", "xor", "--sizes", "16", "--triangles", "10", "--runs", "1", "-o", bench.to_str().unwrap()],
+        vec!["mesh", "stats", "builtin:nope"],
+    ] {
+        // Like `texgeo … 2>&1 | head -c0`: both streams closed.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(&args)
+            .stdout(Stdio::from(writer.try_clone().unwrap()))
+            .stderr(Stdio::from(writer))
+            .status()
+            .unwrap();
+        let want = if args[1] == "stats" { 2 } else { 0 };
+        assert_eq!(o.code(), Some(want), "{args:?}: {o}");
+    }
+    assert_eq!(std::fs::read(&classes).unwrap().len(), 200);
+    assert!(volume.exists());
+    assert!(std::fs::read_dir(&bench).unwrap().count() >= 2, "the bench tables were written");
+}
+
+#[test]
+fn output_names_up_to_255_bytes_work() {
+    let dir = TempDir::new("outputs-long");
+    for len in [235, 250, 255] {
+        let name = format!("{}.off", "n".repeat(len - 4));
+        let o = texgeo(&["mesh", "convert", "builtin:cube", &dir.arg(&name)]);
+        assert!(o.status.success(), "{len} bytes: {}", common::stderr(&o));
+        let o = texgeo(&["mesh", "stats", &dir.arg(&name)]);
+        assert!(stdout(&o).contains("faces                  6"), "{len} bytes: {}", stdout(&o));
+    }
+    assert!(dir.entries().iter().all(|e| !e.starts_with('.')), "{:?}", dir.entries());
+}
+
+#[test]
+fn outputs_are_checked_against_what_the_command_writes_and_never_replace_an_input() {
+    let dir = TempDir::new("outputs-kind");
+    let knot = dir.arg("knot.off");
+    assert!(texgeo(&["mesh", "convert", "builtin:knot", &knot]).status.success());
+    let before = std::fs::read(&knot).unwrap();
+    std::os::unix::fs::symlink(&knot, dir.join("link.off")).unwrap();
+    std::fs::write(dir.join("p.txt"), "0 0 0\n").unwrap();
+    for (args, needle) in [
+        (vec!["voxelize", &knot, "--res", "8", "-o", &knot], "written as binvox; name it .binvox"),
+        (vec!["voxelize", "builtin:knot", "--res", "8", "-o", &dir.arg("v.png")], "name it .binvox"),
+        (vec!["mesh", "convert", &knot, &knot], "is an input of this run"),
+        (vec!["mesh", "convert", &knot, &dir.arg("link.off")], "is an input of this run"),
+        (vec!["subdivide", &knot, "-l", "1", "-o", &dir.arg("link.off")], "is an input of this run"),
+        (vec!["inclusion", &knot, "--random", "5", "-o", &knot], "name it .txt, .dat, .csv, .labels or .npy"),
+        (vec!["inclusion", &knot, "--points", &dir.arg("p.txt"), "-o", &dir.arg("p.txt")], "is an input"),
+        (vec!["boolean", &knot, "builtin:cube", "--op", "union", "-o", &knot], "is an input of this run"),
+        (vec!["render", &knot, "-o", &dir.arg("k.jpg")], "name it .png"),
+    ] {
+        let o = texgeo(&args);
+        assert_refused(&o, &[needle]);
+        assert!(stdout(&o).is_empty(), "{args:?} worked first: {}", stdout(&o));
+    }
+    assert_eq!(std::fs::read(&knot).unwrap(), before, "the input is untouched");
+    // The viewer checks its outputs before it opens a window (no display needed to see it).
+    for (args, needle) in [
+        (vec!["--frames", "1", "--screenshot", "no/such/x.png"], "its folder no/such does not exist"),
+        (vec!["--frames", "1", "--screenshot", "x.jpg"], "screenshots are PNG; name it .png"),
+        (vec!["--save-mesh", "no/such/x.off"], "does not exist"),
+        (vec!["--save-mesh", "x.xyz"], "unknown mesh format '.xyz'"),
+        (vec!["--save-mesh", &knot], "is an input of this run"),
+    ] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_texgeo"));
+        cmd.args(["view", &knot]).args(&args).env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
+        assert_refused(&cmd.current_dir(dir.path()).output().unwrap(), &[needle]);
+    }
+}
+
+/// Waits until `dir` holds a temporary file of `target` (true), or `child` ended (false).
+fn wait_for_temporary(dir: &TempDir, target: &str, child: &mut std::process::Child) -> bool {
+    let prefix = format!(".{target}.texgeo-");
+    let started = std::time::Instant::now();
+    while started.elapsed().as_secs() < 120 {
+        if dir.entries().iter().any(|e| e.starts_with(&prefix)) {
+            return true;
+        }
+        if child.try_wait().unwrap().is_some() {
+            return false;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    false
+}
+
+#[test]
+fn a_signal_removes_the_temporary_file_and_the_next_run_removes_stale_ones() {
+    let dir = TempDir::new("outputs-signal");
+    let out = dir.join("s.binvox");
+    for signal in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
+        std::fs::write(&out, b"previous good contents").unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
+            .args(["voxelize", "builtin:sphere", "--res", "768", "--method", "scanline", "-o", out.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let writing = wait_for_temporary(&dir, "s.binvox", &mut child);
+        // SAFETY: a plain kill(2) of the child this test started.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let status = child.wait().unwrap();
+        assert_eq!(dir.entries(), vec!["s.binvox"], "signal {signal}: a temporary file is left");
+        let bytes = std::fs::read(&out).unwrap();
+        if writing && bytes == b"previous good contents" {
+            use std::os::unix::process::ExitStatusExt as _;
+            assert_eq!(status.signal(), Some(signal), "ended by the signal, as without the handler");
+        }
+    }
+    // A temporary file a killed run left (its PID is above any PID the kernel hands out)
+    // goes with the next run of the same output; one of a live process stays.
+    let dead = ".c.txt.texgeo-4194311-0.tmp";
+    let live = format!(".c.txt.texgeo-{}-0.tmp", std::process::id());
+    let other = ".d.txt.texgeo-4194311-0.tmp";
+    for name in [dead, &live, other] {
+        std::fs::write(dir.join(name), b"partial").unwrap();
+    }
+    let o = texgeo(&["inclusion", "builtin:cube", "--random", "10", "-o", &dir.arg("c.txt")]);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    let left = dir.entries();
+    assert!(!left.contains(&dead.to_string()), "{left:?}");
+    assert!(left.contains(&live) && left.contains(&other.to_string()), "{left:?}");
+}

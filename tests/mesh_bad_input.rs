@@ -3,7 +3,11 @@
 //! bytes in memory named like files (the readers behind `formats::read`), so parallel
 //! tests share nothing.
 
+mod common;
+
 use std::path::{Path, PathBuf};
+
+use common::{TempDir, assert_refused, texgeo_in_shell};
 
 use texgeo::mesh::error::Location;
 use texgeo::mesh::formats::{self, Format, ply, stl};
@@ -34,6 +38,16 @@ fn expect(name: &str, bytes: &[u8], location: Location, message: &str) {
         other => panic!("{name}: not a parse error: {other}"),
     }
     assert!(text.starts_with(&format!("{}{location}: ", file.display())), "{name}: {text}");
+}
+
+/// Checks that `bytes`, well formed without any face, read as the file `name` give a
+/// valid empty mesh (no faces) with `vertices` vertices: texgeo writes such files for
+/// empty results, so every reader takes them.
+fn expect_empty(name: &str, bytes: &[u8], vertices: usize) {
+    match read_named(name, bytes) {
+        Ok(m) => assert_eq!((m.num_faces(), m.num_vertices()), (0, vertices), "{name}"),
+        Err(e) => panic!("{name}: a file without faces is an empty mesh, not an error: {e}"),
+    }
 }
 
 fn line(n: usize) -> Location {
@@ -134,8 +148,9 @@ fn obj_non_finite_coordinates() {
 fn obj_small_faces_and_no_faces() {
     expect("two.obj", &obj("f 1 2\n"), line(4), "a face needs at least 3 vertices, this one has 2");
     expect("none.obj", &obj("f\n"), line(4), "this one has 0");
-    expect("nofaces.obj", OBJ_TRI.as_bytes(), Location::File, "the file holds no faces");
-    expect("comments.obj", b"# nothing\n\n", Location::File, "the file holds no faces");
+    // OBJ keeps only the vertices faces use.
+    expect_empty("nofaces.obj", OBJ_TRI.as_bytes(), 0);
+    expect_empty("comments.obj", b"# nothing\n\n", 0);
 }
 
 #[test]
@@ -170,7 +185,7 @@ fn off_bad_files() {
         "the file ends after 1 of 1000000000 vertices",
     );
     expect("utf8.off", b"OFF\n1 0 0\n\xc3\x28 0 0\n", line(3), "invalid UTF-8");
-    expect("nofaces.off", b"OFF\n1 0 0\n0 0 0\n", Location::File, "the file holds no faces");
+    expect_empty("nofaces.off", b"OFF\n1 0 0\n0 0 0\n", 1);
 }
 
 // ---------------------------------------------------------------- PLY, ascii
@@ -425,7 +440,7 @@ fn stl_binary_truncated_or_counts_larger_than_the_file() {
     // Zero triangles.
     let mut b = good[..84].to_vec();
     b[80..84].copy_from_slice(&0u32.to_le_bytes());
-    expect("zero.stl", &b, Location::File, "the file holds no faces");
+    expect_empty("zero.stl", &b, 0);
 }
 
 #[test]
@@ -476,7 +491,7 @@ fn stl_ascii_errors_name_the_line() {
         "a facet normal needs three numbers",
     );
     expect("endfacet.stl", &ascii_stl_with(8, "endloop"), line(8), "expected 'endfacet', found 'endloop'");
-    expect("no-facets.stl", b"solid t\nendsolid t\n", Location::File, "the file holds no faces");
+    expect_empty("no-facets.stl", b"solid t\nendsolid t\n", 0);
     expect("utf8.stl", b"solid t\nfacet \xff\n", line(2), "invalid UTF-8 at byte 14");
 }
 
@@ -495,10 +510,13 @@ fn replace_bytes(bytes: Vec<u8>, marker: &str, with: &[u8]) -> Vec<u8> {
 fn converts_back(m: &texgeo::mesh::Mesh) {
     use texgeo::mesh::covering::Covering;
     use texgeo::mesh::formats::Format;
+    // OBJ keeps only the vertices faces use: none in a mesh without faces.
+    let empty = texgeo::mesh::Mesh::new(Vec::new(), Vec::new()).unwrap();
     for format in [Format::Obj, Format::Off, Format::Ply] {
         let mut bytes = Vec::new();
         formats::write_to(&mut bytes, m, format).unwrap();
-        assert_eq!(&formats::read_bytes(&bytes, format, Path::new("back")).unwrap(), m, "{format:?}");
+        let want = if format == Format::Obj && m.num_faces() == 0 { &empty } else { m };
+        assert_eq!(&formats::read_bytes(&bytes, format, Path::new("back")).unwrap(), want, "{format:?}");
     }
     let mut bytes = Vec::new();
     match formats::write_to(&mut bytes, m, Format::Stl) {
@@ -558,8 +576,8 @@ fn mutated_files_never_panic() {
             }
             match formats::read_bytes(&b, *format, path) {
                 Ok(m) => {
+                    // Possibly without faces: a mutation can leave a well-formed empty mesh.
                     accepted += 1;
-                    assert!(m.num_faces() > 0);
                     converts_back(&m);
                 }
                 Err(MeshError::Parse { .. }) => rejected += 1,
@@ -569,6 +587,86 @@ fn mutated_files_never_panic() {
         assert!(
             rejected > 100,
             "{format:?}: only {rejected} of 3000 mutations rejected ({accepted} accepted)"
+        );
+    }
+}
+
+// ---------------------------------------------------------------- endless inputs
+
+/// Runs texgeo with at most 2 GiB of address space and 60 s of CPU: an endless input read
+/// whole would fail the limit (or the test) instead of filling the machine.
+fn bounded(args: &[&str]) -> std::process::Output {
+    texgeo_in_shell("ulimit -v 2097152; ulimit -t 60;", args)
+}
+
+#[test]
+fn endless_and_random_devices_stop_at_the_first_impossible_byte() {
+    let dir = TempDir::new("endless");
+    for (name, device, at) in [
+        ("zero.off", "/dev/zero", "byte 0"),
+        ("zero.obj", "/dev/zero", "byte 0"),
+        ("zero.ply", "/dev/zero", "byte 0"),
+        ("zero.stl", "/dev/zero", "byte 84"),
+        ("random.off", "/dev/urandom", "byte "),
+        ("random.obj", "/dev/urandom", "byte "),
+        ("random.ply", "/dev/urandom", "byte "),
+        ("random.stl", "/dev/urandom", "byte "),
+    ] {
+        let link = dir.join(name);
+        std::os::unix::fs::symlink(device, &link).unwrap();
+        let o = bounded(&["mesh", "stats", link.to_str().unwrap()]);
+        assert_refused(&o, &[name, at, "stopped reading"]);
+    }
+    std::os::unix::fs::symlink("/dev/zero", dir.join("zero.npy")).unwrap();
+    for points in ["/dev/zero", "/dev/urandom", &dir.arg("zero.npy")] {
+        let o = bounded(&["inclusion", "builtin:cube", "--points", points]);
+        assert_refused(&o, &[points, "byte ", "stopped reading"]);
+    }
+}
+
+#[test]
+fn over_long_lines_are_refused_with_the_limit_and_offset() {
+    let dir = TempDir::new("long-lines");
+    let line = "#".repeat(texgeo::mesh::formats::bounded::MAX_LINE + 1);
+    std::fs::write(dir.join("long.off"), format!("OFF\n{line}\n4 4 0\n")).unwrap();
+    std::fs::write(dir.join("long.txt"), format!("1 2 3\n{line}\n4 5 6\n")).unwrap();
+    let o = bounded(&["mesh", "stats", &dir.arg("long.off")]);
+    assert_refused(&o, &["long.off: byte 4: a line longer than 16 MiB"]);
+    let o = bounded(&["inclusion", "builtin:cube", "--method", "cpu", "--points", &dir.arg("long.txt")]);
+    assert_refused(&o, &["long.txt: byte 6: a line longer than 16 MiB"]);
+    // A PLY header without end.
+    std::fs::write(dir.join("long.ply"), format!("ply\n{}", "comment x\n".repeat(120_000))).unwrap();
+    let o = bounded(&["mesh", "stats", &dir.arg("long.ply")]);
+    assert_refused(&o, &["long.ply: byte 0: no 'end_header' line within the first 1 MiB"]);
+}
+
+// ---------------------------------------------------------------- terminal safety
+
+#[test]
+fn control_bytes_from_files_and_names_are_escaped_in_messages() {
+    let dir = TempDir::new("escape");
+    let cases: [(&str, &str, &str); 5] = [
+        // C1 controls and bidirectional overrides are valid UTF-8 text: quoted, escaped.
+        ("bad.obj", "v 0 0 0\n\u{9b}2Jclear 1 2\n", "unknown OBJ statement '\\u{9b}2Jclear'"),
+        ("bad.off", "OFF\n1 0 0\n0 \u{202e}1 0\n", "'\\u{202e}1' is not a number"),
+        ("bad.binvox", "#binvox 1\n\u{9b}5mdim 4 4 4\ndata\n", "unknown header line '\\u{9b}5mdim'"),
+        // ASCII controls stop the reading and are named, not echoed.
+        ("esc.off", "OFF\n1 0 0\n0 \x1b]0;title\x07 0\n", "byte 0x1b cannot be part of OFF text"),
+        // Names too.
+        ("bad\x1b[31mname.off", "PLY\n", "bad\\x1b[31mname.off:1"),
+    ];
+    for (name, text, needle) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        let o = if name.ends_with(".binvox") {
+            common::texgeo(&["render", &dir.arg(name), "-o", &dir.arg("x.png")])
+        } else {
+            common::texgeo(&["mesh", "stats", &dir.arg(name)])
+        };
+        assert_refused(&o, &[needle]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !err.chars().any(|c| (c.is_control() && c != '\n') || c == '\u{202e}'),
+            "{name}: raw control characters in {err:?}"
         );
     }
 }

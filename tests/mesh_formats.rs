@@ -427,3 +427,28 @@ fn text_formats_accept_a_byte_order_mark() {
     let e = formats::read_bytes(b"\xef\xbb\xbfOFF\n1 0 0\n0 y 0\n", Format::Off, &path("b.off")).unwrap_err();
     assert!(e.to_string().ends_with("b.off:3: 'y' is not a number"), "{e}");
 }
+
+#[test]
+fn empty_meshes_are_written_and_read_back_in_every_format() {
+    let dir = common::TempDir::new("formats-empty");
+    let empty = Mesh::new(Vec::new(), Vec::new()).unwrap();
+    // What an all-holes subdivision leaves: vertices, no faces.
+    let points = Mesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], Vec::new()).unwrap();
+    for (mesh, name) in [(&empty, "empty"), (&points, "points")] {
+        for ext in ["obj", "off", "ply", "stl"] {
+            let file = dir.join(&format!("{name}.{ext}"));
+            formats::write(&file, mesh).unwrap();
+            let back = formats::read(&file).unwrap_or_else(|e| panic!("{name}.{ext}: {e}"));
+            assert_eq!(back.num_faces(), 0, "{name}.{ext}");
+            // OBJ and STL keep only what faces use; OFF and PLY every vertex.
+            let kept = if matches!(ext, "off" | "ply") { mesh.num_vertices() } else { 0 };
+            assert_eq!(back.num_vertices(), kept, "{name}.{ext}");
+        }
+        let mut ascii = Vec::new();
+        ply::write_ascii(&mut ascii, mesh).unwrap();
+        assert_eq!(ply::read(&ascii, &path("a.ply")).unwrap(), *mesh, "{name} through ascii PLY");
+        let mut ascii = Vec::new();
+        stl::write_ascii(&mut ascii, mesh).unwrap();
+        assert_eq!(stl::read(&ascii, &path("a.stl")).unwrap().num_faces(), 0, "{name} through ascii STL");
+    }
+}

@@ -385,3 +385,38 @@ fn bad_options_are_refused_before_anything_runs() {
     assert_eq!(o.status.code(), Some(2), "-o is required");
     std::fs::remove_dir_all(empty).unwrap();
 }
+
+#[test]
+fn a_damaged_report_is_listed_and_gives_status_2() {
+    let base = temp("damaged");
+    let measurements = "experiment,model,quantity,unit,value,min,max,runs\n\
+                        voxelize,knot,time:cpu@64,s,1e0,9e-1,1.1e0,3\n\
+                        voxelize,knot,time:zoned@64,s,1e0,9e-1,1.1e0,3\n";
+    let claims = "id,source,claim,decided by,thesis,measured,verdict\nV1,s,c,d,t,m,holds\n";
+    let [old, new] = ["old", "new"].map(|n| base.join(n));
+    for dir in [&old, &new] {
+        std::fs::create_dir_all(dir.join("csv")).unwrap();
+        std::fs::write(dir.join("csv/measurements.csv"), measurements).unwrap();
+        std::fs::write(dir.join("csv/claims.csv"), claims).unwrap();
+        std::fs::write(dir.join("report.md"), "# report\n").unwrap();
+    }
+    let (o, n) = (old.to_str().unwrap(), new.to_str().unwrap());
+    // Whole but for run.json: the comparison is printed, and the damage makes it status 2.
+    let out = texgeo(&["reproduce", "--compare", o, n], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("damaged") && err.contains("run.json: missing"), "{err}");
+    // Cut measurements and a deleted claims file are listed.
+    std::fs::write(new.join("csv/measurements.csv"), measurements.lines().take(2).collect::<Vec<_>>().join("\n"))
+        .unwrap();
+    std::fs::remove_file(new.join("csv/claims.csv")).unwrap();
+    let out = texgeo(&["reproduce", "--compare", o, n], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let md = String::from_utf8_lossy(&out.stdout);
+    assert!(md.contains("Measurements of the old report missing from the new one (1)"), "{md}");
+    assert!(md.contains("voxelize / knot / time:zoned@64"), "{md}");
+    assert!(md.contains("Claims of the old report missing from the new one (1)") && md.contains("- V1"), "{md}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("claims.csv: missing"), "{err}");
+    std::fs::remove_dir_all(base).unwrap();
+}

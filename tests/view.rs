@@ -317,3 +317,79 @@ fn without_a_display_the_viewer_exits_2_and_points_to_pictures() {
         assert_eq!(err.trim_end().lines().count(), 1, "one message: {err}");
     }
 }
+
+#[test]
+fn every_script_step_takes_effect_in_first_position() {
+    let x = Xvfb::start();
+    let dir = temp("first");
+    let size = ["--size", "160x120"];
+    // The last of two frames, with `script` from the first frame on.
+    let shot = |name: &str, model: &[&str], script: &str| -> (Picture, String) {
+        let png = dir.join(format!("{name}.png"));
+        let mut args = model.to_vec();
+        args.extend(size);
+        args.extend(["--frames", "2", "--screenshot", png.to_str().unwrap()]);
+        if !script.is_empty() {
+            args.extend(["--script", script]);
+        }
+        let out = clean(&view(&x, &args, &dir), name);
+        (Picture::load_png(&png).unwrap(), out)
+    };
+    let render = |name: &str, model: &[&str]| -> Picture {
+        let png = dir.join(format!("{name}-render.png"));
+        let mut args = vec!["render"];
+        args.extend(model);
+        args.extend(size);
+        args.extend(["-o", png.to_str().unwrap()]);
+        clean(&texgeo(&args), name);
+        Picture::load_png(&png).unwrap()
+    };
+    let same = |a: &Picture, b: &Picture| a.pixels_differing(b, 1) == Some(0);
+    let cube = ["builtin:cube"];
+    let (plain, _) = shot("plain", &cube, "");
+    assert!(same(&plain, &render("plain", &cube)));
+    // Camera steps before the first frame: the camera they turn is the first one.
+    let (orbit, _) = shot("orbit", &cube, "orbit:90:0");
+    let turned = render("orbit", &["builtin:cube", "--yaw", "125"]);
+    assert!(orbit.pixels_differing(&turned, 8).is_some_and(|d| d < 100), "orbit:90:0 = --yaw 125");
+    assert!(!same(&orbit, &plain), "orbit:90:0 first turns the camera");
+    for (name, script, back) in [("zoom", "zoom:0.5", "zoom:0.5,zoom:2"), ("pan", "pan:0.2:0", "pan:0.2:0,pan:-0.2:0")] {
+        let (moved, _) = shot(name, &cube, script);
+        assert!(!same(&moved, &plain), "{script} alone changes the picture");
+        let (undone, _) = shot(&format!("{name}-back"), &cube, back);
+        assert!(undone.pixels_differing(&plain, 8).is_some_and(|d| d < 100), "{back} comes back");
+    }
+    // Keys first: the same picture as the option they toggle.
+    for (key, option) in
+        [("v", &["--valence"][..]), ("w", &["--wireframe"]), ("f", &["--shading", "smooth"]), ("+", &["--level", "1"])]
+    {
+        let (got, _) = shot(&format!("key-{key}"), &cube, key);
+        let mut model = cube.to_vec();
+        model.extend(option);
+        assert!(same(&got, &render(&format!("key-{key}"), &model)), "'{key}' first = {option:?}");
+    }
+    let (reset, _) = shot("key-r", &cube, "r");
+    assert!(same(&reset, &plain), "'r' first keeps the initial view");
+    let (saved, out) = shot("key-s", &cube, "s");
+    assert!(out.contains("wrote texgeo-view-001.png"), "{out}");
+    assert!(same(&Picture::load_png(dir.join("texgeo-view-001.png")).unwrap(), &saved));
+    let voxels = ["builtin:cube", "--voxels", "--res", "8", "--aspect", "perlin"];
+    let (aspect, _) = shot("aspect", &voxels, "");
+    let (flat, _) = shot("key-p", &voxels, "p");
+    assert!(!same(&aspect, &flat), "'p' first turns the aspect colours off");
+    // Window steps first.
+    let (resized, _) = shot("size", &cube, "size:200x150,wait:3");
+    assert_eq!((resized.width, resized.height), (200, 150));
+    for script in ["hide,wait:2,show", "minimize,wait:2,restore", "wait:3"] {
+        let (p, _) = shot("window", &cube, script);
+        assert!(same(&p, &plain), "{script}");
+    }
+    // --save-mesh names its file once.
+    let saved = dir.join("saved.obj");
+    let out = clean(
+        &view(&x, &["builtin:cube", "--frames", "1", "--save-mesh", saved.to_str().unwrap()], &dir),
+        "save-mesh",
+    );
+    assert_eq!(out.matches("saved.obj").count(), 1, "{out}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -18,7 +18,7 @@ pub enum SubdivError {
     TooLarge { level: u32, vertices: u64 },
     /// The level would not fit the memory the system has available.
     #[error(
-        "level {level} needs about {need_mib} MiB but only {have_mib} MiB are available; use a lower level"
+        "level {level} needs {need_mib} MiB but only {have_mib} MiB are available; use a lower level"
     )]
     Memory { level: u32, need_mib: crate::host::Mib, have_mib: u64 },
     /// The fragment-mesh path cannot represent this input or stream (SPEC §5.2).

@@ -94,6 +94,9 @@ struct App {
     frames: u64,
     step: usize,
     waiting: u32,
+    /// Camera steps of the script that came before there was a camera (the scene is
+    /// prepared with the first frame): applied, in order, to the first camera.
+    early_camera: Vec<Step>,
     /// The scene changed: rebuild the GPU buffers before the next frame.
     dirty: bool,
     /// The swapchain must be remade (resize, out of date).
@@ -118,6 +121,7 @@ impl App {
             frames: 0,
             step: 0,
             waiting: 0,
+            early_camera: Vec::new(),
             dirty: true,
             stale: true,
             shot: false,
@@ -231,21 +235,10 @@ impl App {
         let window = self.window.as_ref();
         match step {
             Step::Key(k) => self.key(k)?,
-            Step::Orbit(a, b) => {
-                if let Some(c) = &mut self.camera {
-                    c.orbit(a.to_radians(), b.to_radians());
-                }
-            }
-            Step::Zoom(f) => {
-                if let Some(c) = &mut self.camera {
-                    c.zoom(f);
-                }
-            }
-            Step::Pan(x, y) => {
-                if let Some(c) = &mut self.camera {
-                    c.pan(x, y);
-                }
-            }
+            Step::Orbit(..) | Step::Zoom(_) | Step::Pan(..) => match &mut self.camera {
+                Some(camera) => apply_camera(camera, &step),
+                None => self.early_camera.push(step),
+            },
             Step::Size(w, h) => {
                 if let Some(win) = window {
                     let _ = win.request_inner_size(PhysicalSize::new(w, h));
@@ -280,6 +273,11 @@ impl App {
             self.dirty = false;
             if self.camera.is_none() {
                 self.reset_camera();
+                if let Some(camera) = &mut self.camera {
+                    for step in self.early_camera.drain(..) {
+                        apply_camera(camera, &step);
+                    }
+                }
             }
             if self
                 .gfx
@@ -391,6 +389,16 @@ impl App {
             crate::say!("wrote {}", path.display());
         }
         Ok(())
+    }
+}
+
+/// Applies a camera step of a script (orbit, zoom, pan; other steps do nothing here).
+fn apply_camera(camera: &mut Camera, step: &Step) {
+    match *step {
+        Step::Orbit(a, b) => camera.orbit(a.to_radians(), b.to_radians()),
+        Step::Zoom(f) => camera.zoom(f),
+        Step::Pan(x, y) => camera.pan(x, y),
+        _ => {}
     }
 }
 

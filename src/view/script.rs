@@ -76,8 +76,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
             ("wait", 1) => Step::Wait(number(step, args[0])?),
             _ => {
                 return Err(ViewError::Usage(format!(
-                    "unknown script step '{step}' (keys + - v w f r s p; orbit:DX:DY, pan:DX:DY, zoom:F, \
-                     size:WxH, hide, show, minimize, restore, wait[:N])"
+                    "unknown script step '{step}' (steps are separated by commas, e.g. '+,+,v'; keys + - v w f r s p; \
+                     orbit:DX:DY, pan:DX:DY, zoom:F, size:WxH, hide, show, minimize, restore, wait[:N])"
                 )));
             }
         });

@@ -76,7 +76,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let outputs: Vec<(Operation, PathBuf)> = match (&args.output, &args.all) {
         (Some(path), _) => {
             Format::from_path(path).with_context(|| format!("output {}", path.display()))?;
-            texgeo::output::check_file(path)?;
+            texgeo::output::check_output(path, &MeshArg::files([&args.a, &args.b]))?;
             let op = op.context("--op is needed with -o")?;
             vec![(op, path.clone())]
         }
@@ -85,7 +85,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             Format::from_path(&probe).with_context(|| format!("--format {}", args.format))?;
             texgeo::output::check_dir(dir)?;
             let ops: Vec<Operation> = op.map_or(Operation::ALL.to_vec(), |o| vec![o]);
-            ops.into_iter().map(|o| (o, dir.join(format!("{}.{}", o.name(), args.format)))).collect()
+            let paths: Vec<(Operation, PathBuf)> =
+                ops.into_iter().map(|o| (o, dir.join(format!("{}.{}", o.name(), args.format)))).collect();
+            for (_, path) in &paths {
+                texgeo::output::check_not_input(path, &MeshArg::files([&args.a, &args.b]))?;
+            }
+            paths
         }
         (None, None) => anyhow::bail!("give -o OUT or --all DIR"),
     };

@@ -42,11 +42,15 @@ pub struct Args {
     /// Reverse every face of an inverted solid (faces pointing inwards) instead of refusing it.
     #[arg(long)]
     flip_inverted: bool,
-    /// Write one line per point: 1 inside, 0 outside, 2 on the boundary (to a `.npy` path:
-    /// a uint8 array of those values).
+    /// Write one line per point: 1 inside, 0 outside, 2 on the boundary (a text file:
+    /// `.txt`, `.dat`, `.csv`, `.labels` or no extension), or to a `.npy` path a uint8 array
+    /// of those values.
     #[arg(short, long)]
     output: Option<PathBuf>,
 }
+
+/// Extensions of `-o`: text, or NumPy.
+const LABEL_EXTENSIONS: [&str; 5] = ["txt", "dat", "csv", "labels", "npy"];
 
 /// Bytes per query point while classifying: the point (24), its class, the GPU paths'
 /// per-point bookkeeping (flags, cell keys, sorted order), with margin.
@@ -54,7 +58,16 @@ const BYTES_PER_POINT: u64 = 64;
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
-        texgeo::output::check_file(out)?;
+        if out.extension().is_some() {
+            texgeo::output::check_extension(
+                out,
+                &LABEL_EXTENSIONS,
+                "labels are written as text (or NumPy), not in the format that name says",
+            )?;
+        }
+        let mut inputs = crate::mesh::MeshArg::files([&args.mesh]);
+        inputs.extend(args.points.as_deref());
+        texgeo::output::check_output(out, &inputs)?;
     }
     // The size of what is held whole, before anything is read or allocated: random points
     // and `.npy` files (text files are read a block at a time).
@@ -208,7 +221,7 @@ pub fn check_size(count: u64, from_file: bool, to_file: bool) -> anyhow::Result<
             String::new()
         };
         anyhow::bail!(
-            "{count} points: {what} need about {need} MiB of memory, but only {have} MiB are available{text}"
+            "{count} points: {what} need {need} MiB of memory, but only {have} MiB are available{text}"
         );
     }
     Ok(())

@@ -68,6 +68,11 @@ impl MeshArg {
     pub fn file(&self) -> Option<&Path> {
         self.builtin().is_none().then_some(self.0.as_path())
     }
+
+    /// The files among `args` (for "never overwrite an input").
+    pub fn files<'a>(args: impl IntoIterator<Item = &'a MeshArg>) -> Vec<&'a Path> {
+        args.into_iter().filter_map(MeshArg::file).collect()
+    }
 }
 
 /// Reads a mesh file, or a built-in model given as `builtin:NAME`.
@@ -128,7 +133,7 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
         }
         Command::Convert { input, output } => {
             formats::Format::from_path(&output)?;
-            texgeo::output::check_file(&output)?;
+            texgeo::output::check_output(&output, &MeshArg::files([&input]))?;
             let m = load(&input)?;
             formats::write(&output, &m)?;
             say!("{input} -> {}: {} vertices, {} faces", output.display(), m.num_vertices(), m.num_faces());

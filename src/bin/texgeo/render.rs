@@ -179,6 +179,11 @@ impl Show {
         self.aspect.as_ref().map(|_| Aspect { material: self.material, ..Aspect::default() })
     }
 
+    /// The files read (for "never overwrite an input").
+    pub fn inputs(&self) -> Vec<&std::path::Path> {
+        MeshArg::files(std::iter::once(&self.input).chain(&self.others).chain(&self.boolean))
+    }
+
     /// All inputs, for titles and messages.
     pub fn name(&self) -> String {
         if let (Some(b), Some(op)) = (&self.boolean, self.op) {
@@ -200,10 +205,8 @@ const PALETTE: [colour::Rgba; 4] = [colour::FIRST, colour::SECOND, colour::SURFA
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let show = &args.show;
     show.check()?;
-    if !args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-        bail!("{}: the picture is written as PNG; name it .png", args.output.display());
-    }
-    texgeo::output::check_file(&args.output)?;
+    texgeo::output::check_extension(&args.output, &["png"], "the picture is written as PNG")?;
+    texgeo::output::check_output(&args.output, &show.inputs())?;
     let content = show.content()?;
     let ctx = crate::open_context(device)?;
     let mut model = Model::new(&ctx, content, show.level, show.look(), show.aspect())?;

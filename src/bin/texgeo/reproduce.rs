@@ -81,7 +81,11 @@ impl Monitor for Bars {
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(dirs) = &args.compare {
         let [old, new] = dirs.as_slice() else { anyhow::bail!("--compare needs two folders: OLD NEW") };
-        say!("{}", reproduce::compare(old, new)?.trim_end());
+        let c = reproduce::compare(old, new)?;
+        say!("{}", c.markdown.trim_end());
+        if !c.damage.is_empty() {
+            anyhow::bail!("damaged report(s), compared in part only: {}", c.damage.join("; "));
+        }
         return Ok(());
     }
     let out = args.out.clone().ok_or_else(|| anyhow::anyhow!("-o DIR is required"))?;

@@ -183,7 +183,7 @@ fn check_size(
     let bytes = 48 * v + 64 * f + 9 * e + gpu;
     if let Err((need, have)) = texgeo::host::check_available(Mib::saturate(bytes)) {
         anyhow::bail!(
-            "level {level} ({vs} vertices, {fs} faces) needs about {need} MiB, but only {have} MiB are available{text}; \
+            "level {level} ({vs} vertices, {fs} faces) needs {need} MiB, but only {have} MiB are available{text}; \
              use a lower level"
         );
     }
@@ -221,7 +221,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
         // A wrong extension or an unwritable folder fails now, not after the subdivision.
         formats::Format::from_path(out)?;
-        texgeo::output::check_file(out)?;
+        texgeo::output::check_output(out, &crate::mesh::MeshArg::files([&args.input]))?;
     }
     let tagged = crate::mesh::load_tagged(&args.input)?;
     for ignored in &tagged.ignored {

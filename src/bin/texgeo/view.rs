@@ -21,8 +21,11 @@ pub struct Args {
     /// With --frames: save the last frame, as presented, to this PNG.
     #[arg(long)]
     screenshot: Option<PathBuf>,
-    /// Steps applied one per frame: keys `+ - v w f r s p`, `orbit:DX:DY` (degrees),
-    /// `pan:DX:DY`, `zoom:F`, `size:WxH`, `hide`, `show`, `minimize`, `restore`, `wait[:N]`.
+    /// Steps applied one per frame, separated by commas: keys `+ - v w f r s p`,
+    /// `orbit:DX:DY` (degrees), `pan:DX:DY` (picture heights), `zoom:F` (distance factor),
+    /// `size:WxH`, `hide`, `show`, `minimize`, `restore`, `wait[:N]` (frames). Example:
+    /// `--script 'orbit:90:0,zoom:0.5,+,+,v,s'` turns the camera, moves closer, goes two
+    /// levels up, colours by valence and saves a screenshot.
     #[arg(long, allow_hyphen_values = true)]
     script: Option<String>,
     /// On exit, write the mesh on screen (at the level shown) to this file.
@@ -33,15 +36,19 @@ pub struct Args {
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let show = &args.show;
     show.check()?;
+    // Every output is checked before the window opens, like every other command's.
     if let Some(path) = &args.screenshot {
         if args.frames.is_none() {
             bail!(
                 "--screenshot saves the last of --frames N frames; add --frames (or press `s` in the window)"
             );
         }
-        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-            bail!("{}: screenshots are PNG; name it .png", path.display());
-        }
+        texgeo::output::check_extension(path, &["png"], "screenshots are PNG")?;
+        texgeo::output::check_output(path, &show.inputs())?;
+    }
+    if let Some(path) = &args.save_mesh {
+        texgeo::mesh::formats::Format::from_path(path)?;
+        texgeo::output::check_output(path, &show.inputs())?;
     }
     if args.frames == Some(0) {
         bail!("--frames must be at least 1");

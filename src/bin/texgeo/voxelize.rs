@@ -55,7 +55,8 @@ pub struct Args {
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     // Check the request and every output path before touching the mesh or the device.
     texgeo::voxel::grid::check_resolution(args.res)?;
-    texgeo::output::check_file(&args.output)?;
+    texgeo::output::check_extension(&args.output, &["binvox"], "the volume is written as binvox")?;
+    texgeo::output::check_output(&args.output, &crate::mesh::MeshArg::files([&args.mesh]))?;
     if let Some(dir) = &args.slices {
         texgeo::output::check_dir(dir)?;
     }

@@ -3,7 +3,11 @@
 //! runs (`csv/measurements.csv`); a value moved when the two ranges do not overlap —
 //! the noise is what the runs themselves showed, not a constant. Counts and sizes (a
 //! single exact value) moved when they differ at all. Claims whose verdict changed are
-//! listed too.
+//! listed too, and so is everything that keeps the two reports from being compared whole:
+//! a missing or unreadable file (`run.json`, `csv/measurements.csv`, `csv/claims.csv`,
+//! `report.md`), measurements and claims found in one report only. A report with a
+//! missing or unreadable file is damaged ([`Comparison::damage`]): the command prints the
+//! comparison and exits with status 2.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -39,9 +43,13 @@ pub fn measurements_csv(facts: &Facts) -> String {
 /// (experiment, model, quantity) → value.
 type Measurements = Vec<((String, String, String), Stat)>;
 
-fn read_measurements(dir: &Path) -> Result<Measurements> {
+/// Reads `csv/measurements.csv`; a missing file is `Ok(None)` (the caller lists it).
+fn read_measurements(dir: &Path) -> Result<Option<Measurements>> {
     let path = dir.join("csv").join("measurements.csv");
     let bad = |why: String| ReproduceError::Usage(format!("{}: {why}", path.display()));
+    if !path.exists() {
+        return Ok(None);
+    }
     let mut r =
         csv::Reader::from_path(&path).map_err(|e| bad(format!("{e} (not a texgeo reproduce folder?)")))?;
     let header: Vec<String> =
@@ -60,30 +68,79 @@ fn read_measurements(dir: &Path) -> Result<Measurements> {
         let stat = Stat { value: num(4)?, min: num(5)?, max: num(6)?, runs: num(7)? as usize };
         out.push(((rec[0].to_string(), rec[1].to_string(), rec[2].to_string()), stat));
     }
+    Ok(Some(out))
+}
+
+/// id → verdict, from `csv/claims.csv`; `Err` says what is wrong with the file.
+fn read_verdicts(dir: &Path) -> std::result::Result<Vec<(String, String)>, String> {
+    let path = dir.join("csv").join("claims.csv");
+    let mut r = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = Vec::new();
+    for (line, rec) in r.records().enumerate() {
+        let rec = rec.map_err(|e| format!("{}: {e}", path.display()))?;
+        match (rec.get(0), rec.get(6)) {
+            (Some(id), Some(verdict)) if !id.is_empty() => out.push((id.to_string(), verdict.to_string())),
+            _ => return Err(format!("{}: line {}: no claim id and verdict", path.display(), line + 2)),
+        }
+    }
     Ok(out)
 }
 
-/// id → verdict, from `csv/claims.csv`.
-fn read_verdicts(dir: &Path) -> Vec<(String, String)> {
-    let Ok(mut r) = csv::Reader::from_path(dir.join("csv").join("claims.csv")) else { return Vec::new() };
-    r.records().flatten().filter_map(|rec| Some((rec.get(0)?.to_string(), rec.get(6)?.to_string()))).collect()
+fn read_header(dir: &Path) -> std::result::Result<Header, String> {
+    let path = dir.join("run.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn read_header(dir: &Path) -> Option<Header> {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).ok()?).ok()
+/// What `--compare` found: the comparison as Markdown, and what is missing or unreadable
+/// in either report (empty: both are whole).
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    pub markdown: String,
+    pub damage: Vec<String>,
+}
+
+/// At most this many keys are listed per "in one report only" list.
+const LISTED: usize = 20;
+
+/// A Markdown list of `keys` (at most [`LISTED`], then how many more).
+fn key_list(s: &mut String, keys: &[String]) {
+    for k in keys.iter().take(LISTED) {
+        let _ = writeln!(s, "- {k}");
+    }
+    if keys.len() > LISTED {
+        let _ = writeln!(s, "- … and {} more", keys.len() - LISTED);
+    }
 }
 
 fn num(v: f64) -> String {
     super::experiments::num(v)
 }
 
-/// The comparison of two report folders, as Markdown.
-pub fn compare(old: &Path, new: &Path) -> Result<String> {
-    let (a, b) = (read_measurements(old)?, read_measurements(new)?);
+/// The comparison of two report folders. Fails when either has no readable
+/// measurements (nothing to compare), listing every problem of both.
+pub fn compare(old: &Path, new: &Path) -> Result<Comparison> {
+    let mut damage = Vec::new();
+    let mut measured = Vec::new();
+    for dir in [old, new] {
+        match read_measurements(dir) {
+            Ok(Some(m)) => measured.push(m),
+            Ok(None) => damage.push(format!("{}: missing", dir.join("csv/measurements.csv").display())),
+            Err(e) => damage.push(e.to_string()),
+        }
+        for file in ["report.md", "csv/claims.csv", "run.json"] {
+            if !dir.join(file).is_file() {
+                damage.push(format!("{}: missing", dir.join(file).display()));
+            }
+        }
+    }
+    let [a, b]: [Measurements; 2] = measured.try_into().map_err(|_| {
+        ReproduceError::Usage(format!("cannot compare the reports: {}", damage.join("; ")))
+    })?;
     let mut s = String::from("# texgeo reproduce --compare\n\n");
     for (label, dir) in [("old", old), ("new", new)] {
         match read_header(dir) {
-            Some(h) => {
+            Ok(h) => {
                 let _ = writeln!(
                     s,
                     "- {label}: `{}` — {} on {} ({}), {} {}, texgeo {} ({}), {}, {}",
@@ -99,7 +156,10 @@ pub fn compare(old: &Path, new: &Path) -> Result<String> {
                     h.mode
                 );
             }
-            None => {
+            Err(e) => {
+                if dir.join("run.json").is_file() {
+                    damage.push(e);
+                }
                 let _ = writeln!(s, "- {label}: `{}`", dir.display());
             }
         }
@@ -107,12 +167,13 @@ pub fn compare(old: &Path, new: &Path) -> Result<String> {
     let mut moved = Vec::new();
     let mut changed = Vec::new();
     let mut within = 0usize;
-    let mut unmatched = 0usize;
+    let name = |(e, m, q): &(String, String, String)| format!("{e} / {m} / {q}");
+    let only_old: Vec<String> =
+        a.iter().filter(|(k, _)| !b.iter().any(|(j, _)| j == k)).map(|(k, _)| name(k)).collect();
+    let only_new: Vec<String> =
+        b.iter().filter(|(k, _)| !a.iter().any(|(j, _)| j == k)).map(|(k, _)| name(k)).collect();
     for (key, x) in &a {
-        let Some((_, y)) = b.iter().find(|(k, _)| k == key) else {
-            unmatched += 1;
-            continue;
-        };
+        let Some((_, y)) = b.iter().find(|(k, _)| k == key) else { continue };
         let ratio = if x.value != 0.0 { y.value / x.value } else { f64::INFINITY };
         if x.runs < 2 || y.runs < 2 {
             if x.value != y.value {
@@ -159,7 +220,19 @@ pub fn compare(old: &Path, new: &Path) -> Result<String> {
         }
         s.push_str("\nThese were measured once per run (index builds, memory, counts): no noise estimate.\n");
     }
-    let (va, vb) = (read_verdicts(old), read_verdicts(new));
+    let mut verdicts = Vec::new();
+    for dir in [old, new] {
+        match read_verdicts(dir) {
+            Ok(v) => verdicts.push(v),
+            Err(e) => {
+                if dir.join("csv/claims.csv").is_file() {
+                    damage.push(e);
+                }
+                verdicts.push(Vec::new());
+            }
+        }
+    }
+    let (va, vb) = (&verdicts[0], &verdicts[1]);
     let flips: Vec<String> = va
         .iter()
         .filter_map(|(id, v)| {
@@ -174,11 +247,28 @@ pub fn compare(old: &Path, new: &Path) -> Result<String> {
     if flips.is_empty() {
         s.push_str("None.\n");
     }
-    if unmatched > 0 {
-        let _ =
-            writeln!(s, "\n{unmatched} measurement(s) of the old report have no counterpart in the new one.");
+    let claims_only = |x: &[(String, String)], y: &[(String, String)]| -> Vec<String> {
+        x.iter().filter(|(id, _)| !y.iter().any(|(j, _)| j == id)).map(|(id, _)| id.clone()).collect()
+    };
+    let lists = [
+        ("Measurements of the old report missing from the new one", only_old),
+        ("Measurements of the new report missing from the old one", only_new),
+        ("Claims of the old report missing from the new one", claims_only(va, vb)),
+        ("Claims of the new report missing from the old one", claims_only(vb, va)),
+    ];
+    for (title, keys) in &lists {
+        if !keys.is_empty() {
+            let _ = writeln!(s, "\n## {title} ({})\n", keys.len());
+            key_list(&mut s, keys);
+        }
     }
-    Ok(s)
+    if !damage.is_empty() {
+        let _ = writeln!(s, "\n## Damaged reports: missing or unreadable files ({})\n", damage.len());
+        for d in &damage {
+            let _ = writeln!(s, "- {d}");
+        }
+    }
+    Ok(Comparison { markdown: s, damage })
 }
 
 #[cfg(test)]
@@ -206,12 +296,46 @@ mod tests {
     #[test]
     fn only_values_whose_runs_do_not_overlap_have_moved() {
         let (a, b, c) = (run_dir("a", 1.0, 0.1), run_dir("b", 1.15, 0.1), run_dir("c", 2.0, 0.1));
-        let ab = compare(&a, &b).unwrap();
+        let ab = compare(&a, &b).unwrap().markdown;
         assert!(ab.contains("(0 of 2)"), "{ab}");
-        let ac = compare(&a, &c).unwrap();
+        let ac = compare(&a, &c).unwrap().markdown;
         assert!(ac.contains("(1 of 2)") && ac.contains("time:cpu@64") && ac.contains("2.000×"), "{ac}");
         assert!(ac.contains("memory:octants"), "an exact value that changed is listed: {ac}");
         for d in [a, b, c] {
+            std::fs::remove_dir_all(d).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_damaged_report_is_named_with_what_is_missing() {
+        let a = run_dir("whole", 1.0, 0.1);
+        let b = run_dir("damaged", 1.0, 0.1);
+        for dir in [&a, &b] {
+            std::fs::write(dir.join("report.md"), "# report\n").unwrap();
+            std::fs::write(dir.join("run.json"), "{}").unwrap();
+            std::fs::write(
+                dir.join("csv/claims.csv"),
+                "id,source,claim,decided by,thesis,measured,verdict\nV1,s,c,d,t,m,holds\nV2,s,c,d,t,m,holds\n",
+            )
+            .unwrap();
+        }
+        // Whole but for run.json's contents: damaged, and said so.
+        let c = compare(&a, &b).unwrap();
+        assert_eq!(c.damage.len(), 2, "{:?}", c.damage);
+        assert!(c.damage.iter().all(|d| d.contains("run.json")), "{:?}", c.damage);
+        // Measurements cut to the first row, claims deleted.
+        let m = std::fs::read_to_string(b.join("csv/measurements.csv")).unwrap();
+        let cut: Vec<&str> = m.lines().take(2).collect();
+        std::fs::write(b.join("csv/measurements.csv"), cut.join("\n") + "\n").unwrap();
+        std::fs::remove_file(b.join("csv/claims.csv")).unwrap();
+        let c = compare(&a, &b).unwrap();
+        assert!(c.damage.iter().any(|d| d.ends_with("claims.csv: missing")), "{:?}", c.damage);
+        let md = &c.markdown;
+        assert!(md.contains("Measurements of the old report missing from the new one (2)"), "{md}");
+        assert!(md.contains("voxelize / knot / time:zoned@64") && md.contains("inclusion / knot / memory:octants"));
+        assert!(md.contains("Claims of the old report missing from the new one (2)") && md.contains("- V2"), "{md}");
+        assert!(md.contains("## Damaged reports"), "{md}");
+        for d in [a, b] {
             std::fs::remove_dir_all(d).unwrap();
         }
     }
