@@ -333,7 +333,7 @@ fn a_signal_removes_the_temporary_file_and_the_next_run_removes_stale_ones() {
     for signal in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
         std::fs::write(&out, b"previous good contents").unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
-            .args(["voxelize", "builtin:sphere", "--res", "768", "--method", "scanline", "-o", out.to_str().unwrap()])
+            .args(["voxelize", "builtin:sphere", "--res", "1024", "--method", "scanline", "-o", out.to_str().unwrap()])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()

@@ -364,9 +364,10 @@ impl App {
     /// Drops every GPU resource, then checks that nothing leaked and validation stayed quiet.
     fn finish(mut self) -> Result<()> {
         let saved = match (&self.options.save_mesh, self.gfx.as_ref().and_then(|g| g.model.shown_mesh())) {
-            (Some(path), Some(mesh)) => crate::mesh::formats::write(path, mesh)
-                .map_err(|e| ViewError::Output { path: path.clone(), message: e.to_string() })
-                .map(|()| Some(path.clone())),
+            // The error names the path already.
+            (Some(path), Some(mesh)) => {
+                crate::mesh::formats::write(path, mesh).map_err(ViewError::from).map(|()| Some(path.clone()))
+            }
             (Some(_), None) => Err(ViewError::Usage("--save-mesh needs a single mesh on screen".into())),
             _ => Ok(None),
         };
