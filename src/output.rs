@@ -98,7 +98,8 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
             // Kept locked: nothing is created or committed from here on.
             let list = pending();
             for p in list.iter() {
-                let _ = if p.folder { std::fs::remove_dir_all(&p.path) } else { std::fs::remove_file(&p.path) };
+                let _ =
+                    if p.folder { std::fs::remove_dir_all(&p.path) } else { std::fs::remove_file(&p.path) };
             }
             let _ = signal_hook::low_level::emulate_default_handler(signal);
             std::process::exit(128 + signal);
@@ -146,7 +147,10 @@ fn alive(pid: u32) -> bool {
 /// A folder is listed once per process (texgeo temporaries only, by name and PID); each
 /// target then removes its own.
 fn remove_stale(target: &Path) {
-    static FOUND: Mutex<Option<HashMap<PathBuf, Vec<(Vec<u8>, u32, PathBuf)>>>> = Mutex::new(None);
+    /// Per folder: the target name (or its cut prefix), the PID and the path of each
+    /// texgeo temporary file found when the folder was first listed.
+    type Found = HashMap<PathBuf, Vec<(Vec<u8>, u32, PathBuf)>>;
+    static FOUND: Mutex<Option<Found>> = Mutex::new(None);
     let (Some(name), folder) = (target.file_name(), folder_of(target)) else { return };
     let mut found = FOUND.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let listed = found.get_or_insert_with(HashMap::new).entry(folder.clone()).or_insert_with(|| {

@@ -15,7 +15,9 @@ fn rerun_paths() -> Vec<PathBuf> {
     let output = out_dir.parent().expect("OUT_DIR has a parent").join("output");
     let text = std::fs::read_to_string(&output).unwrap_or_else(|e| panic!("{}: {e}", output.display()));
     text.lines()
-        .filter_map(|l| l.strip_prefix("cargo:rerun-if-changed=").or_else(|| l.strip_prefix("cargo::rerun-if-changed=")))
+        .filter_map(|l| {
+            l.strip_prefix("cargo:rerun-if-changed=").or_else(|| l.strip_prefix("cargo::rerun-if-changed="))
+        })
         .map(|p| Path::new(env!("CARGO_MANIFEST_DIR")).join(p))
         .collect()
 }
@@ -25,7 +27,11 @@ fn every_path_the_build_script_watches_exists() {
     let paths = rerun_paths();
     assert!(paths.iter().any(|p| p.ends_with("glsl")), "{paths:?}");
     for p in &paths {
-        assert!(p.exists(), "{} is watched but does not exist: every build would rerun the build script", p.display());
+        assert!(
+            p.exists(),
+            "{} is watched but does not exist: every build would rerun the build script",
+            p.display()
+        );
     }
 }
 

@@ -374,17 +374,35 @@ fn option_values_that_would_overflow_are_refused_up_front() {
     let dir = TempDir::new("cli-overflow");
     let out = dir.arg("bench");
     for (args, needles) in [
-        (vec!["sweep", "m.txt", "--task", "inclusion", "-o", &out, "--timeout", "1e20"], vec!["--timeout", "1e20"]),
+        (
+            vec!["sweep", "m.txt", "--task", "inclusion", "-o", &out, "--timeout", "1e20"],
+            vec!["--timeout", "1e20"],
+        ),
         (vec!["sweep", "m.txt", "--task", "inclusion", "-o", &out, "--timeout", "nan"], vec!["--timeout"]),
         (vec!["bench", "scale", "--budget", "1e30", "-o", &out], vec!["--budget"]),
-        (vec!["bench", "xor", "--triangles", "18446744073709551615", "-o", &out], vec!["at most 1431655765 triangles"]),
+        (
+            vec!["bench", "xor", "--triangles", "18446744073709551615", "-o", &out],
+            vec!["at most 1431655765 triangles"],
+        ),
         (vec!["bench", "xor", "--triangles", "1000000000", "-o", &out], vec!["1000000000 triangles", "MiB"]),
-        (vec!["bench", "inclusion", "--points", "18446744073709551615", "-o", &out], vec!["more than", "MiB"]),
+        (
+            vec!["bench", "inclusion", "--points", "18446744073709551615", "-o", &out],
+            vec!["more than", "MiB"],
+        ),
         (vec!["bench", "scale", "--points", "100000000000", "-o", &out], vec!["100000000000 points", "MiB"]),
         (vec!["bench", "boolean", "--scaling", "100000000000", "-o", &out], vec!["--scaling 100000000000"]),
-        (vec!["bench", "boolean", "--scaling", "2000000000", "-o", &out], vec!["--scaling 2000000000", "MiB"]),
-        (vec!["voxelize", "builtin:cube", "--res", "9223372036854775808", "-o", "a.binvox"], vec!["more than"]),
-        (vec!["subdivide", "builtin:cube", "-l", "4000000000"], vec!["more than 18446744073709551615 vertices"]),
+        (
+            vec!["bench", "boolean", "--scaling", "2000000000", "-o", &out],
+            vec!["--scaling 2000000000", "MiB"],
+        ),
+        (
+            vec!["voxelize", "builtin:cube", "--res", "9223372036854775808", "-o", "a.binvox"],
+            vec!["more than"],
+        ),
+        (
+            vec!["subdivide", "builtin:cube", "-l", "4000000000"],
+            vec!["more than 18446744073709551615 vertices"],
+        ),
     ] {
         let started = std::time::Instant::now();
         let o = texgeo(&args);
@@ -406,7 +424,8 @@ fn mesh_paths_need_not_be_utf8() {
     let path = dir.path().join(std::ffi::OsStr::from_bytes(b"t\xffe.off"));
     assert!(texgeo(&["mesh", "convert", "builtin:tetrahedron", dir.arg("t.off").as_str()]).status.success());
     std::fs::rename(dir.join("t.off"), &path).unwrap();
-    for (before, after) in [(&["mesh", "stats"][..], &[][..]), (&["inclusion"][..], &["--random", "10"][..])] {
+    for (before, after) in [(&["mesh", "stats"][..], &[][..]), (&["inclusion"][..], &["--random", "10"][..])]
+    {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_texgeo"))
             .args(before)
             .arg(&path)
@@ -426,7 +445,12 @@ fn an_empty_mesh_is_a_solid_that_holds_nothing() {
     let o = texgeo(&["mesh", "stats", &empty]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
-    for needle in ["faces                  0", "volume                 0 ", "area                   0\n", "solid: yes (empty)"] {
+    for needle in [
+        "faces                  0",
+        "volume                 0 ",
+        "area                   0\n",
+        "solid: yes (empty)",
+    ] {
         assert!(out.contains(needle), "'{needle}' in {out}");
     }
     for method in ["auto", "cpu", "bvh", "jordan", "winding", "gpu"] {
@@ -456,9 +480,23 @@ fn an_all_holes_subdivision_is_written_readable_and_validates() {
     for ext in ["obj", "off"] {
         let out = dir.arg(&format!("out.{ext}"));
         // --validate reads OpenSubdiv's result, a file without faces, back too.
-        let o = texgeo(&["subdivide", cube.to_str().unwrap(), "-l", "1", "--method", "cpu", "--validate", "-o", &out]);
+        let o = texgeo(&[
+            "subdivide",
+            cube.to_str().unwrap(),
+            "-l",
+            "1",
+            "--method",
+            "cpu",
+            "--validate",
+            "-o",
+            &out,
+        ]);
         assert!(o.status.success(), "{ext}: {}{}", stdout(&o), stderr(&o));
-        assert!(stdout(&o).contains("level 1: ") && stdout(&o).contains("validation passed"), "{}", stdout(&o));
+        assert!(
+            stdout(&o).contains("level 1: ") && stdout(&o).contains("validation passed"),
+            "{}",
+            stdout(&o)
+        );
         let o = texgeo(&["mesh", "stats", &out]);
         assert!(o.status.success(), "{ext}: {}", stderr(&o));
         assert!(stdout(&o).contains("faces                  0") && stdout(&o).contains("solid: yes (empty)"));

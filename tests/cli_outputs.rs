@@ -239,7 +239,18 @@ fn a_closed_stderr_is_not_a_panic_and_outputs_are_still_written() {
         // `auto` names its choice on stderr; bench says which files it wrote there.
         vec!["inclusion", "builtin:knot", "--random", "100", "-o", classes.to_str().unwrap()],
         vec!["voxelize", "builtin:knot", "--res", "16", "-o", volume.to_str().unwrap()],
-        vec!["bench", "xor", "--sizes", "16", "--triangles", "10", "--runs", "1", "-o", bench.to_str().unwrap()],
+        vec![
+            "bench",
+            "xor",
+            "--sizes",
+            "16",
+            "--triangles",
+            "10",
+            "--runs",
+            "1",
+            "-o",
+            bench.to_str().unwrap(),
+        ],
         vec!["mesh", "stats", "builtin:nope"],
     ] {
         // Like `texgeo … 2>&1 | head -c0`: both streams closed.
@@ -333,7 +344,16 @@ fn a_signal_removes_the_temporary_file_and_the_next_run_removes_stale_ones() {
     for signal in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
         std::fs::write(&out, b"previous good contents").unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
-            .args(["voxelize", "builtin:sphere", "--res", "1024", "--method", "scanline", "-o", out.to_str().unwrap()])
+            .args([
+                "voxelize",
+                "builtin:sphere",
+                "--res",
+                "1024",
+                "--method",
+                "scanline",
+                "-o",
+                out.to_str().unwrap(),
+            ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()

@@ -407,15 +407,21 @@ fn a_damaged_report_is_listed_and_gives_status_2() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("damaged") && err.contains("run.json: missing"), "{err}");
     // Cut measurements and a deleted claims file are listed.
-    std::fs::write(new.join("csv/measurements.csv"), measurements.lines().take(2).collect::<Vec<_>>().join("\n"))
-        .unwrap();
+    std::fs::write(
+        new.join("csv/measurements.csv"),
+        measurements.lines().take(2).collect::<Vec<_>>().join("\n"),
+    )
+    .unwrap();
     std::fs::remove_file(new.join("csv/claims.csv")).unwrap();
     let out = texgeo(&["reproduce", "--compare", o, n], &[]);
     assert_eq!(out.status.code(), Some(2));
     let md = String::from_utf8_lossy(&out.stdout);
     assert!(md.contains("Measurements of the old report missing from the new one (1)"), "{md}");
     assert!(md.contains("voxelize / knot / time:zoned@64"), "{md}");
-    assert!(md.contains("Claims of the old report missing from the new one (1)") && md.contains("- V1"), "{md}");
+    assert!(
+        md.contains("Claims of the old report missing from the new one (1)") && md.contains("- V1"),
+        "{md}"
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("claims.csv: missing"), "{err}");
     std::fs::remove_dir_all(base).unwrap();

@@ -354,7 +354,9 @@ fn every_script_step_takes_effect_in_first_position() {
     let turned = render("orbit", &["builtin:l-prism", "--yaw", "125"]);
     assert!(orbit.pixels_differing(&turned, 8).is_some_and(|d| d < 100), "orbit:90:0 = --yaw 125");
     assert!(!same(&orbit, &plain), "orbit:90:0 first turns the camera");
-    for (name, script, back) in [("zoom", "zoom:0.5", "zoom:0.5,zoom:2"), ("pan", "pan:0.2:0", "pan:0.2:0,pan:-0.2:0")] {
+    for (name, script, back) in
+        [("zoom", "zoom:0.5", "zoom:0.5,zoom:2"), ("pan", "pan:0.2:0", "pan:0.2:0,pan:-0.2:0")]
+    {
         let (moved, _) = shot(name, &prism, script);
         assert!(!same(&moved, &plain), "{script} alone changes the picture");
         let (undone, _) = shot(&format!("{name}-back"), &prism, back);
@@ -363,9 +365,12 @@ fn every_script_step_takes_effect_in_first_position() {
     let cube = ["builtin:cube"];
     let (plain, _) = shot("plain", &cube, "");
     // Keys first: the same picture as the option they toggle.
-    for (key, option) in
-        [("v", &["--valence"][..]), ("w", &["--wireframe"]), ("f", &["--shading", "smooth"]), ("+", &["--level", "1"])]
-    {
+    for (key, option) in [
+        ("v", &["--valence"][..]),
+        ("w", &["--wireframe"]),
+        ("f", &["--shading", "smooth"]),
+        ("+", &["--level", "1"]),
+    ] {
         let (got, _) = shot(&format!("key-{key}"), &cube, key);
         let mut model = cube.to_vec();
         model.extend(option);

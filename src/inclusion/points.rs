@@ -62,16 +62,19 @@ impl bounded::Guard for NpyGuard {
             };
             let Some(len) = len else { return Ok(()) };
             if len > bounded::MAX_HEADER {
-                return Err(stop(8, format!("a .npy header of {len} bytes (at most {} MiB)", bounded::MAX_HEADER >> 20)));
+                return Err(stop(
+                    8,
+                    format!("a .npy header of {len} bytes (at most {} MiB)", bounded::MAX_HEADER >> 20),
+                ));
             }
             if bytes.len() < start + len {
                 return Ok(());
             }
-            let h = npy_header(&bytes[..start + len], Path::new("")).map_err(|e| {
-                stop(start, e.to_string().trim_start_matches(": ").to_string())
-            })?;
+            let h = npy_header(&bytes[..start + len], Path::new(""))
+                .map_err(|e| stop(start, e.to_string().trim_start_matches(": ").to_string()))?;
             let items = h.shape.iter().try_fold(1u64, |n, &d| n.checked_mul(d));
-            let size = items.and_then(|n| n.checked_mul(h.size as u64)).and_then(|n| n.checked_add(h.data as u64));
+            let size =
+                items.and_then(|n| n.checked_mul(h.size as u64)).and_then(|n| n.checked_add(h.data as u64));
             self.size = Some(size.ok_or_else(|| stop(start, "the .npy shape is too large".into()))?);
         }
         match self.size {

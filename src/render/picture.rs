@@ -58,8 +58,7 @@ impl Picture {
     pub fn save_png(&self, path: impl AsRef<Path>) -> Result<()> {
         let image = image::RgbaImage::from_raw(self.width, self.height, self.rgba.clone())
             .ok_or_else(|| RenderError::Usage("picture size".into()))?;
-        crate::output::write_png(path, &image)
-            .map_err(|e| RenderError::Io { path: e.path, source: e.error })
+        crate::output::write_png(path, &image).map_err(|e| RenderError::Io { path: e.path, source: e.error })
     }
 
     /// Reads a PNG (any colour type) as RGBA8.

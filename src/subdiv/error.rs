@@ -17,9 +17,7 @@ pub enum SubdivError {
     #[error("level {level} would be too large for 32-bit indices ({vertices} vertices)")]
     TooLarge { level: u32, vertices: u64 },
     /// The level would not fit the memory the system has available.
-    #[error(
-        "level {level} needs {need_mib} MiB but only {have_mib} MiB are available; use a lower level"
-    )]
+    #[error("level {level} needs {need_mib} MiB but only {have_mib} MiB are available; use a lower level")]
     Memory { level: u32, need_mib: crate::host::Mib, have_mib: u64 },
     /// The fragment-mesh path cannot represent this input or stream (SPEC §5.2).
     #[error("fragment mesh: {0}")]

@@ -71,5 +71,6 @@ impl SweepError {
 /// Writes `bytes` to `path` whole or not at all, synced to the disk
 /// ([`crate::output::write_bytes_durable`]).
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    crate::output::write_bytes_durable(path, bytes).map_err(|e| SweepError::Io { path: e.path, source: e.error })
+    crate::output::write_bytes_durable(path, bytes)
+        .map_err(|e| SweepError::Io { path: e.path, source: e.error })
 }

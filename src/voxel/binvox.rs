@@ -11,12 +11,12 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::error::{Result, VoxelError};
-use crate::mesh::MeshError;
-use crate::mesh::formats::bounded;
 use super::grid::{Grid, MAX_RES};
 use super::scanline;
 use super::solid::Solid;
 use super::volume::Volume;
+use crate::mesh::MeshError;
+use crate::mesh::formats::bounded;
 
 /// Encodes `volume` on `grid` as a binvox file.
 pub fn to_bytes(grid: &Grid, volume: &Volume) -> Result<Vec<u8>> {
@@ -349,12 +349,17 @@ impl bounded::Guard for Guard {
             if value > 1 || count == 0 {
                 return Err(stop(
                     self.run,
-                    format!("a run of value {value} and count {count} (runs are a value 0 or 1 and a count ≥ 1)"),
+                    format!(
+                        "a run of value {value} and count {count} (runs are a value 0 or 1 and a count ≥ 1)"
+                    ),
                 ));
             }
             self.covered += u64::from(count);
             if self.covered > self.voxels {
-                return Err(stop(self.run, format!("the runs cover more than the {} voxels of its dim", self.voxels)));
+                return Err(stop(
+                    self.run,
+                    format!("the runs cover more than the {} voxels of its dim", self.voxels),
+                ));
             }
             self.run += 2;
         }

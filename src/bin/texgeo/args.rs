@@ -37,7 +37,9 @@ pub const MAX_THREADS: usize = 1024;
 pub fn threads(s: &str) -> Result<usize, String> {
     match s.parse::<u128>() {
         Ok(0) => Err("must be at least 1".into()),
-        Ok(v) if v > MAX_THREADS as u128 => Err(format!("{s} is more than the {MAX_THREADS} threads texgeo starts")),
+        Ok(v) if v > MAX_THREADS as u128 => {
+            Err(format!("{s} is more than the {MAX_THREADS} threads texgeo starts"))
+        }
         Ok(v) => Ok(v as usize),
         Err(_) => Err(format!("'{s}' is not a whole number of threads (1 to {MAX_THREADS})")),
     }

@@ -235,7 +235,10 @@ fn check_sizes(cmd: &Command) -> anyhow::Result<()> {
                 n as u128 / 8 < u128::from(u32::MAX),
                 "--scaling {n}: more triangles than 32-bit vertex indices allow"
             );
-            check_memory(format!("--scaling {n}: two {n}-triangle operands"), n as u128 * BOOLEAN_BYTES_PER_TRIANGLE)
+            check_memory(
+                format!("--scaling {n}: two {n}-triangle operands"),
+                n as u128 * BOOLEAN_BYTES_PER_TRIANGLE,
+            )
         }),
         Command::Xor { sizes, triangles, .. } => {
             anyhow::ensure!(
@@ -338,15 +341,7 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut thread_counts = if thread_counts.is_empty() { vec![1, cores] } else { thread_counts };
             thread_counts.dedup();
-            let cfg = Config {
-                points,
-                methods,
-                sizes,
-                voxel_methods,
-                threads: thread_counts,
-                runs,
-                budget,
-            };
+            let cfg = Config { points, methods, sizes, voxel_methods, threads: thread_counts, runs, budget };
             finish(bench::scale::run(&ctx, &inclusion, &voxel, &cfg)?, &Common { runs, out })
         }
         Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {

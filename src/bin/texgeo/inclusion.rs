@@ -108,11 +108,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let t = Instant::now();
     let (method, options, choice) = resolve(args.method, &mesh, &options);
     if let Some(choice) = &choice {
-        note!(
-            "texgeo: --method auto: {choice} for {} faces and {} points",
-            mesh.num_faces(),
-            options.points
-        );
+        note!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), options.points);
     }
     let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;

@@ -189,7 +189,11 @@ impl Show {
         if let (Some(b), Some(op)) = (&self.boolean, self.op) {
             return format!("{} {} {b}", self.input, op.symbol());
         }
-        std::iter::once(&self.input).chain(&self.others).map(MeshArg::to_string).collect::<Vec<_>>().join(" + ")
+        std::iter::once(&self.input)
+            .chain(&self.others)
+            .map(MeshArg::to_string)
+            .collect::<Vec<_>>()
+            .join(" + ")
     }
 
     pub fn camera(&self, scene: &Scene) -> anyhow::Result<Camera> {

@@ -175,7 +175,9 @@ fn check_size(
     };
     let (vs, fs) = (count_text(v, COUNT_LIMIT), count_text(f, COUNT_LIMIT));
     if v >= u64::from(u32::MAX) as u128 || 4 * f >= u64::from(u32::MAX) as u128 {
-        anyhow::bail!("level {level} would have {vs} vertices and {fs} faces, more than 32-bit indices hold{text}");
+        anyhow::bail!(
+            "level {level} would have {vs} vertices and {fs} faces, more than 32-bit indices hold{text}"
+        );
     }
     // The last level and the mesh built from it (as `cpu::refine` counts them), and for
     // the GPU two RGBA32F targets and a readback, fragments overlapping by up to 2×.

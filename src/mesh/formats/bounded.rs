@@ -154,7 +154,7 @@ pub(crate) fn read(path: &Path, guard: &mut dyn Guard) -> Result<Vec<u8>> {
     let mut file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     // A regular file's size is known: check it now. Anything else is checked as it grows.
-    let size = meta.is_file().then(|| meta.len());
+    let size = meta.is_file().then_some(meta.len());
     let mut next_check = match size {
         Some(size) => {
             memory(path, size)?;

@@ -550,9 +550,12 @@ impl super::bounded::Guard for Guard {
         }
         self.header.check(bytes, from)?;
         if let Some(end) = self.header.header_end {
-            let ascii = bytes[..end]
-                .split(|&b| b == b'\n')
-                .any(|l| l.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).take(2).eq([&b"format"[..], b"ascii"]));
+            let ascii = bytes[..end].split(|&b| b == b'\n').any(|l| {
+                l.split(u8::is_ascii_whitespace)
+                    .filter(|w| !w.is_empty())
+                    .take(2)
+                    .eq([&b"format"[..], b"ascii"])
+            });
             if ascii {
                 let mut body = super::bounded::Text::starting_at("ASCII PLY", end);
                 body.check(bytes, end)?;

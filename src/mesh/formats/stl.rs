@@ -92,8 +92,10 @@ impl super::bounded::Guard for Guard {
             if let Some(first) = text.get(start..start + 5)
                 && !first.eq_ignore_ascii_case(b"solid")
             {
-                self.not_text =
-                    Some(Stop { at: (skipped + start) as u64, why: "as ASCII STL it must start with 'solid'".into() });
+                self.not_text = Some(Stop {
+                    at: (skipped + start) as u64,
+                    why: "as ASCII STL it must start with 'solid'".into(),
+                });
             } else if let Err(stop) =
                 self.text.get_or_insert_with(|| super::bounded::Text::new("ASCII STL")).check(bytes, from)
             {
@@ -108,7 +110,9 @@ impl super::bounded::Guard for Guard {
             if bytes.len() as u64 > size {
                 self.not_binary = Some(Stop {
                     at: size,
-                    why: format!("as binary STL its header's {n} triangles end at byte {size}, but more bytes follow"),
+                    why: format!(
+                        "as binary STL its header's {n} triangles end at byte {size}, but more bytes follow"
+                    ),
                 });
             }
             while self.not_binary.is_none() && self.checked < n {
@@ -120,7 +124,10 @@ impl super::bounded::Guard for Guard {
                 if let Some(k) = bad {
                     self.not_binary = Some(Stop {
                         at: (base + k) as u64,
-                        why: format!("as binary STL triangle {} has a coordinate that is not finite", self.checked),
+                        why: format!(
+                            "as binary STL triangle {} has a coordinate that is not finite",
+                            self.checked
+                        ),
                     });
                 }
                 self.checked += 1;

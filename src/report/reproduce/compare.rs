@@ -134,9 +134,9 @@ pub fn compare(old: &Path, new: &Path) -> Result<Comparison> {
             }
         }
     }
-    let [a, b]: [Measurements; 2] = measured.try_into().map_err(|_| {
-        ReproduceError::Usage(format!("cannot compare the reports: {}", damage.join("; ")))
-    })?;
+    let [a, b]: [Measurements; 2] = measured
+        .try_into()
+        .map_err(|_| ReproduceError::Usage(format!("cannot compare the reports: {}", damage.join("; "))))?;
     let mut s = String::from("# texgeo reproduce --compare\n\n");
     for (label, dir) in [("old", old), ("new", new)] {
         match read_header(dir) {
@@ -332,8 +332,14 @@ mod tests {
         assert!(c.damage.iter().any(|d| d.ends_with("claims.csv: missing")), "{:?}", c.damage);
         let md = &c.markdown;
         assert!(md.contains("Measurements of the old report missing from the new one (2)"), "{md}");
-        assert!(md.contains("voxelize / knot / time:zoned@64") && md.contains("inclusion / knot / memory:octants"));
-        assert!(md.contains("Claims of the old report missing from the new one (2)") && md.contains("- V2"), "{md}");
+        assert!(
+            md.contains("voxelize / knot / time:zoned@64")
+                && md.contains("inclusion / knot / memory:octants")
+        );
+        assert!(
+            md.contains("Claims of the old report missing from the new one (2)") && md.contains("- V2"),
+            "{md}"
+        );
         assert!(md.contains("## Damaged reports"), "{md}");
         for d in [a, b] {
             std::fs::remove_dir_all(d).unwrap();
