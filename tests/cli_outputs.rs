@@ -188,17 +188,15 @@ fn concurrent_runs_never_mix_their_files() {
     assert_eq!(dir.entries(), vec!["knot.obj", "mesh.obj", "sphere.obj"]);
 }
 
-#[test]
-fn an_interrupted_run_leaves_the_previous_file() {
-    let dir = TempDir::new("outputs-kill");
-    let out = dir.join("s.binvox");
-    std::fs::write(&out, b"previous good contents").unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
+/// Starts writing the sphere's `res`³ volume to `out` (streamed by the scanline method:
+/// the file is being written for most of the run).
+fn spawn_sphere_volume(out: &std::path::Path, res: &str) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_texgeo"))
         .args([
             "voxelize",
             "builtin:sphere",
             "--res",
-            "512",
+            res,
             "--method",
             "scanline",
             "-o",
@@ -207,7 +205,15 @@ fn an_interrupted_run_leaves_the_previous_file() {
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
-        .unwrap();
+        .unwrap()
+}
+
+#[test]
+fn an_interrupted_run_leaves_the_previous_file() {
+    let dir = TempDir::new("outputs-kill");
+    let out = dir.join("s.binvox");
+    std::fs::write(&out, b"previous good contents").unwrap();
+    let mut child = spawn_sphere_volume(&out, "512");
     // Kill it as soon as it starts writing (a temporary file appears, or the target
     // changes), or when it is done.
     let started = std::time::Instant::now();
@@ -343,21 +349,7 @@ fn a_signal_removes_the_temporary_file_and_the_next_run_removes_stale_ones() {
     let out = dir.join("s.binvox");
     for signal in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
         std::fs::write(&out, b"previous good contents").unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_texgeo"))
-            .args([
-                "voxelize",
-                "builtin:sphere",
-                "--res",
-                "1024",
-                "--method",
-                "scanline",
-                "-o",
-                out.to_str().unwrap(),
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
+        let mut child = spawn_sphere_volume(&out, "1024");
         let writing = wait_for_temporary(&dir, "s.binvox", &mut child);
         // SAFETY: a plain kill(2) of the child this test started.
         unsafe { libc::kill(child.id() as libc::pid_t, signal) };
