@@ -58,19 +58,34 @@ impl Text {
     /// Checks `bytes[from..]`, the continuation of a text whose current line started at
     /// `self.line_start`; offsets in messages are `base` + the index into `bytes`.
     pub fn check_at(&mut self, bytes: &[u8], from: usize, base: u64) -> Result<(), Stop> {
-        for (i, &b) in bytes.iter().enumerate().skip(from) {
-            if b >= 0x20 {
-                continue;
+        const ONES: u64 = 0x0101_0101_0101_0101;
+        let mut i = from;
+        while i < bytes.len() {
+            // Eight bytes at a time while none is below 0x20 (the usual case between line
+            // ends): `(w − 0x20…) & !w & 0x80…` is zero exactly then.
+            if let Some(word) = bytes.get(i..i + 8) {
+                let w = u64::from_le_bytes([word[0], word[1], word[2], word[3], word[4], word[5], word[6], word[7]]);
+                if w.wrapping_sub(0x20 * ONES) & !w & (0x80 * ONES) == 0 {
+                    i += 8;
+                    continue;
+                }
             }
-            if b == b'\n' {
-                self.line_ends(i, base)?;
-                self.line_start = i + 1;
-            } else if !matches!(b, b'\t' | 0x0b | 0x0c | b'\r') {
-                return Err(Stop {
-                    at: base + i as u64,
-                    why: format!("byte 0x{b:02x} cannot be part of {} text (a control byte)", self.what),
-                });
+            for (k, &b) in bytes[i..bytes.len().min(i + 8)].iter().enumerate() {
+                if b >= 0x20 {
+                    continue;
+                }
+                let at = i + k;
+                if b == b'\n' {
+                    self.line_ends(at, base)?;
+                    self.line_start = at + 1;
+                } else if !matches!(b, b'\t' | 0x0b | 0x0c | b'\r') {
+                    return Err(Stop {
+                        at: base + at as u64,
+                        why: format!("byte 0x{b:02x} cannot be part of {} text (a control byte)", self.what),
+                    });
+                }
             }
+            i += 8;
         }
         self.line_ends(bytes.len(), base)
     }
