@@ -63,8 +63,8 @@ impl Text {
         while i < bytes.len() {
             // Eight bytes at a time while none is below 0x20 (the usual case between line
             // ends): `(w − 0x20…) & !w & 0x80…` is zero exactly then.
-            if let Some(word) = bytes.get(i..i + 8) {
-                let w = u64::from_le_bytes([word[0], word[1], word[2], word[3], word[4], word[5], word[6], word[7]]);
+            if let Some(word) = bytes.get(i..i + 8).and_then(|w| <[u8; 8]>::try_from(w).ok()) {
+                let w = u64::from_le_bytes(word);
                 if w.wrapping_sub(0x20 * ONES) & !w & (0x80 * ONES) == 0 {
                     i += 8;
                     continue;
