@@ -21,13 +21,12 @@ pub enum InclusionError {
     Options(String),
     #[error("method '{0}' runs on the GPU and needs a Vulkan device")]
     NeedsGpu(&'static str),
-    /// `--allow-open` on a surface that is not closed: only the generalized winding number
-    /// gives it a meaning (see [`crate::mesh::solidity`]).
+    /// A GPU method asked for a mesh that is not a solid under `--allow-open`.
     #[error(
-        "--allow-open: {edge}, so the surface has no inside; its points are classified by the \
-         generalized winding number (inside iff w ≥ ½), which only --method winding computes, not '{method}'"
+        "method {0} answers for solids only; under --allow-open a mesh that is not a solid is classified \
+         by its generalized winding number on the CPU (--method auto, or any CPU method)"
     )]
-    OpenNeedsWinding { method: &'static str, edge: UnbalancedEdge },
+    NotForNonSolids(&'static str),
 }
 
 impl From<crate::gpu::GpuError> for InclusionError {

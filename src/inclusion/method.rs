@@ -118,10 +118,14 @@ pub struct Options {
     pub points: usize,
     /// Jordan octree depth (the thesis' "Octree-6").
     pub octree_depth: u32,
-    /// Accept a surface that is not closed and consistently oriented. Only the `winding`
-    /// method classifies such a surface (inside iff its generalized winding number is at
-    /// least ½); the factory refuses the others on it.
+    /// Accept a mesh that is not a solid (`--allow-open`): it is classified by its
+    /// generalized winding number (inside iff w ≥ ½) whichever CPU method is asked for; the
+    /// GPU methods refuse it.
     pub allow_open: bool,
+    /// The caller found the mesh not to be a solid ([`crate::mesh::solidity::check`]: a
+    /// closed mesh may still self-intersect, nest or be inverted); under `allow_open` the
+    /// winding-number rule then applies even though the surface is closed.
+    pub non_solid: bool,
     /// The caller has already found the surface closed and consistently oriented (the
     /// command line's [`crate::mesh::solidity::require_solid`], whose verdicts are cached),
     /// so the default method does not check it again.
@@ -137,6 +141,7 @@ impl Default for Options {
             points: 0,
             octree_depth: 6,
             allow_open: false,
+            non_solid: false,
             known_closed: false,
         }
     }

@@ -7,8 +7,10 @@
 //! - **Inside** iff the winding number w of the surface around P is non-zero. For a
 //!   valid solid ([`crate::mesh::solidity`]) w ∈ {0, 1} and this is the thesis'
 //!   `acc == 2`. The commands refuse meshes that are not valid solids; with
-//!   `--allow-open` only the `winding` method runs, and it answers w ≥ ½ for the
-//!   generalized winding number of the open surface.
+//!   `--allow-open` such a mesh (open, self-intersecting, nested, inverted) is classified
+//!   by the one rule of [`crate::mesh::solidity`] — inside iff its generalized winding
+//!   number is at least ½ — whichever CPU method is asked for, by the certified
+//!   hierarchical evaluation of [`fast_winding`] ([`multipole`]); the GPU methods refuse it.
 //! - **OnBoundary** iff P is within ε of some face polygon ([`surface::Surface::on_face`]).
 //!
 //! ## The tolerance rule (one rule, used everywhere)
@@ -54,10 +56,12 @@ pub mod bvh;
 pub mod classifier;
 pub mod cpu;
 pub mod error;
+pub mod fast_winding;
 pub mod gpu;
 pub mod gpu_grid;
 pub mod jordan;
 pub mod method;
+pub mod multipole;
 pub mod octants;
 pub mod octree;
 pub mod points;

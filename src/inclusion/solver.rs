@@ -2,9 +2,10 @@
 //! [`Method`] behind one interface, for the command line and the benchmarks; [`build`]
 //! gives the CPU classifiers as [`Classifier`] objects.
 //!
-//! It also applies the one rule every method follows ([`crate::mesh::solidity`]): a
-//! surface that is not closed is only classified under `allow_open`, and then only by
-//! the winding number (inside iff w ≥ ½).
+//! It also applies the one rule every method follows ([`crate::mesh::solidity`]): under
+//! `allow_open`, a mesh that is not a solid is classified by its generalized winding
+//! number (inside iff w ≥ ½), whichever CPU method is asked for, by
+//! [`FastWinding`]; the GPU methods refuse it.
 
 use glam::DVec3;
 
@@ -13,6 +14,7 @@ use super::bvh::Bvh;
 use super::classifier::{BuildStats, Class, Classifier};
 use super::cpu::{EdgeRule, FeitoTorres};
 use super::error::{InclusionError, Result};
+use super::fast_winding::FastWinding;
 use super::gpu::{GpuInclusion, GpuOptions, GpuStats, Phase2};
 use super::gpu_grid::GpuGridInclusion;
 use super::jordan::Jordan;
@@ -37,23 +39,22 @@ pub enum Solver {
     GpuGrid(Box<GpuGridInclusion>),
 }
 
-/// Under `allow_open`, a surface that is really open may only be classified by `winding`.
-fn check_open(method: Method, mesh: &Mesh, options: &Options) -> Result<()> {
-    if options.allow_open && method != Method::Winding {
-        if let Some(edge) = Covering::new(mesh).unbalanced_edge() {
-            return Err(InclusionError::OpenNeedsWinding { method: method.name(), edge });
-        }
-    }
-    Ok(())
+/// Whether the winding-number rule for meshes that are not solids applies: under
+/// `allow_open`, to a mesh the caller found not to be a solid, or whose surface is not
+/// closed.
+pub fn winding_rule(mesh: &Mesh, options: &Options) -> bool {
+    options.allow_open
+        && (options.non_solid || (!options.known_closed && Covering::new(mesh).unbalanced_edge().is_some()))
 }
 
 /// The method `auto` stands for on `mesh` with `options` (other methods: themselves).
-/// Under `allow_open` on a surface that really is open, only `winding` classifies.
+/// Under the winding-number rule ([`winding_rule`]) it is `winding`, evaluated by
+/// [`FastWinding`].
 pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Options, Option<Choice>) {
     if method != Method::Auto {
         return (method, *options, None);
     }
-    if options.allow_open && Covering::new(mesh).unbalanced_edge().is_some() {
+    if winding_rule(mesh, options) {
         let choice = Choice { method: Method::Winding, resolution: None, predicted: f64::NAN };
         return (Method::Winding, *options, Some(choice));
     }
@@ -70,7 +71,12 @@ pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Optio
 pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
     let (method, options, _) = resolve(method, mesh, options);
     let options = &options;
-    check_open(method, mesh, options)?;
+    if winding_rule(mesh, options) {
+        if !method.is_cpu() {
+            return Err(InclusionError::NotForNonSolids(method.name()));
+        }
+        return Ok(Box::new(FastWinding::new(mesh, options.points)?));
+    }
     let ft = || FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open);
     Ok(match method {
         Method::Cpu => Box::new(ft()?),
@@ -112,7 +118,9 @@ impl Solver {
         if method.is_cpu() {
             return Ok(Solver::Cpu(build(method, mesh, options)?));
         }
-        check_open(method, mesh, options)?;
+        if winding_rule(mesh, options) {
+            return Err(InclusionError::NotForNonSolids(method.name()));
+        }
         let grid = || {
             GridClassifier::new(
                 FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open)?,

@@ -33,10 +33,15 @@
 //!
 //! - `--flip-inverted`: an inverted solid (every face reversed would make it valid) is
 //!   flipped and then treated as the solid it describes;
-//! - `--allow-open` (`inclusion` only): a mesh that is not closed has no inside; a point
-//!   is then classified by the *generalized* winding number of the open surface (inside
-//!   iff w ≥ ½), which only the `winding` method computes: other methods are refused
-//!   under it when the mesh really is open;
+//! - `--allow-open` (`inclusion`, `voxelize`, `sweep`): **a mesh that is not a solid** —
+//!   open, self-intersecting, with nested or crossing shells, inverted — is accepted, and a
+//!   point is inside iff the *generalized* winding number of its faces (polygons as their
+//!   covering, as for solids) is at least ½. That is the rule above, read for any mesh: on a
+//!   valid solid nothing changes. On an inverted mesh w = −1 inside, so nothing is inside
+//!   (`--flip-inverted` makes it the solid it describes); where two shells overlap or nest
+//!   with the same orientation w = 2, inside. [`crate::inclusion::fast_winding`] evaluates
+//!   it with a certified bound. Only a mesh whose area or volume overflows f64 is still
+//!   refused;
 //! - `--allow-self-intersections` (`boolean` only): go on with crossing faces, best effort.
 //!
 //! [`check`] measures everything and lists every defect (`texgeo mesh stats` prints it);
@@ -347,6 +352,45 @@ fn orientation(report: &mut Solidity) {
     report.defects.extend(found);
 }
 
+/// The boundary curve of a mesh that is not closed: its edges whose directed uses do not
+/// cancel (counted once each), and the loops they form (components sharing a vertex).
+pub fn boundary_loops(mesh: &Mesh) -> (usize, usize) {
+    let mut uses: Vec<(u32, u32, i32)> = mesh
+        .faces()
+        .flat_map(|f| (0..f.len()).map(move |i| (f[i], f[(i + 1) % f.len()])))
+        .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
+        .collect();
+    uses.sort_unstable_by_key(|&(a, b, _)| (a, b));
+    let mut sets = UnionFind::new(mesh.num_vertices());
+    let mut ends = Vec::new();
+    for run in uses.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if run.iter().map(|x| x.2).sum::<i32>() != 0 {
+            sets.union(run[0].0, run[0].1);
+            ends.push(run[0].0);
+        }
+    }
+    let mut roots: Vec<u32> = ends.iter().map(|&v| sets.find(v)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    (ends.len(), roots.len())
+}
+
+/// What `--allow-open` makes of a mesh with this defect: the rule, and what it means here.
+pub fn allow_open_note(defect: &Defect) -> &'static str {
+    match defect {
+        Defect::Overflow { .. } => "refused even with --allow-open",
+        Defect::Inverted { .. } | Defect::InvertedShell { .. } => {
+            "inside by winding number ≥ ½ with --allow-open: the winding number is −1 inside an \
+             inverted shell, so none of it is inside (--flip-inverted reverses the faces of an inverted solid)"
+        }
+        Defect::NestedShell { .. } | Defect::CrossingShells { .. } | Defect::SelfIntersecting { .. } => {
+            "inside by winding number ≥ ½ with --allow-open (where shells overlap or nest the same way, \
+             w = 2: inside)"
+        }
+        Defect::Open(_) => "inside by winding number ≥ ½ with --allow-open",
+    }
+}
+
 /// `mesh` with every face reversed (inside and outside swapped).
 pub fn flipped(mesh: &Mesh) -> Mesh {
     let (offsets, indices) = mesh.face_parts();
@@ -361,8 +405,8 @@ pub fn flipped(mesh: &Mesh) -> Mesh {
 /// What a command may accept besides valid solids (the flags of the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Policy {
-    /// `--allow-open`: accept a surface that is not closed (classified by the generalized
-    /// winding number).
+    /// `--allow-open`: accept a mesh that is not a solid (open, self-intersecting, nested,
+    /// inverted): inside iff its generalized winding number is at least ½.
     pub allow_open: bool,
     /// `--flip-inverted`: reverse every face of an inverted solid.
     pub flip_inverted: bool,
@@ -374,7 +418,8 @@ pub struct Policy {
 /// excused when the policy flips it; [`require_solid`] then checks the flipped mesh).
 pub fn first_refusal(solidity: &Solidity, policy: Policy) -> Option<&Defect> {
     solidity.defects.iter().find(|d| match d {
-        Defect::Open(_) => !policy.allow_open,
+        Defect::Overflow { .. } => true,
+        _ if policy.allow_open => false,
         Defect::Inverted { .. } => !policy.flip_inverted,
         Defect::SelfIntersecting { .. } | Defect::CrossingShells { .. } => !policy.allow_self_intersections,
         _ => true,
@@ -389,9 +434,9 @@ pub struct Accepted {
     pub solidity: Solidity,
     /// The faces were reversed (`--flip-inverted`).
     pub flipped: bool,
-    /// The surface is not closed (`--allow-open`): only the generalized winding number
-    /// classifies it.
-    pub open: bool,
+    /// Not a solid, accepted under `--allow-open`: its first defect. Points are then
+    /// inside iff the generalized winding number is at least ½.
+    pub non_solid: Option<Defect>,
 }
 
 /// Why [`require_solid`] refused a mesh: the first defect the policy does not excuse.
@@ -413,7 +458,7 @@ pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
     let key = store.as_ref().map(|_| verdict_key(&mesh));
     if let (Some(store), Some(key)) = (&store, &key) {
         if let Some(solidity) = store.get(key).and_then(|b| decode_solid(&b)) {
-            return Ok(Accepted { mesh, solidity, flipped: false, open: false });
+            return Ok(Accepted { mesh, solidity, flipped: false, non_solid: None });
         }
     }
     let accepted = require_solid_uncached(mesh, policy)?;
@@ -499,16 +544,19 @@ pub fn require_solid_uncached(mesh: Mesh, policy: Policy) -> Result<Accepted, No
     if let Some(d) = first_refusal(&solidity, policy) {
         return Err(NotSolid { defect: d.clone() });
     }
-    let open = solidity.defects.iter().any(|d| matches!(d, Defect::Open(_)));
-    if solidity.defects.iter().any(|d| matches!(d, Defect::Inverted { .. })) {
+    if policy.flip_inverted && solidity.defects.iter().any(|d| matches!(d, Defect::Inverted { .. })) {
         let mesh = flipped(&mesh);
         let solidity = check(&mesh);
         return match first_refusal(&solidity, Policy { flip_inverted: false, ..policy }) {
-            None => Ok(Accepted { mesh, solidity, flipped: true, open }),
+            None => {
+                let non_solid = solidity.defects.first().cloned();
+                Ok(Accepted { mesh, solidity, flipped: true, non_solid })
+            }
             Some(d) => Err(NotSolid { defect: d.clone() }),
         };
     }
-    Ok(Accepted { mesh, solidity, flipped: false, open })
+    let non_solid = solidity.defects.first().cloned();
+    Ok(Accepted { mesh, solidity, flipped: false, non_solid })
 }
 
 #[cfg(test)]
@@ -585,7 +633,10 @@ mod tests {
             require_solid(open.clone(), Policy::default()).unwrap_err().defect,
             Defect::Open(_)
         ));
-        assert!(require_solid(open, Policy { allow_open: true, ..Policy::default() }).unwrap().open);
+        assert!(matches!(
+            require_solid(open, Policy { allow_open: true, ..Policy::default() }).unwrap().non_solid,
+            Some(Defect::Open(_))
+        ));
         let huge = cube.map_positions(|p| p * 1e120).unwrap();
         let e = require_solid(huge, Policy::default()).unwrap_err();
         assert!(matches!(e.defect, Defect::Overflow { .. }), "{e}");

@@ -35,8 +35,10 @@ pub struct Args {
     /// GPU methods: tetrahedra per point-vertex (1 = the thesis' one point per tetrahedron).
     #[arg(long, value_parser = crate::args::positive_u32)]
     batch: Option<u32>,
-    /// Accept a mesh that is not closed: a point is then inside iff the generalized winding
-    /// number of the open surface is at least ½, which only `--method winding` computes.
+    /// Accept a mesh that is not a solid (open, self-intersecting, nested or inverted): a
+    /// point is then inside iff the generalized winding number of its faces is at least ½,
+    /// computed with a certified error bound by every CPU method (`auto` included); the GPU
+    /// methods (gpu, cpu+gpu, gpu+tetragrid) refuse such a mesh. Solids are unchanged.
     #[arg(long)]
     allow_open: bool,
     /// Reverse every face of an inverted solid (faces pointing inwards) instead of refusing it.
@@ -87,6 +89,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if solid.flipped {
         note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
+    if let Some(defect) = &solid.non_solid {
+        if !args.method.is_cpu() {
+            anyhow::bail!("{}: {}", args.mesh, texgeo::inclusion::InclusionError::NotForNonSolids(args.method.name()));
+        }
+        crate::mesh::warn_non_solid(&args.mesh, defect);
+    }
     let mut source = match (&args.points, args.random) {
         (Some(file), _) => points::PointReader::open(file)?,
         (_, Some(n)) => {
@@ -102,23 +110,26 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         voxel_space_resolution: args.grid,
         points: source.estimated_total(),
         allow_open: args.allow_open,
-        known_closed: !solid.open,
+        non_solid: solid.non_solid.is_some(),
+        known_closed: !matches!(solid.non_solid, Some(texgeo::mesh::solidity::Defect::Open(_))),
         ..Options::default()
     };
     let t = Instant::now();
     let (method, options, choice) = resolve(args.method, &mesh, &options);
-    if let Some(choice) = &choice {
-        note!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), options.points);
+    match &choice {
+        Some(_) if solid.non_solid.is_some() => note!(
+            "texgeo: --method auto: the generalized winding number (fast-winding) for {} faces and {} points",
+            mesh.num_faces(),
+            options.points
+        ),
+        Some(choice) => {
+            note!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), options.points)
+        }
+        None => {}
     }
     let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
     let build = t.elapsed();
-    if solid.open {
-        note!(
-            "texgeo: warning: {} is not closed; points are classified by the generalized winding number",
-            args.mesh
-        );
-    }
     // Block by block: classify, count, write (a text output as it goes; a `.npy` output
     // needs the count in its header, so its one byte per point waits for the end).
     let mut out = match &args.output {

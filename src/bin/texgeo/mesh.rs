@@ -107,14 +107,45 @@ pub fn load_solid(spec: &MeshArg, policy: Policy, flags: &[&str]) -> anyhow::Res
     let mesh = load(spec)?;
     solidity::require_solid(mesh, policy).map_err(|e| {
         let hint = match e.defect.remedy().filter(|f| flags.contains(f)) {
+            Some(f @ "--flip-inverted") if flags.contains(&"--allow-open") => {
+                format!(" ({f} reverses every face; --allow-open takes any mesh by its winding number)")
+            }
             Some(f @ "--flip-inverted") => format!(" ({f} reverses every face)"),
-            Some(f @ "--allow-open") => {
-                format!(" ({f} classifies it by the generalized winding number, with --method winding)")
+            _ if flags.contains(&"--allow-open") && !matches!(e.defect, Defect::Overflow { .. }) => {
+                " (--allow-open classifies it by the generalized winding number: inside iff w ≥ ½)".to_string()
             }
             _ => String::new(),
         };
         anyhow::anyhow!("{spec}: {e}{hint}")
     })
+}
+
+/// The one warning on stderr for a mesh accepted under `--allow-open` although it is not
+/// a solid: its defect and the rule its points follow.
+pub fn warn_non_solid(spec: &MeshArg, defect: &Defect) {
+    let inverted = if matches!(defect, Defect::Inverted { .. } | Defect::InvertedShell { .. }) {
+        "; the winding number is −1 inside an inverted shell, so none of it is inside \
+         (--flip-inverted reverses the faces of an inverted solid)"
+    } else {
+        ""
+    };
+    note!(
+        "texgeo: warning: {spec} is not a solid: {defect}; with --allow-open a point is inside iff the \
+         generalized winding number of its faces is at least ½{inverted}"
+    );
+}
+
+/// What `--allow-open` does with a mesh that is not a solid, for `mesh stats`.
+fn allow_open_line(m: &Mesh, defect: &Defect) -> String {
+    let what = match defect {
+        Defect::Open(_) => {
+            let (edges, loops) = solidity::boundary_loops(m);
+            let s = |n: usize| if n == 1 { "" } else { "s" };
+            format!("open: {edges} boundary edge{} in {loops} loop{}", s(edges), s(loops))
+        }
+        d => d.slug().replace('-', " "),
+    };
+    format!("{what}; {}", solidity::allow_open_note(defect))
 }
 
 pub fn run(cmd: Command) -> anyhow::Result<()> {
@@ -125,6 +156,9 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
             say!("{}", m.report());
             let solidity = solidity::check(&m);
             say!("{solidity}");
+            if let Some(d) = solidity.defects.first() {
+                say!("with --allow-open       {}", allow_open_line(&m, d));
+            }
             if let Some(Defect::Overflow { .. }) = solidity.defects.first() {
                 anyhow::bail!("{mesh}: cannot measure it: {}", solidity.defects[0]);
             }

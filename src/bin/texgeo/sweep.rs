@@ -80,7 +80,9 @@ struct RunArgs {
     /// inclusion: tetrahedra per point-vertex of the GPU methods.
     #[arg(long, help_heading = "Task options")]
     batch: Option<u64>,
-    /// inclusion: accept surfaces that are not closed.
+    /// inclusion, voxelize: accept meshes that are not solids (open, self-intersecting,
+    /// nested, inverted); they are classified by the generalized winding number (inside iff
+    /// w ≥ ½) on the CPU whatever the method, and the defect is kept in a `non_solid` column.
     #[arg(long, help_heading = "Task options")]
     allow_open: bool,
     /// voxelize: voxels per side (default 64).

@@ -50,6 +50,13 @@ pub struct Args {
     /// Reverse every face of an inverted solid (faces pointing inwards) instead of refusing it.
     #[arg(long)]
     flip_inverted: bool,
+    /// Accept a mesh that is not a solid (open, self-intersecting, nested or inverted): a
+    /// voxel is then occupied iff its centre is inside by `inclusion --allow-open` (the
+    /// generalized winding number at least ½; centres on the boundary are empty), computed
+    /// on the CPU with a certified error bound (`auto`, `cpu` and `scanline` do this; the
+    /// GPU methods refuse such a mesh). Solids are voxelized as without the flag.
+    #[arg(long)]
+    allow_open: bool,
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
@@ -69,13 +76,39 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(dir) = &aspect_dir {
         texgeo::output::check_dir(dir)?;
     }
-    let policy = Policy { flip_inverted: args.flip_inverted, ..Policy::default() };
-    let solid = crate::mesh::load_solid(&args.mesh, policy, &["--flip-inverted"])?;
+    let policy = Policy { flip_inverted: args.flip_inverted, allow_open: args.allow_open, ..Policy::default() };
+    let solid = crate::mesh::load_solid(&args.mesh, policy, &["--flip-inverted", "--allow-open"])?;
     if solid.flipped {
         note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     let mesh = solid.mesh;
     let grid = Grid::for_mesh(&mesh, args.res)?;
+    if let Some(defect) = &solid.non_solid {
+        if let Choice::Method(m) = args.method {
+            if m.uses_gpu() {
+                anyhow::bail!(
+                    "{}: method {m} voxelizes solids only; under --allow-open a mesh that is not a solid is \
+                     voxelized by its generalized winding number on the CPU (--method auto, cpu or scanline)",
+                    args.mesh
+                );
+            }
+        }
+        crate::mesh::warn_non_solid(&args.mesh, defect);
+        let t = std::time::Instant::now();
+        let volume = texgeo::inclusion::fast_winding::FastWinding::new(&mesh, 0)?.voxelize(&grid)?;
+        say!(
+            "{}: {}³ voxels, {} occupied, generalized winding number ≥ ½ (fast-winding) in {:.1} ms",
+            args.mesh,
+            args.res,
+            volume.count(),
+            t.elapsed().as_secs_f64() * 1e3
+        );
+        let ctx = match args.aspect {
+            Some(_) => Some(crate::open_context_for(device, "cpu, without --aspect")?),
+            None => None,
+        };
+        return write_outputs(&args, &grid, &volume, ctx.as_ref(), aspect_dir.as_deref());
+    }
     let solid = Solid::new(&mesh)?;
     let mut opened = None;
     let method = match args.method {
@@ -154,21 +187,33 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             result.band.changed
         );
     }
+    write_outputs(&args, &grid, &result.volume, ctx.as_ref(), aspect_dir.as_deref())
+}
+
+/// Writes the volume (binvox), and the slices and aspect pictures when asked for.
+fn write_outputs(
+    args: &Args,
+    grid: &Grid,
+    volume: &texgeo::voxel::Volume,
+    ctx: Option<&texgeo::gpu::Context>,
+    aspect_dir: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
-    binvox::write(&args.output, &grid, &result.volume)?;
+    binvox::write(&args.output, grid, volume)?;
     say!("wrote {} in {:.1} ms", args.output.display(), ms(t.elapsed()));
     if let Some(dir) = &args.slices {
-        let files = pictures::write_slices(&result.volume, dir)?;
+        let files = pictures::write_slices(volume, dir)?;
         say!("wrote {} slice PNGs into {}", files.len(), dir.display());
     }
-    if let (Some(dir), Some(ctx)) = (&aspect_dir, &ctx) {
+    if let (Some(dir), Some(ctx)) = (aspect_dir, ctx) {
         let params = Aspect { material: args.material, frequency: args.frequency, ..Aspect::default() };
         // Slices stream to PNG files a group at a time; the front view is built as they pass.
         let mut picture = pictures::front_canvas(args.res);
         let mut count = 0;
-        aspect::render_each(ctx, &result.volume, &params, |j, pixels| {
+        aspect::render_each(ctx, volume, &params, |j, pixels| {
             pictures::write_rgba_slice(args.res, j, pixels, dir)?;
-            pictures::front_row(&result.volume, j, Some(pixels), &mut picture);
+            pictures::front_row(volume, j, Some(pixels), &mut picture);
             count += 1;
             Ok(())
         })?;

@@ -28,7 +28,10 @@ pub struct Options {
     pub batch: Option<u32>,
     /// A CPU method every answer is compared with, or `none`.
     pub reference: String,
-    /// Accept surfaces that are not closed (answers follow the winding number).
+    /// Accept meshes that are not solids (open, self-intersecting, nested, inverted): their
+    /// points are classified by the generalized winding number (inside iff w ≥ ½) on the
+    /// CPU whatever the method, compared with the direct sum over every triangle, and the
+    /// defect is recorded (`non_solid`).
     pub allow_open: bool,
 }
 
@@ -91,15 +94,22 @@ impl Task for Inclusion {
         let method: Method = o.method.parse().map_err(|e| Failure::failed("options", e))?;
         // The same gate as `texgeo inclusion`: what the command refuses, the sweep refuses.
         let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
-        let mesh = &require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?.mesh;
+        let accepted = require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?;
+        let mesh = &accepted.mesh;
         let (lo, hi) = mesh.bounds();
         let points = Rng::new(o.seed).points_in_box(o.points, lo, hi);
         out.size("points", points.len());
         let options = inclusion::Options {
             tetragrid_resolution: o.grid,
             allow_open: o.allow_open,
+            non_solid: accepted.non_solid.is_some(),
+            points: points.len(),
             ..Default::default()
         };
+        if let Some(defect) = &accepted.non_solid {
+            out.check("non_solid", defect.slug());
+            return winding_rule(mesh, &options, &points, o, out);
+        }
 
         let t = Instant::now();
         let mut solver = Solver::new(method, mesh, &options, ctx, o.batch).map_err(refusal)?;
@@ -138,6 +148,48 @@ impl Task for Inclusion {
     }
 }
 
+/// A mesh that is not a solid, under `allow_open`: the certified winding-number
+/// classifier (whatever the method: the GPU methods answer for solids only), checked
+/// against the winding number summed directly over every triangle.
+fn winding_rule(
+    mesh: &Mesh,
+    options: &inclusion::Options,
+    points: &[glam::DVec3],
+    o: &Options,
+    out: &mut Record,
+) -> Result<(), Failure> {
+    use crate::inclusion::Classifier;
+    let t = Instant::now();
+    let fast = inclusion::fast_winding::FastWinding::new(mesh, options.points).map_err(refusal)?;
+    out.time("build", t.elapsed());
+    let t = Instant::now();
+    let classes = fast.classify_all(points);
+    out.time("classify", t.elapsed());
+    let count = |c: Class| classes.iter().filter(|&&x| x == c).count();
+    out.size("inside", count(Class::Inside));
+    out.size("outside", count(Class::Outside));
+    out.size("boundary", count(Class::OnBoundary));
+    let mut h = Fnv::default();
+    h.bytes(&classes.iter().map(|&c| c as u8).collect::<Vec<_>>());
+    out.hash("classes", &h);
+    if o.reference == "none" {
+        return Ok(());
+    }
+    let t = Instant::now();
+    let direct = inclusion::winding::WindingNumber::with_policy(mesh, true).map_err(refusal)?;
+    let expected = direct.classify_all(points);
+    out.time("reference", t.elapsed());
+    let differing = classes.iter().zip(&expected).filter(|(a, b)| a != b).count();
+    out.check("differing", differing);
+    if differing > 0 {
+        return Err(Failure::failed(
+            "check",
+            format!("{differing} of {} points differ from the winding number summed directly", points.len()),
+        ));
+    }
+    Ok(())
+}
+
 /// Refusals (what `texgeo inclusion` would reject) and failures.
 fn refusal(e: InclusionError) -> Failure {
     match e {
@@ -147,7 +199,7 @@ fn refusal(e: InclusionError) -> Failure {
         | InclusionError::OctreeDepth(_)
         | InclusionError::Options(_)
         | InclusionError::UnknownMethod { .. }
-        | InclusionError::OpenNeedsWinding { .. } => Failure::refused("options", e),
+        | InclusionError::NotForNonSolids(_) => Failure::refused("options", e),
         InclusionError::Gpu(_) => Failure::failed("gpu", e),
         InclusionError::NeedsGpu(_) => Failure::failed("device", e),
     }

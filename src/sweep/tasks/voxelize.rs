@@ -23,11 +23,16 @@ pub struct Options {
     pub reference: String,
     /// Zone height for `zoned` (default: chosen from the mesh and memory).
     pub zone: Option<usize>,
+    /// Accept meshes that are not solids (`voxelize --allow-open`): their voxels are the
+    /// centres inside by the generalized winding number (on the CPU whatever the method),
+    /// checked against the per-point classification of every centre, and the defect is
+    /// recorded (`non_solid`).
+    pub allow_open: bool,
 }
 
 impl Default for Options {
     fn default() -> Options {
-        Options { method: "zoned".into(), res: 64, reference: "scanline".into(), zone: None }
+        Options { method: "zoned".into(), res: 64, reference: "scanline".into(), zone: None, allow_open: false }
     }
 }
 
@@ -88,7 +93,13 @@ impl Task for Voxelize {
         let m = method(&o.method).map_err(|e| Failure::failed("options", e))?;
         let refusal = |e: VoxelError| refusal(e, report);
         // The same gate as `texgeo voxelize`: what the command refuses, the sweep refuses.
-        let mesh = &require_solid(mesh.clone(), Policy::default()).map_err(Failure::not_solid)?.mesh;
+        let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
+        let accepted = require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?;
+        let mesh = &accepted.mesh;
+        if let Some(defect) = &accepted.non_solid {
+            out.check("non_solid", defect.slug());
+            return winding_rule(mesh, o, out);
+        }
         let t = Instant::now();
         let grid = Grid::for_mesh(mesh, o.res).map_err(refusal)?;
         let solid = Solid::new(mesh).map_err(refusal)?;
@@ -134,6 +145,53 @@ impl Task for Voxelize {
         }
         Ok(())
     }
+}
+
+/// A mesh that is not a solid, under `allow_open`: the voxels whose centre is inside by
+/// the generalized winding number, checked centre by centre against the per-point
+/// classification (`inclusion --allow-open`).
+fn winding_rule(mesh: &Mesh, o: &Options, out: &mut Record) -> Result<(), Failure> {
+    use rayon::prelude::*;
+    let map = |e: crate::inclusion::InclusionError| Failure::failed("winding", e);
+    let grid = Grid::for_mesh(mesh, o.res).map_err(|e| Failure::refused("flat", e))?;
+    out.size("res", o.res);
+    let t = Instant::now();
+    let fast = crate::inclusion::fast_winding::FastWinding::new(mesh, 0).map_err(map)?;
+    let volume = fast.voxelize(&grid).map_err(|e| Failure::failed("winding", e))?;
+    out.time("voxelize", t.elapsed());
+    out.size("occupied", volume.count());
+    let mut h = Fnv::default();
+    for j in 0..o.res {
+        for k in 0..o.res {
+            for &w in volume.row(j, k) {
+                h.u64(w);
+            }
+        }
+    }
+    out.hash("volume", &h);
+    if o.reference == "none" {
+        return Ok(());
+    }
+    let t = Instant::now();
+    let n = o.res;
+    let differing: u64 = (0..n * n)
+        .into_par_iter()
+        .map(|jk| {
+            let (j, k) = (jk / n, jk % n);
+            (0..n)
+                .filter(|&i| {
+                    let inside = fast.classify_point(grid.centre(i, j, k)).0 == crate::inclusion::Class::Inside;
+                    inside != volume.get(i, j, k)
+                })
+                .count() as u64
+        })
+        .sum();
+    out.time("reference", t.elapsed());
+    out.check("differing", differing);
+    if differing > 0 {
+        return Err(Failure::failed("check", format!("{differing} voxels differ from their centres' labels")));
+    }
+    Ok(())
 }
 
 /// Refusals (what `texgeo voxelize` would reject) and failures.

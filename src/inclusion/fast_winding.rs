@@ -1,0 +1,421 @@
+//! Inside by the generalized winding number, fast and certified: how `inclusion` and
+//! `voxelize` answer, under `--allow-open`, for a mesh that is not a solid.
+//!
+//! **The rule** ([`crate::mesh::solidity`]): P is inside iff w(P) ≥ ½, w the generalized
+//! winding number of the covering triangles; within ε of a face it is OnBoundary (the
+//! shared predicate of [`super::surface`], decided exactly), for `voxelize` not occupied.
+//!
+//! **Per point.** After the exact boundary test, w(P) is estimated with the cluster tree
+//! of [`super::multipole`], which returns w̃ and a bound E of its error; the label is
+//! certain as soon as [w̃ − E, w̃ + E] lies on one side of ½. Otherwise the tree is walked
+//! again with a per-cluster tolerance [`TOLERANCES`]`[1]` a hundred times smaller, and if
+//! that still leaves ½ inside the interval, every triangle is summed directly with
+//! compensated sums. A point still undecided then (w within the direct sum's own bound of
+//! ½: it lies on the ½ level set itself or within about 1e-6 of a face) takes the side of
+//! the direct sum's value.
+//!
+//! **Per cell.** Points are mostly far from the ½ level set, and w is smooth away from the
+//! surface: its gradient is a line integral over the surface's *boundary curve* Γ (the
+//! directed edges of the covering whose uses do not cancel; Biot–Savart), so
+//! |∇w(X)| ≤ 1/(4π) Σ_{e∈Γ} m_e·|e| / dist(X, e)². On a closed mesh Γ is empty and w is
+//! constant between the sheets. A box that no face comes within 2ε of is labelled whole
+//! when w̃(centre) ± (E + |∇w|·radius) stays [`MARGIN`] away from ½ — the same answer every
+//! point in it would get on its own. Boxes are split in halves down to single cells of a
+//! lattice ([`Lattice`]): for `inclusion` cells of a grid over the mesh's box, sized by
+//! the number of points, whose undecided cells send their points to the per-point path;
+//! for `voxelize` the voxel centres themselves.
+//!
+//! Nothing here assumes a solid, so the meshes the solidity rule refuses — open,
+//! self-intersecting, nested, inverted — all get this answer; on a valid solid w is 0 or 1
+//! and it is the solid's own answer.
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
+use super::error::Result;
+use super::multipole::{Estimate, Tree};
+use super::surface::Surface;
+use crate::mesh::Mesh;
+use crate::mesh::covering::Covering;
+use crate::voxel::{Grid, Volume};
+
+/// Per-cluster error tolerances of the two tree walks (units of w).
+pub const TOLERANCES: [f64; 2] = [2e-4, 2e-6];
+/// A cell is labelled whole only when its interval of w keeps this far from ½.
+pub const MARGIN: f64 = 1e-3;
+/// Fewer query points than this get no cell grid.
+const MIN_POINTS_FOR_CELLS: usize = 20_000;
+/// Largest cell grid for `inclusion` (n³ bytes).
+const MAX_CELLS: usize = 128;
+/// Boundary edges per group of the gradient bound.
+const EDGE_GROUP: usize = 32;
+
+/// How a point's label was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tier {
+    /// Within ε of a face.
+    Boundary,
+    /// Decided by the first (0) or second (1) tree walk.
+    Tree(u8),
+    /// Decided by the direct compensated sum.
+    Direct,
+    /// Not decided by any bound: the direct sum's value.
+    Undecided,
+}
+
+/// The generalized winding number classifier with its cluster tree and, for many points,
+/// a grid of certified cells.
+#[derive(Clone, Debug)]
+pub struct FastWinding {
+    surface: Surface,
+    tree: Tree,
+    boundary: Boundary,
+    cells: Option<Cells>,
+    stats: BuildStats,
+}
+
+impl FastWinding {
+    /// The classifier for `mesh` (any mesh: open, self-intersecting, …), with a cell grid
+    /// sized for about `points` query points (none for few).
+    pub fn new(mesh: &Mesh, points: usize) -> Result<FastWinding> {
+        let start = Instant::now();
+        let surface = Surface::with_policy(mesh, true)?;
+        let tree = Tree::new(surface.covering());
+        let boundary = Boundary::new(surface.covering());
+        let mut fw = FastWinding { surface, tree, boundary, cells: None, stats: BuildStats::default() };
+        if points >= MIN_POINTS_FOR_CELLS && !fw.tree.is_empty() {
+            let n = ((points as f64 / 4.0).cbrt().round() as usize).clamp(4, MAX_CELLS);
+            fw.cells = Some(fw.cells(n));
+        }
+        let bytes = fw.surface.bytes()
+            + fw.tree.bytes()
+            + vec_bytes(&fw.boundary.edges)
+            + vec_bytes(&fw.boundary.groups)
+            + fw.cells.as_ref().map_or(0, |c| vec_bytes(&c.labels));
+        fw.stats = BuildStats { build_time: start.elapsed(), bytes };
+        Ok(fw)
+    }
+
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    pub fn tree(&self) -> &Tree {
+        &self.tree
+    }
+
+    /// Number of directed edges of the boundary curve Γ (0 for a closed mesh).
+    pub fn boundary_edges(&self) -> usize {
+        self.boundary.edges.len()
+    }
+
+    /// True when `p` is within ε of a face (the shared exact predicate).
+    fn on_boundary(&self, p: DVec3) -> bool {
+        self.surface.in_bounds(p)
+            && self.tree.any_near(p, p, self.surface.eps(), |t| self.surface.on_boundary_near(t, p))
+    }
+
+    /// The label of `p` without the cell grid, and how it was found.
+    pub fn classify_point(&self, p: DVec3) -> (Class, Tier) {
+        if self.on_boundary(p) {
+            return (Class::OnBoundary, Tier::Boundary);
+        }
+        let p = self.off_polygon_planes(p);
+        let class = |inside: bool| if inside { Class::Inside } else { Class::Outside };
+        for (k, &tol) in TOLERANCES.iter().enumerate() {
+            if let Some(inside) = self.tree.winding(p, tol).decides(0.0) {
+                return (class(inside), Tier::Tree(k as u8));
+            }
+        }
+        let e = self.tree.direct(p);
+        match e.decides(0.0) {
+            Some(inside) => (class(inside), Tier::Direct),
+            None => (class(e.w >= 0.5), Tier::Undecided),
+        }
+    }
+
+    /// `p` moved ε/2 off the plane of a non-convex face it lies in (see
+    /// [`Surface::off_polygon_planes`]): there the face's overlapping covering triangles
+    /// would each see it on a side of their plane decided by rounding.
+    fn off_polygon_planes(&self, p: DVec3) -> DVec3 {
+        let c = self.surface.covering();
+        if c.triangles.len() == c.num_faces() {
+            return p;
+        }
+        let mut near = Vec::new();
+        self.tree.any_near(p, p, self.surface.eps(), |t| {
+            near.push(t);
+            false
+        });
+        self.surface.off_polygon_planes(p, near)
+    }
+
+    /// The generalized winding number at `p` with its certified bound (first tree walk).
+    pub fn estimate(&self, p: DVec3) -> Estimate {
+        self.tree.winding(p, TOLERANCES[0])
+    }
+
+    /// Labels every sample of `lattice`: `put(i, j, k, class)` for the samples of blocks
+    /// decided whole (`i` a range along x), `leaf(p)` for a sample no block decides.
+    fn label_slab(
+        &self,
+        lattice: &Lattice,
+        j: std::ops::Range<usize>,
+        leaf: &dyn Fn(DVec3) -> Option<Class>,
+        put: &mut dyn FnMut(std::ops::Range<usize>, usize, usize, Class),
+    ) {
+        let n = lattice.n;
+        let mut stack = vec![[0..n, j, 0..n]];
+        while let Some(block) = stack.pop() {
+            if let Some(class) = self.certify(lattice, &block) {
+                for jj in block[1].clone() {
+                    for k in block[2].clone() {
+                        put(block[0].clone(), jj, k, class);
+                    }
+                }
+                continue;
+            }
+            let longest = (0..3).max_by_key(|&a| (block[a].len(), a)).unwrap_or(0);
+            let r = &block[longest];
+            if r.len() <= 1 {
+                let [i, jj, k] = [block[0].start, block[1].start, block[2].start];
+                if let Some(class) = leaf(lattice.sample(i, jj, k)) {
+                    put(i..i + 1, jj, k, class);
+                }
+                continue;
+            }
+            let mid = r.start + r.len() / 2;
+            let (mut a, mut b) = (block.clone(), block);
+            a[longest] = a[longest].start..mid;
+            b[longest] = mid..b[longest].end;
+            stack.push(b);
+            stack.push(a);
+        }
+    }
+
+    /// The class every sample of `block` has, when one evaluation at its centre proves it.
+    fn certify(&self, lattice: &Lattice, block: &[std::ops::Range<usize>; 3]) -> Option<Class> {
+        let eps = self.surface.eps();
+        let lo = lattice.sample(block[0].start, block[1].start, block[2].start) - lattice.pad - eps;
+        let hi = lattice.sample(block[0].end - 1, block[1].end - 1, block[2].end - 1) + lattice.pad + eps;
+        if self.tree.may_meet_box(lo - eps, hi + eps) {
+            return None;
+        }
+        let c = (lo + hi) * 0.5;
+        let radius = (hi - lo).length() * 0.5 * (1.0 + 1e-12);
+        let slope = self.boundary.gradient_bound(c, radius)?;
+        let e = self.tree.winding(c, TOLERANCES[0]);
+        let spread = Estimate { w: e.w, err: e.err + slope * radius };
+        spread.decides(MARGIN).map(|inside| if inside { Class::Inside } else { Class::Outside })
+    }
+
+    /// The cell grid for `inclusion`: n³ cells over the covering's box.
+    fn cells(&self, n: usize) -> Cells {
+        let (lo, hi) = self.surface.bounds();
+        let side = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        let h = side / n as f64;
+        let origin = (lo + hi) * 0.5 - DVec3::splat(side * 0.5);
+        let lattice = Lattice { origin, h, n, pad: 0.5 * h };
+        let mut labels = vec![UNKNOWN; n * n * n];
+        let slab = slab_height(n);
+        labels.par_chunks_mut(slab * n * n).enumerate().for_each(|(s, chunk)| {
+            let j0 = s * slab;
+            let j1 = (j0 + slab).min(n);
+            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
+                let row = ((j - j0) * n + k) * n;
+                chunk[row + i.start..row + i.end].fill(class as u8);
+            };
+            self.label_slab(&lattice, j0..j1, &|_| None, &mut put);
+        });
+        Cells { lattice, labels }
+    }
+
+    /// The voxels of `grid` whose centre is inside by the rule: the same label `classify`
+    /// gives each centre (centres on the boundary are not occupied).
+    pub fn voxelize(&self, grid: &Grid) -> crate::voxel::Result<Volume> {
+        let n = grid.n;
+        let mut volume = Volume::new(n)?;
+        let lattice = Lattice { origin: grid.min, h: grid.h(), n, pad: 0.0 };
+        let slab = slab_height(n);
+        let leaf = |p: DVec3| Some(self.classify_point(p).0);
+        volume.par_slabs(slab, |mut s| {
+            let j = s.slices();
+            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
+                if class == Class::Inside {
+                    s.xor_span(j, k, i.start, i.end);
+                }
+            };
+            self.label_slab(&lattice, j, &leaf, &mut put);
+        });
+        Ok(volume)
+    }
+}
+
+/// Slices per parallel task of the cell labelling: about 16 slabs (large blocks stay
+/// whole; two to a few dozen cores get work).
+fn slab_height(n: usize) -> usize {
+    n.div_ceil(16).max(4)
+}
+
+/// Cells (i, j, k) of size h from `origin`, each with its sample at the centre
+/// `origin + (i + ½)·h` (per coordinate, as [`Grid::centre`] computes it); a block of cells
+/// covers the box of its samples grown by `pad` (h/2: the whole cells; 0: the samples).
+#[derive(Clone, Copy, Debug)]
+struct Lattice {
+    origin: DVec3,
+    h: f64,
+    n: usize,
+    pad: f64,
+}
+
+impl Lattice {
+    fn sample(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        let c = |o: f64, i: usize| o + (i as f64 + 0.5) * self.h;
+        DVec3::new(c(self.origin.x, i), c(self.origin.y, j), c(self.origin.z, k))
+    }
+}
+
+const UNKNOWN: u8 = 3;
+
+/// Certified cells: labels (0 outside, 1 inside, [`UNKNOWN`]) of an n³ grid, x fastest.
+#[derive(Clone, Debug)]
+struct Cells {
+    lattice: Lattice,
+    labels: Vec<u8>,
+}
+
+impl Cells {
+    /// The label of the cell holding `p`, if it was decided whole. (A point on a face
+    /// between cells may land in either: both hold it.)
+    fn label(&self, p: DVec3) -> Option<Class> {
+        let l = &self.lattice;
+        let g = (p - l.origin) / l.h;
+        if !(g.cmpge(DVec3::ZERO).all() && g.cmple(DVec3::splat(l.n as f64)).all()) {
+            return None;
+        }
+        let idx = |x: f64| (x as usize).min(l.n - 1);
+        match self.labels[(idx(g.y) * l.n + idx(g.z)) * l.n + idx(g.x)] {
+            0 => Some(Class::Outside),
+            1 => Some(Class::Inside),
+            _ => None,
+        }
+    }
+}
+
+/// The boundary curve Γ: covering edges whose directed uses do not cancel, with their
+/// net multiplicity, in spatial groups for [`Boundary::gradient_bound`].
+#[derive(Clone, Debug)]
+struct Boundary {
+    /// End points and |net multiplicity|, grouped: group g is `edges[g·EDGE_GROUP..]`.
+    edges: Vec<(DVec3, DVec3, f64)>,
+    /// Per group: bounds and Σ multiplicity × length.
+    groups: Vec<(DVec3, DVec3, f64)>,
+}
+
+impl Boundary {
+    fn new(covering: &Covering) -> Boundary {
+        let mut uses: Vec<(u32, u32, i32)> = covering
+            .triangles
+            .iter()
+            .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+            .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
+            .collect();
+        uses.par_sort_unstable_by_key(|&(a, b, _)| (a, b));
+        let mut edges = Vec::new();
+        for run in uses.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+            let m: i32 = run.iter().map(|x| x.2).sum();
+            if m != 0 {
+                let (a, b) = (covering.points[run[0].0 as usize], covering.points[run[0].1 as usize]);
+                edges.push((a, b, m.unsigned_abs() as f64));
+            }
+        }
+        group(&mut edges);
+        let groups = edges
+            .chunks(EDGE_GROUP)
+            .map(|g| {
+                g.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0), |(lo, hi, l), &(a, b, m)| {
+                    (lo.min(a).min(b), hi.max(a).max(b), l + m * a.distance(b))
+                })
+            })
+            .collect();
+        Boundary { edges, groups }
+    }
+
+    /// A bound of |∇w| over the ball of `radius` about `c` (`None`: Γ comes too close).
+    fn gradient_bound(&self, c: DVec3, radius: f64) -> Option<f64> {
+        let mut sum = 0.0;
+        for (g, &(lo, hi, len)) in self.groups.iter().enumerate() {
+            let gap = (lo - c).max(c - hi).max(DVec3::ZERO).length() - radius;
+            if gap > 2.0 * (hi - lo).length() {
+                sum += len / (gap * gap);
+                continue;
+            }
+            let end = ((g + 1) * EDGE_GROUP).min(self.edges.len());
+            for &(a, b, m) in &self.edges[g * EDGE_GROUP..end] {
+                let d = segment_distance(c, a, b) * (1.0 - 1e-12) - radius;
+                if d <= 0.0 {
+                    return None;
+                }
+                sum += m * a.distance(b) / (d * d);
+            }
+        }
+        // Relative margin for the rounding of the sum and the distances.
+        Some(sum / (4.0 * PI) * (1.0 + 1e-9))
+    }
+}
+
+/// Orders edges so that consecutive groups of [`EDGE_GROUP`] are compact (median splits
+/// along the longest axis of their midpoints).
+fn group(edges: &mut [(DVec3, DVec3, f64)]) {
+    if edges.len() <= EDGE_GROUP {
+        return;
+    }
+    let mid = |e: &(DVec3, DVec3, f64)| (e.0 + e.1) * 0.5;
+    let (lo, hi) = edges.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), e| (l.min(mid(e)), h.max(mid(e))));
+    let ext = hi - lo;
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    // Split at a multiple of the group size so that groups do not straddle the halves.
+    let half = (edges.len() / 2).div_ceil(EDGE_GROUP) * EDGE_GROUP;
+    if half >= edges.len() {
+        return;
+    }
+    edges.select_nth_unstable_by(half, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
+    let (a, b) = edges.split_at_mut(half);
+    group(a);
+    group(b);
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    p.distance(a + ab * t)
+}
+
+impl Classifier for FastWinding {
+    fn name(&self) -> &str {
+        "fast-winding"
+    }
+
+    fn classify(&self, p: DVec3) -> Class {
+        if let Some(class) = self.cells.as_ref().and_then(|c| c.label(p)) {
+            return class;
+        }
+        self.classify_point(p).0
+    }
+
+    fn build_stats(&self) -> BuildStats {
+        self.stats
+    }
+}
