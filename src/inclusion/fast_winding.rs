@@ -22,8 +22,15 @@
 //! when w̃(centre) ± (E + |∇w|·radius) stays [`MARGIN`] away from ½ — the same answer every
 //! point in it would get on its own. Boxes are split in halves down to single cells of a
 //! lattice ([`Lattice`]): for `inclusion` cells of a grid over the mesh's box, sized by
-//! the number of points, whose undecided cells send their points to the per-point path;
-//! for `voxelize` the voxel centres themselves.
+//! the number of points; for `voxelize` the voxel centres themselves.
+//!
+//! **Near the surface.** Crossing the surface from the side its normal points to changes
+//! w by exactly +1, so from an *anchor* Q with a certified estimate,
+//! w(P) = w(Q) + (signed crossings of the segment QP) + drift, |drift| ≤ |∇w| bound × |QP|,
+//! the crossings decided with exact orientation predicates ([`crate::exact`]). A segment
+//! through an edge or a vertex, or a bound that does not decide, sends P to the per-point
+//! path. Undecided `inclusion` cells get their centre as anchor; `voxelize` walks each row
+//! of undecided voxels from one centre to the next.
 //!
 //! Nothing here assumes a solid, so the meshes the solidity rule refuses — open,
 //! self-intersecting, nested, inverted — all get this answer; on a valid solid w is 0 or 1
@@ -39,20 +46,23 @@ use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::Result;
 use super::multipole::{Estimate, Tree};
 use super::surface::Surface;
+use crate::exact::{closest_point_on_segment, orient3d};
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 use crate::voxel::{Grid, Volume};
 
 /// Per-cluster error tolerances of the two tree walks (units of w).
-pub const TOLERANCES: [f64; 2] = [2e-4, 2e-6];
+pub const TOLERANCES: [f64; 2] = [1e-2, 1e-4];
 /// A cell is labelled whole only when its interval of w keeps this far from ½.
 pub const MARGIN: f64 = 1e-3;
 /// Fewer query points than this get no cell grid.
 const MIN_POINTS_FOR_CELLS: usize = 20_000;
 /// Largest cell grid for `inclusion` (n³ bytes).
-const MAX_CELLS: usize = 128;
+const MAX_CELLS: usize = 96;
 /// Boundary edges per group of the gradient bound.
 const EDGE_GROUP: usize = 32;
+/// A walk along a row starts again from a fresh estimate once its bound is this wide.
+const WALK_ERR: f64 = 0.25;
 
 /// How a point's label was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,6 +71,8 @@ pub enum Tier {
     Boundary,
     /// Decided by the first (0) or second (1) tree walk.
     Tree(u8),
+    /// Decided from an anchor by exact crossings.
+    Walk,
     /// Decided by the direct compensated sum.
     Direct,
     /// Not decided by any bound: the direct sum's value.
@@ -95,7 +107,7 @@ impl FastWinding {
             + fw.tree.bytes()
             + vec_bytes(&fw.boundary.edges)
             + vec_bytes(&fw.boundary.groups)
-            + fw.cells.as_ref().map_or(0, |c| vec_bytes(&c.labels));
+            + fw.cells.as_ref().map_or(0, |c| vec_bytes(&c.labels) + vec_bytes(&c.anchors));
         fw.stats = BuildStats { build_time: start.elapsed(), bytes };
         Ok(fw)
     }
@@ -159,16 +171,16 @@ impl FastWinding {
         self.tree.winding(p, TOLERANCES[0])
     }
 
-    /// Labels every sample of `lattice`: `put(i, j, k, class)` for the samples of blocks
-    /// decided whole (`i` a range along x), `leaf(p)` for a sample no block decides.
+    /// Labels the samples of `lattice` in slices `j` that blocks decide whole (`put(i, j, k,
+    /// class)`, `i` a range along x) and returns the others, (i, j, k), in row order.
     fn label_slab(
         &self,
         lattice: &Lattice,
         j: std::ops::Range<usize>,
-        leaf: &dyn Fn(DVec3) -> Option<Class>,
         put: &mut dyn FnMut(std::ops::Range<usize>, usize, usize, Class),
-    ) {
+    ) -> Vec<[u32; 3]> {
         let n = lattice.n;
+        let mut left = Vec::new();
         let mut stack = vec![[0..n, j, 0..n]];
         while let Some(block) = stack.pop() {
             if let Some(class) = self.certify(lattice, &block) {
@@ -182,10 +194,7 @@ impl FastWinding {
             let longest = (0..3).max_by_key(|&a| (block[a].len(), a)).unwrap_or(0);
             let r = &block[longest];
             if r.len() <= 1 {
-                let [i, jj, k] = [block[0].start, block[1].start, block[2].start];
-                if let Some(class) = leaf(lattice.sample(i, jj, k)) {
-                    put(i..i + 1, jj, k, class);
-                }
+                left.push([block[0].start as u32, block[1].start as u32, block[2].start as u32]);
                 continue;
             }
             let mid = r.start + r.len() / 2;
@@ -194,6 +203,45 @@ impl FastWinding {
             b[longest] = mid..b[longest].end;
             stack.push(b);
             stack.push(a);
+        }
+        left.sort_unstable_by_key(|&[i, j, k]| (j, k, i));
+        left
+    }
+
+    /// An anchor at `p` (off the boundary): the point evaluated and its estimate.
+    fn anchor(&self, p: DVec3) -> (DVec3, Estimate) {
+        let q = self.off_polygon_planes(p);
+        (q, self.tree.winding(q, TOLERANCES[0]))
+    }
+
+    /// w(p) from the anchor `q` (off the boundary) with estimate `at_q`: the signed
+    /// crossings of the segment qp added, the drift bounded by the gradient bound; `None`
+    /// when the segment meets an edge or a vertex, or Γ comes too close.
+    fn walk(&self, q: DVec3, at_q: Estimate, p: DVec3) -> Option<Estimate> {
+        let covering = self.surface.covering();
+        let (mut k, mut degenerate) = (0i32, false);
+        self.tree.any_near(q.min(p), q.max(p), 0.0, |t| {
+            let [a, b, c] = covering.triangle(t);
+            match crossing(a, b, c, q, p) {
+                Some(s) => k += s,
+                None => degenerate = true,
+            }
+            degenerate
+        });
+        if degenerate {
+            return None;
+        }
+        let half = q.distance(p) * 0.5 * (1.0 + 1e-12);
+        let slope = self.boundary.gradient_bound((q + p) * 0.5, half)?;
+        Some(Estimate { w: at_q.w + k as f64, err: at_q.err + slope * 2.0 * half })
+    }
+
+    /// The class of `p` (off the boundary) from an anchor, or on its own.
+    fn from_anchor(&self, anchor: Option<&(DVec3, Estimate)>, p: DVec3) -> Class {
+        let walked = anchor.and_then(|&(q, e)| self.walk(q, e, p)).and_then(|e| e.decides(0.0));
+        match walked {
+            Some(inside) => if inside { Class::Inside } else { Class::Outside },
+            None => self.classify_point(p).0,
         }
     }
 
@@ -222,16 +270,30 @@ impl FastWinding {
         let lattice = Lattice { origin, h, n, pad: 0.5 * h };
         let mut labels = vec![UNKNOWN; n * n * n];
         let slab = slab_height(n);
-        labels.par_chunks_mut(slab * n * n).enumerate().for_each(|(s, chunk)| {
-            let j0 = s * slab;
-            let j1 = (j0 + slab).min(n);
-            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
-                let row = ((j - j0) * n + k) * n;
-                chunk[row + i.start..row + i.end].fill(class as u8);
-            };
-            self.label_slab(&lattice, j0..j1, &|_| None, &mut put);
-        });
-        Cells { lattice, labels }
+        let left: Vec<Vec<[u32; 3]>> = labels
+            .par_chunks_mut(slab * n * n)
+            .enumerate()
+            .map(|(s, chunk)| {
+                let j0 = s * slab;
+                let j1 = (j0 + slab).min(n);
+                let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
+                    let row = ((j - j0) * n + k) * n;
+                    chunk[row + i.start..row + i.end].fill(class as u8);
+                };
+                self.label_slab(&lattice, j0..j1, &mut put)
+            })
+            .collect();
+        // Undecided cells get their centre as anchor (when it is off the boundary).
+        let anchors = left
+            .concat()
+            .into_par_iter()
+            .filter_map(|[i, j, k]| {
+                let c = lattice.sample(i as usize, j as usize, k as usize);
+                let index = ((j as usize * n + k as usize) * n + i as usize) as u32;
+                (!self.on_boundary(c)).then(|| (index, self.anchor(c)))
+            })
+            .collect();
+        Cells { lattice, labels, anchors }
     }
 
     /// The voxels of `grid` whose centre is inside by the rule: the same label `classify`
@@ -241,7 +303,6 @@ impl FastWinding {
         let mut volume = Volume::new(n)?;
         let lattice = Lattice { origin: grid.min, h: grid.h(), n, pad: 0.0 };
         let slab = slab_height(n);
-        let leaf = |p: DVec3| Some(self.classify_point(p).0);
         volume.par_slabs(slab, |mut s| {
             let j = s.slices();
             let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
@@ -249,10 +310,50 @@ impl FastWinding {
                     s.xor_span(j, k, i.start, i.end);
                 }
             };
-            self.label_slab(&lattice, j, &leaf, &mut put);
+            let left = self.label_slab(&lattice, j, &mut put);
+            // Along each row, from one undecided centre to the next.
+            let mut anchor: Option<(usize, usize, usize, DVec3, Estimate)> = None;
+            for [i, j, k] in left {
+                let (i, j, k) = (i as usize, j as usize, k as usize);
+                let p = lattice.sample(i, j, k);
+                if self.on_boundary(p) {
+                    anchor = None;
+                    continue;
+                }
+                let prev = anchor.take().filter(|a| (a.0 + 1, a.1, a.2) == (i, j, k) && a.4.err < WALK_ERR);
+                let walked = prev.and_then(|a| self.walk(a.3, a.4, p));
+                let (q, e) = match walked {
+                    Some(e) => (p, e),
+                    None => self.anchor(p),
+                };
+                let class = match e.decides(0.0) {
+                    Some(inside) => if inside { Class::Inside } else { Class::Outside },
+                    None => self.classify_point(p).0,
+                };
+                put(i..i + 1, j, k, class);
+                anchor = Some((i, j, k, q, e));
+            }
         });
         Ok(volume)
     }
+}
+
+/// Whether the segment q→p crosses the triangle abc: 0 (no), +1 from the side its normal
+/// points to, −1 the other way; `None` when it meets an edge or a vertex or has an end on
+/// the triangle's plane where the line meets it (exact predicates).
+fn crossing(a: DVec3, b: DVec3, c: DVec3, q: DVec3, p: DVec3) -> Option<i32> {
+    let (sq, sp) = (orient3d(a, b, c, q), orient3d(a, b, c, p));
+    if sq == sp && sq != 0 {
+        return Some(0);
+    }
+    let t = [orient3d(q, p, a, b), orient3d(q, p, b, c), orient3d(q, p, c, a)];
+    if t.contains(&1) && t.contains(&-1) {
+        return Some(0);
+    }
+    if sq == 0 || sp == 0 || t.contains(&0) {
+        return None;
+    }
+    Some(if sq > 0 { 1 } else { -1 })
 }
 
 /// Slices per parallel task of the cell labelling: about 16 slabs (large blocks stay
@@ -281,28 +382,31 @@ impl Lattice {
 
 const UNKNOWN: u8 = 3;
 
-/// Certified cells: labels (0 outside, 1 inside, [`UNKNOWN`]) of an n³ grid, x fastest.
+/// Certified cells: labels (0 outside, 1 inside, [`UNKNOWN`]) of an n³ grid, x fastest,
+/// and the anchors of the undecided cells (by cell index).
 #[derive(Clone, Debug)]
 struct Cells {
     lattice: Lattice,
     labels: Vec<u8>,
+    anchors: Vec<(u32, (DVec3, Estimate))>,
 }
 
 impl Cells {
-    /// The label of the cell holding `p`, if it was decided whole. (A point on a face
-    /// between cells may land in either: both hold it.)
-    fn label(&self, p: DVec3) -> Option<Class> {
+    /// The cell holding `p`: its label if it was decided whole, else its anchor (if any).
+    /// (A point on a face between cells may land in either: both hold it.)
+    fn lookup(&self, p: DVec3) -> Option<Result<Class, Option<&(DVec3, Estimate)>>> {
         let l = &self.lattice;
         let g = (p - l.origin) / l.h;
         if !(g.cmpge(DVec3::ZERO).all() && g.cmple(DVec3::splat(l.n as f64)).all()) {
             return None;
         }
         let idx = |x: f64| (x as usize).min(l.n - 1);
-        match self.labels[(idx(g.y) * l.n + idx(g.z)) * l.n + idx(g.x)] {
-            0 => Some(Class::Outside),
-            1 => Some(Class::Inside),
-            _ => None,
-        }
+        let cell = (idx(g.y) * l.n + idx(g.z)) * l.n + idx(g.x);
+        Some(match self.labels[cell] {
+            0 => Ok(Class::Outside),
+            1 => Ok(Class::Inside),
+            _ => Err(self.anchors.binary_search_by_key(&(cell as u32), |a| a.0).ok().map(|at| &self.anchors[at].1)),
+        })
     }
 }
 
@@ -356,7 +460,7 @@ impl Boundary {
             }
             let end = ((g + 1) * EDGE_GROUP).min(self.edges.len());
             for &(a, b, m) in &self.edges[g * EDGE_GROUP..end] {
-                let d = segment_distance(c, a, b) * (1.0 - 1e-12) - radius;
+                let d = c.distance(closest_point_on_segment(c, a, b)) * (1.0 - 1e-12) - radius;
                 if d <= 0.0 {
                     return None;
                 }
@@ -395,24 +499,17 @@ fn group(edges: &mut [(DVec3, DVec3, f64)]) {
     group(b);
 }
 
-/// Distance from `p` to the segment `a`–`b`.
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.length_squared();
-    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    p.distance(a + ab * t)
-}
-
 impl Classifier for FastWinding {
     fn name(&self) -> &str {
         "fast-winding"
     }
 
     fn classify(&self, p: DVec3) -> Class {
-        if let Some(class) = self.cells.as_ref().and_then(|c| c.label(p)) {
-            return class;
+        match self.cells.as_ref().and_then(|c| c.lookup(p)) {
+            Some(Ok(class)) => class,
+            Some(Err(anchor)) if !self.on_boundary(p) => self.from_anchor(anchor, p),
+            _ => self.classify_point(p).0,
         }
-        self.classify_point(p).0
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -21,15 +21,19 @@
 //! - T1 = tr M2 / d³ − 3 rᵀ M2 r / d⁵
 //! - T2 = 15/2 · M3[r, r, r] / d⁷ − 3 Σ_k r_k Σ_i M3_iik / d⁵ − 3/2 Σ_i r_i Σ_j M3_ijj / d⁵
 //!
-//! The rest is −Σ_{l≥4} ∇φ_l. Radially |∂_s φ_l| ≤ l s^{l−1}/d^{l+1} (|P_l| ≤ 1), and along
-//! γ Bernstein's inequality (|sin γ · P_l'(cos γ)| ≤ l for a polynomial of degree l bounded
-//! by 1) gives the same bound, so |∇φ_l(u)| ≤ √2 · l · s^{l−1}/d^{l+1} for |u| = s. With ρ
-//! the cluster's radius (every corner within ρ of C) and q = ρ/d < 1, summing the series:
+//! The rest is −Σ_{l≥4} ∇φ_l. In spherical coordinates about the axis −r, with x = cos γ
+//! and |u| = s, |∇φ_l|² = (s^{l−1}/d^{l+1})² (l² P_l(x)² + (1 − x²) P_l'(x)²). The function
+//! P_l² + (1 − x²) P_l'² / (l(l+1)) has derivative 2x P_l'² / (l(l+1)) (Legendre's equation),
+//! so it is largest at x = ±1, where it is 1; hence |∇φ_l(u)| ≤ √(l(l+1)) s^{l−1}/d^{l+1}
+//! ≤ (l + ½) s^{l−1}/d^{l+1}. On a triangle whose corners are within m_t of C, s ≤ m_t, and
+//! with ρ the cluster's radius (every corner within ρ of C) s^{l−1} ≤ m_t³ ρ^{l−4}. Summing
+//! the series, with q = ρ/d < 1 and B = Σ_t A_t m_t³ (A_t the triangle's area):
 //!
-//! **|truncation| ≤ A / (4π d²) · √2 · q³ (4 − 3q) / (1 − q)²** (A: the cluster's unsigned area)
+//! **|truncation| ≤ B / (4π d⁵) · (q / (1 − q)² + 4.5 / (1 − q))**
 //!
-//! in units of w. A cluster is used as a whole only when that bound (plus rounding) is at
-//! most the evaluation's tolerance per cluster, and only when q ≤ ½.
+//! in units of w (B ≤ A ρ³ for the cluster's area A; a flat disc has B = 0.4 A ρ³). A
+//! cluster is used as a whole only when that bound (plus rounding) is at most the
+//! evaluation's tolerance per cluster, and only when q ≤ ½.
 //!
 //! ## Rounding
 //!
@@ -40,7 +44,7 @@
 //! D = |a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b| are each within 64u·|a||b||c| of their
 //! values for the exact differences (N's six products are bounded by the 1-norms,
 //! ≤ 3√3 |a||b||c|; D's four terms by |a||b||c|); Ω = 2 atan2(N, D) then moves by at most
-//! π·e / (R − e) with e = 128u·|a||b||c| and R = |(N, D)| (the angle between two vectors
+//! π·e / (R − e) with e = 128u·|a||b||c| and R ≤ |(N, D)| (the angle between two vectors
 //! whose ends are e apart, one of length ≥ R − e), plus the rounding of atan2. When R ≤ 2e,
 //! or (N, D) is within e of atan2's cut (N = 0, D < 0: the point is a hair from the
 //! triangle itself), the triangle's term is not known (bound 1 in units of w).
@@ -91,6 +95,8 @@ struct Node {
     centre: DVec3,
     radius: f64,
     area: f64,
+    /// B = Σ_t A_t m_t³ of the truncation bound.
+    b3: f64,
     /// Number of triangles (for the rounding bound).
     count: u32,
     m1: DVec3,
@@ -366,6 +372,15 @@ fn cluster(items: &[Item]) -> Node {
     // Every corner within ρ of C, with room for the rounding of the distances.
     let radius = radius2.sqrt() * (1.0 + 8.0 * U);
     let (mut m1, mut m2, mut m3) = (DVec3::ZERO, [0.0; 9], [0.0; 18]);
+    let b3 = items
+        .iter()
+        .map(|i| {
+            let m2 = i.corners.iter().map(|&v| (v - centre).length_squared()).fold(0.0, f64::max);
+            let m = m2.sqrt() * (1.0 + 8.0 * U);
+            i.area.length() * m * m * m
+        })
+        .sum::<f64>()
+        * (1.0 + 4.0 * U * items.len() as f64);
     for it in items {
         let n = it.area;
         m1 += n;
@@ -391,6 +406,7 @@ fn cluster(items: &[Item]) -> Node {
         centre,
         radius,
         area,
+        b3,
         count: items.len() as u32,
         m1,
         m2,
@@ -413,7 +429,8 @@ fn far_bound(n: &Node, d: f64) -> Option<f64> {
     }
     let scale = n.area / (FOUR_PI * d * d);
     let one_q = 1.0 - q;
-    let truncation = scale * std::f64::consts::SQRT_2 * q * q * q * (4.0 - 3.0 * q) / (one_q * one_q);
+    let d5 = d * d * d * d * d;
+    let truncation = n.b3 / (FOUR_PI * d5) * (q / (one_q * one_q) + 4.5 / one_q);
     let rounding = scale * U * (64.0 + 4.0 * n.count as f64) * (1.0 + 4.0 * q + 12.0 * q * q);
     // The bound itself is computed in f64: a relative margin covers it.
     Some((truncation + rounding) * (1.0 + 32.0 * U))
@@ -465,7 +482,8 @@ pub fn solid_angle_bounded(a: DVec3, b: DVec3, c: DVec3) -> (f64, f64) {
     let den = prod + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
     let omega = 2.0 * num.atan2(den);
     let e = 128.0 * U * prod;
-    let r = num.hypot(den) * (1.0 - 4.0 * U);
+    // A lower bound of |(num, den)|, without the cost of hypot.
+    let r = num.abs().max(den.abs()) * (1.0 - 4.0 * U);
     // Within e of atan2's cut (num = 0, den < 0) the angle may be off by 2π: unknown.
     let cut = num.abs() <= e && den < e;
     let err = if r > 2.0 * e && !cut { (PI * e / (r - e) + 16.0 * U) / FOUR_PI } else { 1.0 };
