@@ -2,27 +2,16 @@
 //! keeps a mesh from being a solid, and `inclusion` and `voxelize` refuse it with status 2
 //! and the reason — or, with `--flip-inverted`, answer for the flipped solid exactly as
 //! for a well-oriented one. `--allow-open` means "inside iff the generalized winding number
-//! is at least ½", which only `--method winding` computes.
+//! is at least ½" for any mesh that is not a solid, by every CPU method.
 
 mod common;
 
+use common::shapes::union;
 use common::{TempDir, assert_refused, stderr, stdout, texgeo};
 use glam::DVec3;
 use texgeo::mesh::procedural::{self, box_between};
 use texgeo::mesh::solidity::flipped;
 use texgeo::mesh::{Mesh, formats};
-
-/// The shells of `parts` in one mesh, vertices not shared.
-fn union(parts: &[Mesh]) -> Mesh {
-    let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    for m in parts {
-        let base = positions.len() as u32;
-        positions.extend_from_slice(m.positions());
-        faces.extend(m.faces().map(|f| f.iter().map(|&i| i + base).collect::<Vec<_>>()));
-    }
-    Mesh::new(positions, faces).unwrap()
-}
 
 fn save(dir: &TempDir, name: &str, mesh: &Mesh) -> String {
     let path = dir.join(name);
@@ -137,11 +126,21 @@ fn allow_open_means_the_generalized_winding_number() {
     let o = texgeo(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&classes).unwrap(), "1\n0\n0\n");
-    for method in ["cpu", "tetragrid", "gpu", "jordan"] {
+    // Every CPU method gives the same answers by the same rule; the GPU methods refuse.
+    for method in ["cpu", "tetragrid", "jordan", "voxel-space", "auto"] {
         let mut a = args(method);
         a.push(&classes);
         let o = texgeo(&a);
-        assert_refused(&o, &["--allow-open", "generalized winding number", "--method winding"]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        assert_eq!(std::fs::read_to_string(&classes).unwrap(), "1\n0\n0\n", "{method}");
+        assert_eq!(stderr(&o).matches("warning").count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).contains("not closed") && stderr(&o).contains("at least ½"), "{}", stderr(&o));
+    }
+    for method in ["gpu", "cpu+gpu", "gpu+tetragrid"] {
+        let mut a = args(method);
+        a.push(&classes);
+        let o = texgeo(&a);
+        assert_refused(&o, &["--allow-open", "solids only", "generalized winding number", "CPU"]);
     }
     // A closed mesh under --allow-open is classified by every method as usual.
     let o = texgeo(&["inclusion", "builtin:cube", "--random", "50", "--allow-open", "--method", "cpu"]);

@@ -20,6 +20,18 @@ fn mesh(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Mesh {
     Mesh::new(positions, faces).expect("test shapes are valid meshes")
 }
 
+/// The shells of `parts` in one mesh, vertices not shared.
+pub fn union(parts: &[Mesh]) -> Mesh {
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    for m in parts {
+        let base = positions.len() as u32;
+        positions.extend_from_slice(m.positions());
+        faces.extend(m.faces().map(|f| f.iter().map(|&i| i + base).collect::<Vec<_>>()));
+    }
+    mesh(positions, faces)
+}
+
 /// Cube [−1,1]³, six quads: every vertex has valence 3 (the built-in model).
 pub fn cube() -> Mesh {
     procedural::cube()
