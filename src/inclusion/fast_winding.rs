@@ -30,7 +30,9 @@
 //! the crossings decided with exact orientation predicates ([`crate::exact`]). A segment
 //! through an edge or a vertex, or a bound that does not decide, sends P to the per-point
 //! path. Undecided `inclusion` cells get their centre as anchor; `voxelize` walks each row
-//! of undecided voxels from one centre to the next.
+//! of undecided voxels from one centre to the next (starting from the interval of the
+//! block before it, or a fresh estimate), and takes a fresh estimate where a step does not
+//! decide.
 //!
 //! Nothing here assumes a solid, so the meshes the solidity rule refuses — open,
 //! self-intersecting, nested, inverted — all get this answer; on a valid solid w is 0 or 1
@@ -61,8 +63,9 @@ const MIN_POINTS_FOR_CELLS: usize = 20_000;
 const MAX_CELLS: usize = 96;
 /// Boundary edges per group of the gradient bound.
 const EDGE_GROUP: usize = 32;
-/// A walk along a row starts again from a fresh estimate once its bound is this wide.
-const WALK_ERR: f64 = 0.25;
+/// `voxelize` does not try to decide blocks of fewer voxels whole: walking their rows
+/// from a neighbour costs less than an estimate.
+const MIN_VOXEL_BLOCK: usize = 256;
 
 /// How a point's label was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -173,28 +176,37 @@ impl FastWinding {
 
     /// Labels the samples of `lattice` in slices `j` that blocks decide whole (`put(i, j, k,
     /// class)`, `i` a range along x) and returns the others, (i, j, k), in row order.
+    /// Blocks of fewer than `min_block` samples are not tried (all their samples are
+    /// returned).
     fn label_slab(
         &self,
         lattice: &Lattice,
         j: std::ops::Range<usize>,
-        put: &mut dyn FnMut(std::ops::Range<usize>, usize, usize, Class),
+        min_block: usize,
+        put: &mut dyn FnMut(std::ops::Range<usize>, usize, usize, Class, Estimate),
     ) -> Vec<[u32; 3]> {
         let n = lattice.n;
         let mut left = Vec::new();
         let mut stack = vec![[0..n, j, 0..n]];
         while let Some(block) = stack.pop() {
-            if let Some(class) = self.certify(lattice, &block) {
+            let size = block.iter().map(|r| r.len()).product::<usize>();
+            let decided = if size >= min_block { self.certify(lattice, &block) } else { None };
+            if let Some((class, e)) = decided {
                 for jj in block[1].clone() {
                     for k in block[2].clone() {
-                        put(block[0].clone(), jj, k, class);
+                        put(block[0].clone(), jj, k, class, e);
                     }
                 }
                 continue;
             }
             let longest = (0..3).max_by_key(|&a| (block[a].len(), a)).unwrap_or(0);
             let r = &block[longest];
-            if r.len() <= 1 {
-                left.push([block[0].start as u32, block[1].start as u32, block[2].start as u32]);
+            if size < min_block || r.len() <= 1 {
+                for jj in block[1].clone() {
+                    for k in block[2].clone() {
+                        left.extend(block[0].clone().map(|i| [i as u32, jj as u32, k as u32]));
+                    }
+                }
                 continue;
             }
             let mid = r.start + r.len() / 2;
@@ -218,19 +230,38 @@ impl FastWinding {
     /// crossings of the segment qp added, the drift bounded by the gradient bound; `None`
     /// when the segment meets an edge or a vertex, or Γ comes too close.
     fn walk(&self, q: DVec3, at_q: Estimate, p: DVec3) -> Option<Estimate> {
-        let covering = self.surface.covering();
         let (mut k, mut degenerate) = (0i32, false);
         self.tree.any_near(q.min(p), q.max(p), 0.0, |t| {
-            let [a, b, c] = covering.triangle(t);
-            match crossing(a, b, c, q, p) {
+            match self.crossing(t, q, p) {
                 Some(s) => k += s,
                 None => degenerate = true,
             }
             degenerate
         });
-        if degenerate {
-            return None;
+        if degenerate { None } else { self.drift(q, at_q, p, k) }
+    }
+
+    /// [`Self::walk`] over the covering triangles `near` (all that may meet the segment).
+    fn walk_among(&self, near: &[usize], q: DVec3, at_q: Estimate, p: DVec3) -> Option<Estimate> {
+        let (lo, hi) = (q.min(p), q.max(p));
+        let mut k = 0;
+        for &t in near {
+            let [a, b, c] = self.surface.covering().triangle(t);
+            if a.min(b).min(c).cmple(hi).all() && a.max(b).max(c).cmpge(lo).all() {
+                k += self.crossing(t, q, p)?;
+            }
         }
+        self.drift(q, at_q, p, k)
+    }
+
+    /// Whether the segment q→p crosses covering triangle `t` (see [`crossing`]).
+    fn crossing(&self, t: usize, q: DVec3, p: DVec3) -> Option<i32> {
+        let [a, b, c] = self.surface.covering().triangle(t);
+        crossing(a, b, c, q, p)
+    }
+
+    /// The estimate at `p` from the one at `q` and the `k` signed crossings between them.
+    fn drift(&self, q: DVec3, at_q: Estimate, p: DVec3, k: i32) -> Option<Estimate> {
         let half = q.distance(p) * 0.5 * (1.0 + 1e-12);
         let slope = self.boundary.gradient_bound((q + p) * 0.5, half)?;
         Some(Estimate { w: at_q.w + k as f64, err: at_q.err + slope * 2.0 * half })
@@ -246,7 +277,8 @@ impl FastWinding {
     }
 
     /// The class every sample of `block` has, when one evaluation at its centre proves it.
-    fn certify(&self, lattice: &Lattice, block: &[std::ops::Range<usize>; 3]) -> Option<Class> {
+    /// With it, the interval of w that holds at every sample of the block.
+    fn certify(&self, lattice: &Lattice, block: &[std::ops::Range<usize>; 3]) -> Option<(Class, Estimate)> {
         let eps = self.surface.eps();
         let lo = lattice.sample(block[0].start, block[1].start, block[2].start) - lattice.pad - eps;
         let hi = lattice.sample(block[0].end - 1, block[1].end - 1, block[2].end - 1) + lattice.pad + eps;
@@ -258,7 +290,7 @@ impl FastWinding {
         let slope = self.boundary.gradient_bound(c, radius)?;
         let e = self.tree.winding(c, TOLERANCES[0]);
         let spread = Estimate { w: e.w, err: e.err + slope * radius };
-        spread.decides(MARGIN).map(|inside| if inside { Class::Inside } else { Class::Outside })
+        spread.decides(MARGIN).map(|inside| (if inside { Class::Inside } else { Class::Outside }, spread))
     }
 
     /// The cell grid for `inclusion`: n³ cells over the covering's box.
@@ -276,11 +308,11 @@ impl FastWinding {
             .map(|(s, chunk)| {
                 let j0 = s * slab;
                 let j1 = (j0 + slab).min(n);
-                let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
+                let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class, _: Estimate| {
                     let row = ((j - j0) * n + k) * n;
                     chunk[row + i.start..row + i.end].fill(class as u8);
                 };
-                self.label_slab(&lattice, j0..j1, &mut put)
+                self.label_slab(&lattice, j0..j1, 1, &mut put)
             })
             .collect();
         // Undecided cells get their centre as anchor (when it is off the boundary).
@@ -305,33 +337,57 @@ impl FastWinding {
         let slab = slab_height(n);
         volume.par_slabs(slab, |mut s| {
             let j = s.slices();
-            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class| {
+            // Where blocks decide: the voxels, and per row the spans with their interval of w.
+            let mut spans: Vec<(u32, u32, u32, Estimate)> = Vec::new();
+            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class, e: Estimate| {
                 if class == Class::Inside {
                     s.xor_span(j, k, i.start, i.end);
                 }
+                spans.push((j as u32, k as u32, i.end as u32, e));
             };
-            let left = self.label_slab(&lattice, j, &mut put);
-            // Along each row, from one undecided centre to the next.
-            let mut anchor: Option<(usize, usize, usize, DVec3, Estimate)> = None;
-            for [i, j, k] in left {
-                let (i, j, k) = (i as usize, j as usize, k as usize);
-                let p = lattice.sample(i, j, k);
-                if self.on_boundary(p) {
-                    anchor = None;
-                    continue;
+            let left = self.label_slab(&lattice, j, MIN_VOXEL_BLOCK, &mut put);
+            spans.sort_unstable_by_key(|&(j, k, i, _)| (j, k, i));
+            let eps = self.surface.eps();
+            let mut near = Vec::new();
+            for row in left.chunk_by(|a, b| (a[1], a[2]) == (b[1], b[2])) {
+                let (j, k) = (row[0][1] as usize, row[0][2] as usize);
+                let (first, last) = (row[0][0] as usize, row[row.len() - 1][0] as usize);
+                // The triangles near this row, from the voxel before its first undecided one.
+                near.clear();
+                let lo = lattice.sample(first.saturating_sub(1), j, k) - 2.0 * eps;
+                self.tree.any_near(lo, lattice.sample(last, j, k) + 2.0 * eps, 0.0, |t| {
+                    near.push(t);
+                    false
+                });
+                let mut anchor: Option<(usize, DVec3, Estimate)> = None;
+                for &[i, _, _] in row {
+                    let i = i as usize;
+                    let p = lattice.sample(i, j, k);
+                    if near.iter().any(|&t| self.surface.on_boundary_near(t, p)) {
+                        anchor = None;
+                        continue;
+                    }
+                    // From the previous centre, or from a block that ends just before this one.
+                    let prev = anchor.take().filter(|a| a.0 + 1 == i).or_else(|| {
+                        let at = spans.binary_search_by_key(&(j as u32, k as u32, i as u32), |x| (x.0, x.1, x.2));
+                        at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
+                    });
+                    let walked = prev
+                        .and_then(|a| self.walk_among(&near, a.1, a.2, p))
+                        .filter(|e| e.decides(0.0).is_some());
+                    let (q, e) = match walked {
+                        Some(e) => (p, e),
+                        None => self.anchor(p),
+                    };
+                    let class = match e.decides(0.0) {
+                        Some(inside) => if inside { Class::Inside } else { Class::Outside },
+                        None => self.classify_point(p).0,
+                    };
+                    if class == Class::Inside {
+                        s.xor_span(j, k, i, i + 1);
+                    }
+                    anchor = Some((i, q, e));
                 }
-                let prev = anchor.take().filter(|a| (a.0 + 1, a.1, a.2) == (i, j, k) && a.4.err < WALK_ERR);
-                let walked = prev.and_then(|a| self.walk(a.3, a.4, p));
-                let (q, e) = match walked {
-                    Some(e) => (p, e),
-                    None => self.anchor(p),
-                };
-                let class = match e.decides(0.0) {
-                    Some(inside) => if inside { Class::Inside } else { Class::Outside },
-                    None => self.classify_point(p).0,
-                };
-                put(i..i + 1, j, k, class);
-                anchor = Some((i, j, k, q, e));
             }
         });
         Ok(volume)
