@@ -241,17 +241,30 @@ impl FastWinding {
         if degenerate { None } else { self.drift(q, at_q, p, k) }
     }
 
-    /// [`Self::walk`] over the covering triangles `near` (all that may meet the segment).
-    fn walk_among(&self, near: &[usize], q: DVec3, at_q: Estimate, p: DVec3) -> Option<Estimate> {
+    /// [`Self::walk`] over the covering triangles `near` (with their bounds: all that may
+    /// meet the segment), with `slope` a gradient bound along it when known.
+    fn walk_among(
+        &self,
+        near: &[(usize, DVec3, DVec3)],
+        slope: Option<f64>,
+        q: DVec3,
+        at_q: Estimate,
+        p: DVec3,
+    ) -> Option<Estimate> {
         let (lo, hi) = (q.min(p), q.max(p));
         let mut k = 0;
-        for &t in near {
-            let [a, b, c] = self.surface.covering().triangle(t);
-            if a.min(b).min(c).cmple(hi).all() && a.max(b).max(c).cmpge(lo).all() {
+        for &(t, tlo, thi) in near {
+            if tlo.cmple(hi).all() && thi.cmpge(lo).all() {
                 k += self.crossing(t, q, p)?;
             }
         }
-        self.drift(q, at_q, p, k)
+        match slope {
+            Some(slope) => {
+                let err = at_q.err + slope * q.distance(p) * (1.0 + 1e-12);
+                Some(Estimate { w: at_q.w + k as f64, err })
+            }
+            None => self.drift(q, at_q, p, k),
+        }
     }
 
     /// Whether the segment q→p crosses covering triangle `t` (see [`crossing`]).
@@ -348,22 +361,31 @@ impl FastWinding {
             let left = self.label_slab(&lattice, j, MIN_VOXEL_BLOCK, &mut put);
             spans.sort_unstable_by_key(|&(j, k, i, _)| (j, k, i));
             let eps = self.surface.eps();
+            let covering = self.surface.covering();
             let mut near = Vec::new();
             for row in left.chunk_by(|a, b| (a[1], a[2]) == (b[1], b[2])) {
                 let (j, k) = (row[0][1] as usize, row[0][2] as usize);
                 let (first, last) = (row[0][0] as usize, row[row.len() - 1][0] as usize);
                 // The triangles near this row, from the voxel before its first undecided one.
                 near.clear();
-                let lo = lattice.sample(first.saturating_sub(1), j, k) - 2.0 * eps;
-                self.tree.any_near(lo, lattice.sample(last, j, k) + 2.0 * eps, 0.0, |t| {
-                    near.push(t);
+                let (start, end) = (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
+                self.tree.any_near(start - 2.0 * eps, end + 2.0 * eps, 0.0, |t| {
+                    let [a, b, c] = covering.triangle(t);
+                    near.push((t, a.min(b).min(c), a.max(b).max(c)));
                     false
                 });
+                // One gradient bound for the whole stretch of the row, when Γ keeps away.
+                let slope = self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
                 let mut anchor: Option<(usize, DVec3, Estimate)> = None;
                 for &[i, _, _] in row {
                     let i = i as usize;
                     let p = lattice.sample(i, j, k);
-                    if near.iter().any(|&t| self.surface.on_boundary_near(t, p)) {
+                    let on_boundary = near.iter().any(|&(t, lo, hi)| {
+                        (lo - eps).cmple(p).all()
+                            && (hi + eps).cmpge(p).all()
+                            && self.surface.on_face(covering.face_of[t] as usize, p)
+                    });
+                    if on_boundary {
                         anchor = None;
                         continue;
                     }
@@ -373,7 +395,7 @@ impl FastWinding {
                         at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
                     });
                     let walked = prev
-                        .and_then(|a| self.walk_among(&near, a.1, a.2, p))
+                        .and_then(|a| self.walk_among(&near, slope, a.1, a.2, p))
                         .filter(|e| e.decides(0.0).is_some());
                     let (q, e) = match walked {
                         Some(e) => (p, e),
