@@ -209,7 +209,8 @@ fn commands_take_non_solids_with_the_flag_and_say_what_they_do() {
     let o = texgeo(&["mesh", "stats", &open]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stdout(&o).contains("open: 4 boundary edges in 1 loop; inside by winding number ≥ ½ with --allow-open"),
+        stdout(&o)
+            .contains("open: 4 boundary edges in 1 loop; inside by winding number ≥ ½ with --allow-open"),
         "{}",
         stdout(&o)
     );
@@ -242,8 +243,17 @@ fn commands_take_non_solids_with_the_flag_and_say_what_they_do() {
     for method in ["auto", "cpu", "scanline"] {
         let o = texgeo(&["voxelize", "builtin:torus", "--res", "24", "--method", method, "-o", &a]);
         assert!(o.status.success(), "{}", stderr(&o));
-        let o =
-            texgeo(&["voxelize", "builtin:torus", "--res", "24", "--method", method, "--allow-open", "-o", &b]);
+        let o = texgeo(&[
+            "voxelize",
+            "builtin:torus",
+            "--res",
+            "24",
+            "--method",
+            method,
+            "--allow-open",
+            "-o",
+            &b,
+        ]);
         assert!(o.status.success() && !stderr(&o).contains("warning"), "{}", stderr(&o));
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{method}");
     }
@@ -259,10 +269,25 @@ fn a_sweep_with_the_flag_records_non_solids_with_their_defect() {
     }
     let out = dir.arg("out");
     let m = meshes.to_string_lossy().into_owned();
-    let o = texgeo(&["sweep", &m, "--task", "inclusion", "--method", "cpu", "--points", "300", "--allow-open", "-o", &out]);
+    let o = texgeo(&[
+        "sweep",
+        &m,
+        "--task",
+        "inclusion",
+        "--method",
+        "cpu",
+        "--points",
+        "300",
+        "--allow-open",
+        "-o",
+        &out,
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(dir.join("out").join("sweep.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("check_non_solid"), "{csv}");
     assert_eq!(csv.lines().filter(|l| l.contains(",ok,")).count(), 4, "{csv}");
-    assert!(csv.contains("not-closed") && (csv.contains("self-intersecting") || csv.contains("crossing-shells")), "{csv}");
+    assert!(
+        csv.contains("not-closed") && (csv.contains("self-intersecting") || csv.contains("crossing-shells")),
+        "{csv}"
+    );
 }

@@ -284,7 +284,13 @@ impl FastWinding {
     fn from_anchor(&self, anchor: Option<&(DVec3, Estimate)>, p: DVec3) -> Class {
         let walked = anchor.and_then(|&(q, e)| self.walk(q, e, p)).and_then(|e| e.decides(0.0));
         match walked {
-            Some(inside) => if inside { Class::Inside } else { Class::Outside },
+            Some(inside) => {
+                if inside {
+                    Class::Inside
+                } else {
+                    Class::Outside
+                }
+            }
             None => self.classify_point(p).0,
         }
     }
@@ -368,14 +374,16 @@ impl FastWinding {
                 let (first, last) = (row[0][0] as usize, row[row.len() - 1][0] as usize);
                 // The triangles near this row, from the voxel before its first undecided one.
                 near.clear();
-                let (start, end) = (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
+                let (start, end) =
+                    (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
                 self.tree.any_near(start - 2.0 * eps, end + 2.0 * eps, 0.0, |t| {
                     let [a, b, c] = covering.triangle(t);
                     near.push((t, a.min(b).min(c), a.max(b).max(c)));
                     false
                 });
                 // One gradient bound for the whole stretch of the row, when Γ keeps away.
-                let slope = self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
+                let slope =
+                    self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
                 let mut anchor: Option<(usize, DVec3, Estimate)> = None;
                 for &[i, _, _] in row {
                     let i = i as usize;
@@ -391,7 +399,8 @@ impl FastWinding {
                     }
                     // From the previous centre, or from a block that ends just before this one.
                     let prev = anchor.take().filter(|a| a.0 + 1 == i).or_else(|| {
-                        let at = spans.binary_search_by_key(&(j as u32, k as u32, i as u32), |x| (x.0, x.1, x.2));
+                        let at =
+                            spans.binary_search_by_key(&(j as u32, k as u32, i as u32), |x| (x.0, x.1, x.2));
                         at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
                     });
                     let walked = prev
@@ -402,7 +411,13 @@ impl FastWinding {
                         None => self.anchor(p),
                     };
                     let class = match e.decides(0.0) {
-                        Some(inside) => if inside { Class::Inside } else { Class::Outside },
+                        Some(inside) => {
+                            if inside {
+                                Class::Inside
+                            } else {
+                                Class::Outside
+                            }
+                        }
                         None => self.classify_point(p).0,
                     };
                     if class == Class::Inside {
@@ -483,7 +498,11 @@ impl Cells {
         Some(match self.labels[cell] {
             0 => Ok(Class::Outside),
             1 => Ok(Class::Inside),
-            _ => Err(self.anchors.binary_search_by_key(&(cell as u32), |a| a.0).ok().map(|at| &self.anchors[at].1)),
+            _ => Err(self
+                .anchors
+                .binary_search_by_key(&(cell as u32), |a| a.0)
+                .ok()
+                .map(|at| &self.anchors[at].1)),
         })
     }
 }
@@ -557,7 +576,8 @@ fn group(edges: &mut [(DVec3, DVec3, f64)]) {
         return;
     }
     let mid = |e: &(DVec3, DVec3, f64)| (e.0 + e.1) * 0.5;
-    let (lo, hi) = edges.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), e| (l.min(mid(e)), h.max(mid(e))));
+    let (lo, hi) =
+        edges.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), e| (l.min(mid(e)), h.max(mid(e))));
     let ext = hi - lo;
     let axis = if ext.x >= ext.y && ext.x >= ext.z {
         0

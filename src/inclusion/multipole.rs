@@ -310,8 +310,9 @@ fn build(items: &mut [Item], base: u32) -> Vec<Node> {
         node.first = 0;
         return vec![node];
     }
-    let (clo, chi) =
-        items.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), i| (l.min(i.centroid), h.max(i.centroid)));
+    let (clo, chi) = items
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), i| (l.min(i.centroid), h.max(i.centroid)));
     let e = chi - clo;
     let axis = if e.x >= e.y && e.x >= e.z {
         0
@@ -364,11 +365,8 @@ fn cluster(items: &[Item]) -> Node {
         weighted += a * i.centroid;
     }
     let centre = if area > 0.0 && (weighted / area).is_finite() { weighted / area } else { (lo + hi) * 0.5 };
-    let radius2 = items
-        .iter()
-        .flat_map(|i| i.corners)
-        .map(|v| (v - centre).length_squared())
-        .fold(0.0, f64::max);
+    let radius2 =
+        items.iter().flat_map(|i| i.corners).map(|v| (v - centre).length_squared()).fold(0.0, f64::max);
     // Every corner within ρ of C, with room for the rounding of the distances.
     let radius = radius2.sqrt() * (1.0 + 8.0 * U);
     let (mut m1, mut m2, mut m3) = (DVec3::ZERO, [0.0; 9], [0.0; 18]);
@@ -455,7 +453,10 @@ fn far_field(n: &Node, r: DVec3, d: f64) -> f64 {
     let m3 = &n.m3;
     // Per i: the symmetric matrix S_i = M3_i.. as (xx, yy, zz, xy, xz, yz).
     let quad = |s: &[f64]| {
-        s[0] * r.x * r.x + s[1] * r.y * r.y + s[2] * r.z * r.z + 2.0 * (s[3] * r.x * r.y + s[4] * r.x * r.z + s[5] * r.y * r.z)
+        s[0] * r.x * r.x
+            + s[1] * r.y * r.y
+            + s[2] * r.z * r.z
+            + 2.0 * (s[3] * r.x * r.y + s[4] * r.x * r.z + s[5] * r.y * r.z)
     };
     let (sx, sy, sz) = (&m3[0..6], &m3[6..12], &m3[12..18]);
     let cubic = r.x * quad(sx) + r.y * quad(sy) + r.z * quad(sz);

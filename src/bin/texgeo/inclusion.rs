@@ -91,7 +91,11 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     }
     if let Some(defect) = &solid.non_solid {
         if !args.method.is_cpu() {
-            anyhow::bail!("{}: {}", args.mesh, texgeo::inclusion::InclusionError::NotForNonSolids(args.method.name()));
+            anyhow::bail!(
+                "{}: {}",
+                args.mesh,
+                texgeo::inclusion::InclusionError::NotForNonSolids(args.method.name())
+            );
         }
         crate::mesh::warn_non_solid(&args.mesh, defect);
     }
@@ -123,7 +127,11 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             options.points
         ),
         Some(choice) => {
-            note!("texgeo: --method auto: {choice} for {} faces and {} points", mesh.num_faces(), options.points)
+            note!(
+                "texgeo: --method auto: {choice} for {} faces and {} points",
+                mesh.num_faces(),
+                options.points
+            )
         }
         None => {}
     }

@@ -112,7 +112,8 @@ pub fn load_solid(spec: &MeshArg, policy: Policy, flags: &[&str]) -> anyhow::Res
             }
             Some(f @ "--flip-inverted") => format!(" ({f} reverses every face)"),
             _ if flags.contains(&"--allow-open") && !matches!(e.defect, Defect::Overflow { .. }) => {
-                " (--allow-open classifies it by the generalized winding number: inside iff w ≥ ½)".to_string()
+                " (--allow-open classifies it by the generalized winding number: inside iff w ≥ ½)"
+                    .to_string()
             }
             _ => String::new(),
         };

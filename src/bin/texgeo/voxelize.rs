@@ -76,7 +76,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(dir) = &aspect_dir {
         texgeo::output::check_dir(dir)?;
     }
-    let policy = Policy { flip_inverted: args.flip_inverted, allow_open: args.allow_open, ..Policy::default() };
+    let policy =
+        Policy { flip_inverted: args.flip_inverted, allow_open: args.allow_open, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--flip-inverted", "--allow-open"])?;
     if solid.flipped {
         note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);

@@ -32,7 +32,13 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Options {
-        Options { method: "zoned".into(), res: 64, reference: "scanline".into(), zone: None, allow_open: false }
+        Options {
+            method: "zoned".into(),
+            res: 64,
+            reference: "scanline".into(),
+            zone: None,
+            allow_open: false,
+        }
     }
 }
 
@@ -180,7 +186,8 @@ fn winding_rule(mesh: &Mesh, o: &Options, out: &mut Record) -> Result<(), Failur
             let (j, k) = (jk / n, jk % n);
             (0..n)
                 .filter(|&i| {
-                    let inside = fast.classify_point(grid.centre(i, j, k)).0 == crate::inclusion::Class::Inside;
+                    let inside =
+                        fast.classify_point(grid.centre(i, j, k)).0 == crate::inclusion::Class::Inside;
                     inside != volume.get(i, j, k)
                 })
                 .count() as u64
@@ -189,7 +196,10 @@ fn winding_rule(mesh: &Mesh, o: &Options, out: &mut Record) -> Result<(), Failur
     out.time("reference", t.elapsed());
     out.check("differing", differing);
     if differing > 0 {
-        return Err(Failure::failed("check", format!("{differing} voxels differ from their centres' labels")));
+        return Err(Failure::failed(
+            "check",
+            format!("{differing} voxels differ from their centres' labels"),
+        ));
     }
     Ok(())
 }
