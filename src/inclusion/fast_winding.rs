@@ -281,7 +281,7 @@ impl FastWinding {
     }
 
     /// The class of `p` (off the boundary) from an anchor, or on its own.
-    fn from_anchor(&self, anchor: Option<&(DVec3, Estimate)>, p: DVec3) -> Class {
+    fn classify_from(&self, anchor: Option<&(DVec3, Estimate)>, p: DVec3) -> Class {
         let walked = anchor.and_then(|&(q, e)| self.walk(q, e, p)).and_then(|e| e.decides(0.0));
         match walked {
             Some(inside) => {
@@ -605,7 +605,7 @@ impl Classifier for FastWinding {
     fn classify(&self, p: DVec3) -> Class {
         match self.cells.as_ref().and_then(|c| c.lookup(p)) {
             Some(Ok(class)) => class,
-            Some(Err(anchor)) if !self.on_boundary(p) => self.from_anchor(anchor, p),
+            Some(Err(anchor)) if !self.on_boundary(p) => self.classify_from(anchor, p),
             _ => self.classify_point(p).0,
         }
     }
