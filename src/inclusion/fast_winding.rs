@@ -175,7 +175,7 @@ impl FastWinding {
     }
 
     /// Labels the samples of `lattice` in slices `j` that blocks decide whole (`put(i, j, k,
-    /// class)`, `i` a range along x) and returns the others, (i, j, k), in row order.
+    /// class, interval of w)`, `i` a range along x) and returns the others, (i, j, k).
     /// Blocks of fewer than `min_block` samples are not tried (all their samples are
     /// returned).
     fn label_slab(
@@ -216,7 +216,6 @@ impl FastWinding {
             stack.push(b);
             stack.push(a);
         }
-        left.sort_unstable_by_key(|&[i, j, k]| (j, k, i));
         left
     }
 
@@ -364,15 +363,34 @@ impl FastWinding {
                 }
                 spans.push((j as u32, k as u32, i.end as u32, e));
             };
+            let (j0, rows) = (j.start, j.len());
             let left = self.label_slab(&lattice, j, MIN_VOXEL_BLOCK, &mut put);
             spans.sort_unstable_by_key(|&(j, k, i, _)| (j, k, i));
+            // The undecided voxels as bits per row, read back in row order.
+            let wpr = n.div_ceil(64);
+            let mut bits = vec![0u64; rows * n * wpr];
+            for [i, jj, k] in left {
+                bits[((jj as usize - j0) * n + k as usize) * wpr + i as usize / 64] |= 1 << (i % 64);
+            }
             let eps = self.surface.eps();
             let covering = self.surface.covering();
-            let mut near = Vec::new();
-            for row in left.chunk_by(|a, b| (a[1], a[2]) == (b[1], b[2])) {
-                let (j, k) = (row[0][1] as usize, row[0][2] as usize);
-                let (first, last) = (row[0][0] as usize, row[row.len() - 1][0] as usize);
-                // The triangles near this row, from the voxel before its first undecided one.
+            let (mut near, mut active, mut row) = (Vec::new(), Vec::new(), Vec::new());
+            for (r, words) in bits.chunks(wpr).enumerate() {
+                if words.iter().all(|&w| w == 0) {
+                    continue;
+                }
+                row.clear();
+                for (at, &w) in words.iter().enumerate() {
+                    let mut w = w;
+                    while w != 0 {
+                        row.push(at * 64 + w.trailing_zeros() as usize);
+                        w &= w - 1;
+                    }
+                }
+                let (j, k) = (j0 + r / n, r % n);
+                let (first, last) = (row[0], row[row.len() - 1]);
+                // The triangles near this row, from the voxel before its first undecided one,
+                // swept along x: `active` holds those that reach the current step.
                 near.clear();
                 let (start, end) =
                     (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
@@ -381,14 +399,22 @@ impl FastWinding {
                     near.push((t, a.min(b).min(c), a.max(b).max(c)));
                     false
                 });
+                near.sort_unstable_by(|a, b| a.1.x.total_cmp(&b.1.x));
+                let (mut next, mut anchor): (usize, Option<(usize, DVec3, Estimate)>) = (0, None);
+                active.clear();
                 // One gradient bound for the whole stretch of the row, when Γ keeps away.
                 let slope =
                     self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
-                let mut anchor: Option<(usize, DVec3, Estimate)> = None;
-                for &[i, _, _] in row {
-                    let i = i as usize;
+                for &i in &row {
                     let p = lattice.sample(i, j, k);
-                    let on_boundary = near.iter().any(|&(t, lo, hi)| {
+                    while next < near.len() && near[next].1.x <= p.x + 2.0 * eps {
+                        active.push(near[next]);
+                        next += 1;
+                    }
+                    // Every step starts at the voxel before at the earliest.
+                    let from = lattice.sample(i.saturating_sub(1), j, k).x - 2.0 * eps;
+                    active.retain(|t: &(usize, DVec3, DVec3)| t.2.x >= from);
+                    let on_boundary = active.iter().any(|&(t, lo, hi)| {
                         (lo - eps).cmple(p).all()
                             && (hi + eps).cmpge(p).all()
                             && self.surface.on_face(covering.face_of[t] as usize, p)
@@ -404,7 +430,7 @@ impl FastWinding {
                         at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
                     });
                     let walked = prev
-                        .and_then(|a| self.walk_among(&near, slope, a.1, a.2, p))
+                        .and_then(|a| self.walk_among(&active, slope, a.1, a.2, p))
                         .filter(|e| e.decides(0.0).is_some());
                     let (q, e) = match walked {
                         Some(e) => (p, e),
