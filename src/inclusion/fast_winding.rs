@@ -48,7 +48,7 @@ use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::Result;
 use super::multipole::{Estimate, Tree};
 use super::surface::Surface;
-use crate::exact::{closest_point_on_segment, orient3d};
+use crate::exact::{closest_point_on_segment, orient2d, orient3d};
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 use crate::voxel::{Grid, Volume};
@@ -240,32 +240,6 @@ impl FastWinding {
         if degenerate { None } else { self.drift(q, at_q, p, k) }
     }
 
-    /// [`Self::walk`] over the covering triangles `near` (with their bounds: all that may
-    /// meet the segment), with `slope` a gradient bound along it when known.
-    fn walk_among(
-        &self,
-        near: &[(usize, DVec3, DVec3)],
-        slope: Option<f64>,
-        q: DVec3,
-        at_q: Estimate,
-        p: DVec3,
-    ) -> Option<Estimate> {
-        let (lo, hi) = (q.min(p), q.max(p));
-        let mut k = 0;
-        for &(t, tlo, thi) in near {
-            if tlo.cmple(hi).all() && thi.cmpge(lo).all() {
-                k += self.crossing(t, q, p)?;
-            }
-        }
-        match slope {
-            Some(slope) => {
-                let err = at_q.err + slope * q.distance(p) * (1.0 + 1e-12);
-                Some(Estimate { w: at_q.w + k as f64, err })
-            }
-            None => self.drift(q, at_q, p, k),
-        }
-    }
-
     /// Whether the segment q→p crosses covering triangle `t` (see [`crossing`]).
     fn crossing(&self, t: usize, q: DVec3, p: DVec3) -> Option<i32> {
         let [a, b, c] = self.surface.covering().triangle(t);
@@ -374,7 +348,7 @@ impl FastWinding {
             }
             let eps = self.surface.eps();
             let covering = self.surface.covering();
-            let (mut near, mut active, mut row) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut near, mut row, mut steps, mut edge) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
             for (r, words) in bits.chunks(wpr).enumerate() {
                 if words.iter().all(|&w| w == 0) {
                     continue;
@@ -389,8 +363,7 @@ impl FastWinding {
                 }
                 let (j, k) = (j0 + r / n, r % n);
                 let (first, last) = (row[0], row[row.len() - 1]);
-                // The triangles near this row, from the voxel before its first undecided one,
-                // swept along x: `active` holds those that reach the current step.
+                // The triangles near this row, from the voxel before its first undecided one.
                 near.clear();
                 let (start, end) =
                     (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
@@ -399,27 +372,77 @@ impl FastWinding {
                     near.push((t, a.min(b).min(c), a.max(b).max(c)));
                     false
                 });
-                near.sort_unstable_by(|a, b| a.1.x.total_cmp(&b.1.x));
-                let (mut next, mut anchor): (usize, Option<(usize, DVec3, Estimate)>) = (0, None);
-                active.clear();
+                // Per voxel from the one before the first: the signed crossings of the step
+                // from the previous centre (`None`: through an edge or a vertex), and whether
+                // it is on the boundary; each triangle visits the few voxels it spans.
+                let base = first.saturating_sub(1);
+                let len = last + 1 - base;
+                steps.clear();
+                steps.resize(len, Some(0i32));
+                edge.clear();
+                edge.resize(len, false);
+                let (h, ox) = (lattice.h, lattice.origin.x);
+                let index = |x: f64| ((x - ox) / h - 0.5).floor();
+                for &(t, lo, hi) in &near {
+                    let from = (index(lo.x - eps) - 1.0).max(base as f64) as usize;
+                    let to = (index(hi.x + eps) + 2.0).min(last as f64);
+                    if to < from as f64 {
+                        continue;
+                    }
+                    let to = to as usize;
+                    let face = covering.face_of[t] as usize;
+                    let [a, b, c] = covering.triangle(t);
+                    let (y, z) = (start.y, start.z);
+                    let near_yz = lo.y - eps <= y && y <= hi.y + eps && lo.z - eps <= z && z <= hi.z + eps;
+                    if !near_yz {
+                        continue;
+                    }
+                    // The row's line misses the triangle when its point in the yz plane is
+                    // strictly outside the triangle's projection (as `crossing` decides it).
+                    let yz = |v: DVec3| [v.y, v.z];
+                    let nx = orient2d(yz(a), yz(b), yz(c));
+                    let misses = nx != 0
+                        && [(a, b), (b, c), (c, a)]
+                            .iter()
+                            .any(|&(u, v)| orient2d(yz(u), yz(v), [y, z]) == -nx);
+                    // Off the plane by more than ε (with room for rounding): not on the boundary.
+                    let n = (b - a).cross(c - a);
+                    let off_plane = |p: DVec3| {
+                        n.dot(p - a).abs() > (eps * (1.0 + 1e-9) + 1e-12 * p.distance(a)) * n.length()
+                    };
+                    let mut side = None;
+                    for i in from..=to {
+                        let p = lattice.sample(i, j, k);
+                        if !edge[i - base]
+                            && p.x >= lo.x - eps
+                            && p.x <= hi.x + eps
+                            && !off_plane(p)
+                            && self.surface.on_face(face, p)
+                        {
+                            edge[i - base] = true;
+                        }
+                        if misses {
+                            continue;
+                        }
+                        // Only a step whose ends are not strictly on one side may cross.
+                        let here = orient3d(a, b, c, p);
+                        if i > base && (side != Some(here) || here == 0) {
+                            let q = lattice.sample(i - 1, j, k);
+                            steps[i - base] = match (steps[i - base], crossing(a, b, c, q, p)) {
+                                (Some(n), Some(d)) => Some(n + d),
+                                _ => None,
+                            };
+                        }
+                        side = Some(here);
+                    }
+                }
+                let mut anchor: Option<(usize, DVec3, Estimate)> = None;
                 // One gradient bound for the whole stretch of the row, when Γ keeps away.
                 let slope =
                     self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
                 for &i in &row {
                     let p = lattice.sample(i, j, k);
-                    while next < near.len() && near[next].1.x <= p.x + 2.0 * eps {
-                        active.push(near[next]);
-                        next += 1;
-                    }
-                    // Every step starts at the voxel before at the earliest.
-                    let from = lattice.sample(i.saturating_sub(1), j, k).x - 2.0 * eps;
-                    active.retain(|t: &(usize, DVec3, DVec3)| t.2.x >= from);
-                    let on_boundary = active.iter().any(|&(t, lo, hi)| {
-                        (lo - eps).cmple(p).all()
-                            && (hi + eps).cmpge(p).all()
-                            && self.surface.on_face(covering.face_of[t] as usize, p)
-                    });
-                    if on_boundary {
+                    if edge[i - base] {
                         anchor = None;
                         continue;
                     }
@@ -430,7 +453,19 @@ impl FastWinding {
                         at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
                     });
                     let walked = prev
-                        .and_then(|a| self.walk_among(&active, slope, a.1, a.2, p))
+                        .and_then(|(_, q, e)| {
+                            let step = steps[i - base]?;
+                            if q != lattice.sample(i - 1, j, k) {
+                                return self.walk(q, e, p); // an anchor moved off a polygon's plane
+                            }
+                            match slope {
+                                Some(g) => Some(Estimate {
+                                    w: e.w + step as f64,
+                                    err: e.err + g * q.distance(p) * (1.0 + 1e-12),
+                                }),
+                                None => self.drift(q, e, p, step),
+                            }
+                        })
                         .filter(|e| e.decides(0.0).is_some());
                     let (q, e) = match walked {
                         Some(e) => (p, e),
