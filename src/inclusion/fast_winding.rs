@@ -308,7 +308,7 @@ impl FastWinding {
             })
             .collect();
         // Undecided cells get their centre as anchor (when it is off the boundary).
-        let anchors = left
+        let mut anchors: Vec<(u32, (DVec3, Estimate))> = left
             .concat()
             .into_par_iter()
             .filter_map(|[i, j, k]| {
@@ -317,6 +317,8 @@ impl FastWinding {
                 (!self.on_boundary(c)).then(|| (index, self.anchor(c)))
             })
             .collect();
+        // By cell, for the binary search of `Cells::lookup`.
+        anchors.par_sort_unstable_by_key(|a| a.0);
         Cells { lattice, labels, anchors }
     }
 
@@ -673,5 +675,29 @@ impl Classifier for FastWinding {
 
     fn build_stats(&self) -> BuildStats {
         self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::procedural;
+
+    #[test]
+    fn every_undecided_cell_finds_its_anchor() {
+        // A cube without its top: cells near its faces and its open side are undecided.
+        let cube = procedural::cube();
+        let open = Mesh::new(cube.positions().to_vec(), cube.faces().take(5).map(<[u32]>::to_vec).collect())
+            .unwrap();
+        let fw = FastWinding::new(&open, 100_000).unwrap();
+        let cells = fw.cells.as_ref().unwrap();
+        assert!(!cells.anchors.is_empty());
+        let n = cells.lattice.n;
+        for &(index, _) in &cells.anchors {
+            let index = index as usize;
+            let (i, k, j) = (index % n, (index / n) % n, index / (n * n));
+            let found = cells.lookup(cells.lattice.sample(i, j, k));
+            assert!(matches!(found, Some(Err(Some(_)))), "cell ({i}, {j}, {k})");
+        }
     }
 }
