@@ -74,8 +74,6 @@ pub enum Tier {
     Boundary,
     /// Decided by the first (0) or second (1) tree walk.
     Tree(u8),
-    /// Decided from an anchor by exact crossings.
-    Walk,
     /// Decided by the direct compensated sum.
     Direct,
     /// Not decided by any bound: the direct sum's value.
