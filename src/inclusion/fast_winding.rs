@@ -254,14 +254,14 @@ impl FastWinding {
     /// The class of `p` (off the boundary) from an anchor, or on its own.
     fn classify_from(&self, anchor: Option<&(DVec3, Estimate)>, p: DVec3) -> Class {
         let walked = anchor.and_then(|&(q, e)| self.walk(q, e, p)).and_then(|e| e.decides(0.0));
-        match walked {
-            Some(inside) => {
-                if inside {
-                    Class::Inside
-                } else {
-                    Class::Outside
-                }
-            }
+        self.decided_or_point(walked, p)
+    }
+
+    /// The class a bound decided (`Some(inside)`), else `p`'s own answer.
+    fn decided_or_point(&self, decided: Option<bool>, p: DVec3) -> Class {
+        match decided {
+            Some(true) => Class::Inside,
+            Some(false) => Class::Outside,
             None => self.classify_point(p).0,
         }
     }
@@ -471,17 +471,7 @@ impl FastWinding {
                         Some(e) => (p, e),
                         None => self.anchor(p),
                     };
-                    let class = match e.decides(0.0) {
-                        Some(inside) => {
-                            if inside {
-                                Class::Inside
-                            } else {
-                                Class::Outside
-                            }
-                        }
-                        None => self.classify_point(p).0,
-                    };
-                    if class == Class::Inside {
+                    if self.decided_or_point(e.decides(0.0), p) == Class::Inside {
                         s.xor_span(j, k, i, i + 1);
                     }
                     anchor = Some((i, q, e));

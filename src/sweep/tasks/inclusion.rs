@@ -136,16 +136,21 @@ impl Task for Inclusion {
         let mut exact = Solver::new(reference, mesh, &options, None, None).map_err(refusal)?;
         let expected = exact.classify_all(&points).map_err(refusal)?;
         out.time("reference", t.elapsed());
-        let differing = classes.iter().zip(&expected).filter(|(a, b)| a != b).count();
-        out.check("differing", differing);
-        if differing > 0 {
-            return Err(Failure::failed(
-                "check",
-                format!("{differing} of {} points differ from the {reference} answer", points.len()),
-            ));
-        }
-        Ok(())
+        compare(&classes, &expected, &format!("the {reference} answer"), out)
     }
+}
+
+/// Records how many answers differ from the reference's, and fails when any does.
+fn compare(classes: &[Class], expected: &[Class], reference: &str, out: &mut Record) -> Result<(), Failure> {
+    let differing = classes.iter().zip(expected).filter(|(a, b)| a != b).count();
+    out.check("differing", differing);
+    if differing > 0 {
+        return Err(Failure::failed(
+            "check",
+            format!("{differing} of {} points differ from {reference}", classes.len()),
+        ));
+    }
+    Ok(())
 }
 
 /// A mesh that is not a solid, under `allow_open`: the certified winding-number
@@ -179,15 +184,7 @@ fn winding_rule(
     let direct = inclusion::winding::WindingNumber::with_policy(mesh, true).map_err(refusal)?;
     let expected = direct.classify_all(points);
     out.time("reference", t.elapsed());
-    let differing = classes.iter().zip(&expected).filter(|(a, b)| a != b).count();
-    out.check("differing", differing);
-    if differing > 0 {
-        return Err(Failure::failed(
-            "check",
-            format!("{differing} of {} points differ from the winding number summed directly", points.len()),
-        ));
-    }
-    Ok(())
+    compare(&classes, &expected, "the winding number summed directly", out)
 }
 
 /// Refusals (what `texgeo inclusion` would reject) and failures.
