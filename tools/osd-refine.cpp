@@ -1,5 +1,5 @@
 // osd-refine: uniform Catmull-Clark refinement by OpenSubdiv, the independent reference
-// for texgeo's CPU and GPU subdivision (SPEC §5.1, issue 14, STACK.md "OpenSubdiv facts").
+// for texgeo's CPU and GPU subdivision (SPEC §5.1, STACK.md "OpenSubdiv facts").
 //
 //   osd-refine IN LEVEL [OUT] [--repeat N] [--sparse]
 //              [--boundary none|edge-only|edge-and-corner] [--crease-method uniform|chaikin]

@@ -3,7 +3,7 @@
 //! under the correspondence. Vertex order may differ; face orientation may not.
 //!
 //! The correspondence is the refinement's own whenever there is one, and positions are
-//! only the check (issue 12, item 7: coincident but distinct vertices must not be
+//! only the check (coincident but distinct vertices must not be
 //! swapped):
 //!
 //! 1. both meshes list their vertices in the same order (the CPU reference and

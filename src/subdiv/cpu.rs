@@ -1,4 +1,4 @@
-//! Reference Catmull-Clark on the CPU (SPEC §5.1, issue 14): any polygon mesh — closed or
+//! Reference Catmull-Clark on the CPU (SPEC §5.1): any polygon mesh — closed or
 //! open, manifold or not — with semi-sharp and infinitely sharp creases, corners, holes,
 //! the three boundary modes, both creasing methods and both triangle weightings, any
 //! level, positions in f64; the surface of OpenSubdiv's `CATMARK` with the same options,

@@ -1,5 +1,5 @@
 //! Fragment meshes in sector layout (2010 thesis §3.3.1, after Shiue, Jones and Peters;
-//! SPEC §5.2), extended with sharp features (issue 14): the CPU base level, one fragment
+//! SPEC §5.2), extended with sharp features: the CPU base level, one fragment
 //! per fan of corners around a vertex, the thesis' storage order, per-texel sharpness
 //! data, and one refinement step of a fragment stream on the CPU — the stencils of
 //! `glsl/subdiv/refine.frag`, in f64, so layout and rules are testable without a GPU.

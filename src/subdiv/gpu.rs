@@ -1,7 +1,7 @@
 //! Catmull-Clark on the GPU with fragment meshes (2010 thesis §3.3, SPEC §5.3): the base
 //! level and the fragments on the CPU, then one full-target fragment pass per level,
 //! ping-ponging between two RGBA32F render targets, one readback, and the topological
-//! assembly on the CPU. Sharp features (issue 14) run in the same pass: a sharp
+//! assembly on the CPU. Sharp features run in the same pass: a sharp
 //! fragment's vertex entries each have a data texel (its sharpness and that of its edges,
 //! `fragment`), which the pass reads to apply OpenSubdiv's crease rules and writes,
 //! decayed, for the next level — one target, one shader source, one pass per level.

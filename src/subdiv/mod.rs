@@ -1,4 +1,4 @@
-//! Catmull-Clark subdivision (2010 thesis, Ch. 3; SPEC §5; issue 14): the sharp features
+//! Catmull-Clark subdivision (2010 thesis, Ch. 3; SPEC §5): the sharp features
 //! and scheme options a control mesh carries ([`features`], read from OBJ tags by
 //! [`tags`]) and their sharpness arithmetic ([`crease`]), the CPU reference ([`cpu`]), the
 //! topology (OpenSubdiv's, non-manifold included) the fragment-mesh path builds on

@@ -1,5 +1,5 @@
 //! Sweeps: one task run over a whole mesh collection, each mesh in isolation, results
-//! kept line by line so that nothing finished is ever lost (issue 15).
+//! kept line by line so that nothing finished is ever lost.
 //!
 //! - [`folder`]: `DIR/sweep.json`, what the sweep is (task, options, meshes); a folder
 //!   holding another sweep is refused.

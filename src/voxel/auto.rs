@@ -11,7 +11,7 @@
 //! voxelize`: `builtin:knot`, 1 200 triangles, and `armadillo.off`, 52 000, at 128³ and
 //! 512³) on this project's reference machine (2-core AMD EPYC, lavapipe = llvmpipe
 //! 15.0.6, Mesa 22.3.6); the device start (`GPU_START`) is the wall time of
-//! `texgeo voxelize builtin:cube --res 8 --method zoned` (December 2026, issue 13). They
+//! `texgeo voxelize builtin:cube --res 8 --method zoned`. They
 //! reproduce those times to within a factor of about 1.5, enough to order methods whose
 //! times differ by 2× or more, as they do there.
 //!

@@ -12,7 +12,7 @@ use glam::DVec3;
 use super::error::{Result, VoxelError};
 use crate::mesh::Mesh;
 
-/// Largest resolution texgeo voxelizes (the "N up to 1024").
+/// Largest resolution texgeo voxelizes.
 pub const MAX_RES: usize = 1024;
 
 /// N×N×N voxels over a cube.

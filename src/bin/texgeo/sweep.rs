@@ -1,5 +1,5 @@
 //! `texgeo sweep MANIFEST --task T [options] -o DIR [--shard I/N] [--jobs J]`,
-//! `texgeo sweep merge DIR`, and the hidden `texgeo sweep worker` (issue 15).
+//! `texgeo sweep merge DIR`, and the hidden `texgeo sweep worker`.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

@@ -1,4 +1,4 @@
-//! `texgeo view MODEL [MORE…]`: the interactive viewer (issue 11). Mouse: left-drag
+//! `texgeo view MODEL [MORE…]`: the interactive viewer. Mouse: left-drag
 //! orbits, right/middle- or shift-left-drag pans, the wheel zooms; keys: `+`/`-` level
 //! (GPU fragment passes), `v` valence colours, `w` wireframe, `f` flat/smooth, `p` Perlin
 //! aspect (voxels), `r` reset view, `s` screenshot, `q`/Esc quit.

@@ -45,7 +45,7 @@ impl Pair {
     }
 }
 
-/// The copy every stand-in is paired with (the armadillo case).
+/// The copy every stand-in is paired with (armadillo minus its copy turned 10° about y, moved 1 % of its diagonal).
 pub fn turned_copy(mesh: &Mesh) -> crate::mesh::Result<Mesh> {
     let (lo, hi) = mesh.bounds();
     let shift = 0.01 * (hi - lo).length();

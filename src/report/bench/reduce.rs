@@ -6,7 +6,7 @@ use crate::gpu::{Context, Reducer, Result, TexFormat, Texture, Timestamps};
 use crate::random::Rng;
 use crate::report::{Environment, Report, Samples, Table, time_runs};
 
-/// Sides measured by default (the 512², 2048², 4096²).
+/// Sides measured by default (512², 2048², 4096²: from a small to the largest common texture side).
 pub const DEFAULT_SIDES: &[u32] = &[512, 2048, 4096];
 
 pub fn run(ctx: &Context, sides: &[u32], runs: usize) -> Result<Report> {

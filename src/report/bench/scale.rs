@@ -1,4 +1,4 @@
-//! `texgeo bench scale` (issue 13): how inclusion and voxelization grow — 1 k, 100 k and
+//! `texgeo bench scale`: how inclusion and voxelization grow — 1 k, 100 k and
 //! 1 M query points per inclusion method (`auto` included), 128³ … 1024³ per voxelization
 //! method — with time and peak memory per method and thread count, and the speed of the
 //! point-file reader and the label writer.

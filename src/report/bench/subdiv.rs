@@ -82,7 +82,7 @@ pub fn ms(d: Duration) -> String {
     }
 }
 
-/// The speed target: the GPU path at most half of OpenSubdiv's time on knot1.off.
+/// texgeo's speed target: the GPU path at most half of OpenSubdiv's time on knot1.off.
 const SPEED_TARGET: f64 = 0.5;
 
 /// One model refined to `Settings::level`.
@@ -362,7 +362,7 @@ pub fn thesis_table5() -> Table {
     table
 }
 
-/// The speed target for sharp features: a creased model at level 5 costs the GPU
+/// texgeo's speed target for sharp features: a creased model at level 5 costs the GPU
 /// path at most this much more than the same model without creases.
 pub const CREASE_TARGET: f64 = 1.2;
 

@@ -308,7 +308,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         cfg.runs.max(1)
     ));
     ratios.note(
-        "The issue asks pgpu/zoned to be at least 3× faster than cpu on armadillo at 256³ with lavapipe, \
+        "texgeo aims for pgpu/zoned at least 3× faster than cpu on armadillo at 256³ with lavapipe, \
          and zoned never slower than pgpu.",
     );
     Report { name: "voxelize".into(), environment, tables: vec![table, ratios] }

@@ -1,5 +1,5 @@
 //! `--task boolean`: a Boolean operation of each mesh with a second solid — by default a
-//! copy of itself turned 10° about y and moved 1 % of its diagonal (the armadillo
+//! copy of itself turned 10° about y and moved 1 % of its diagonal (the armadillo
 //! case, `texgeo bench boolean`'s pairs) — checked for a closed result, the volume
 //! identities, and optionally against CGAL's corefinement.
 
