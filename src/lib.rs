@@ -1,9 +1,23 @@
 //! texgeo: geometry algorithms of the GPGPU texture era on raw Vulkan.
 //!
-//! `gpu` owns every Vulkan object; `mesh` is the polygon mesh and its formats;
-//! the algorithms (`inclusion`, `voxel`, `subdiv`) are short drivers on top; `sweep`
-//! runs one of them over a whole mesh collection; `output` writes every file atomically;
-//! `terminal` is how every message reaches a person.
+//! The modules, roughly from the bottom up:
+//!
+//! - [`exact`]: exact predicates and arithmetic on f64 inputs, one sign convention.
+//! - [`gpu`]: every Vulkan object — device, textures, render targets, ping-pong, reduction,
+//!   readback, pipelines from reflected SPIR-V.
+//! - [`mesh`]: the polygon mesh, its file formats, validation and solidity checks.
+//! - [`tetragrid`]: the grid of cells listing the tetras that may touch each one.
+//! - [`inclusion`]: point in solid (Feito-Torres on the simplicial covering, and its peers).
+//! - [`voxel`]: solid voxelization by slicing tetras with XOR.
+//! - [`subdiv`]: Catmull-Clark subdivision with fragment meshes, checked against OpenSubdiv.
+//! - [`boolean`]: Boolean operations on triangle-mesh solids.
+//! - [`render`]: offscreen pictures of meshes; [`view`]: the interactive viewer.
+//! - [`report`]: benchmarks and the reproduction report; [`sweep`]: one task over a mesh
+//!   collection.
+//! - [`output`]: every file written atomically; [`cache`]: the user's cache folder;
+//!   [`scratch`]: private temporary folders for helper processes; [`host`]: the machine
+//!   texgeo runs on; [`random`]: seeded random numbers; [`terminal`]: every message for a
+//!   person.
 
 pub mod boolean;
 pub mod cache;
