@@ -4,7 +4,7 @@
 //!
 //! Where: `$TEXGEO_CACHE_DIR` if set, else `$XDG_CACHE_HOME/texgeo`, else
 //! `$HOME/.cache/texgeo` (the XDG base directory rule); `TEXGEO_CACHE=off` turns caching off.
-//! Each kind of entry lives in its own versioned folder (`solidity-v1`, `pipelines-v1`):
+//! Each kind of entry lives in its own versioned folder (`solidity-v1`, `pipelines-v2`):
 //! a texgeo whose rules change bumps the version and never reads the old entries.
 //!
 //! An entry is one file named by the hex of its 32-byte key:

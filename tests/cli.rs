@@ -223,7 +223,7 @@ fn the_pipeline_cache_is_kept_in_the_cache_folder_and_survives_a_corrupt_file() 
             .output()
             .unwrap()
     };
-    let folder = dir.join("cache").join("pipelines-v1");
+    let folder = dir.join("cache").join("pipelines-v2");
     let o = run("off");
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!folder.exists(), "TEXGEO_CACHE=off wrote {}", folder.display());
@@ -232,14 +232,14 @@ fn the_pipeline_cache_is_kept_in_the_cache_folder_and_survives_a_corrupt_file() 
     let files: Vec<_> = std::fs::read_dir(&folder).unwrap().map(|e| e.unwrap().path()).collect();
     assert_eq!(files.len(), 1, "{files:?}");
     let good = std::fs::read(&files[0]).unwrap();
-    assert!(good.starts_with(b"texgeo pipeline cache 1\n") && good.len() >= 24 + 32, "{good:?}");
+    assert!(good.starts_with(b"texgeo cache 1\n") && good.len() >= 15 + 72 + 32, "{good:?}");
     // Torn or overwritten with garbage: ignored, and replaced by a whole file.
     for bad in [&good[..good.len() - 3], b"garbage".as_slice()] {
         std::fs::write(&files[0], bad).unwrap();
         let o = run("on");
         assert!(o.status.success(), "{}", stderr(&o));
         let again = std::fs::read(&files[0]).unwrap();
-        assert!(again.starts_with(b"texgeo pipeline cache 1\n") && again.len() >= 24 + 32, "{again:?}");
+        assert!(again.starts_with(b"texgeo cache 1\n") && again.len() >= 15 + 72 + 32, "{again:?}");
     }
     assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 1, "temporary files left");
 }

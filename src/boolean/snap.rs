@@ -19,20 +19,13 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
+use crate::mesh::disjoint_sets::UnionFind;
+
 /// Tolerance of the merge for points with coordinates up to `max_abs` and operands of
 /// bounding-box diagonal `diagonal`: far below any feature of a real model, far above the
 /// few ulps by which an intersection point's coordinates are off.
 pub fn tolerance(max_abs: f64, diagonal: f64) -> f64 {
     (1e-12 * diagonal).max(64.0 * f64::EPSILON * max_abs)
-}
-
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let up = parent[parent[x as usize] as usize];
-        parent[x as usize] = up;
-        x = up;
-    }
-    x
 }
 
 /// The merged id of each new point: `new[k]` has id `first + k`; `anchors(k)` lists the
@@ -51,7 +44,7 @@ pub fn merge(
     for (k, &p) in new.iter().enumerate() {
         grid.entry(cell(p)).or_default().push(k as u32);
     }
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     let mut near = false;
     for (k, &p) in new.iter().enumerate() {
         let c = cell(p);
@@ -61,8 +54,7 @@ pub fn merge(
                     let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else { continue };
                     for &j in list {
                         if (j as usize) < k && new[j as usize].distance(p) <= tolerance {
-                            let (x, y) = (find(&mut parent, j), find(&mut parent, k as u32));
-                            parent[x.max(y) as usize] = x.min(y);
+                            sets.union(j, k as u32);
                             near = true;
                         }
                     }
@@ -79,7 +71,7 @@ pub fn merge(
         for &v in &candidates {
             let d = points[v as usize].distance(p);
             if d <= tolerance {
-                let r = find(&mut parent, k as u32) as usize;
+                let r = sets.find(k as u32) as usize;
                 if (d, v) < best[r] {
                     best[r] = (d, v);
                 }
@@ -90,12 +82,18 @@ pub fn merge(
     if !near {
         return (first..first + n as u32).collect();
     }
+    // A cluster that snaps to no anchor becomes its first point.
+    let mut first_member = vec![u32::MAX; n];
+    for k in 0..n as u32 {
+        let r = sets.find(k) as usize;
+        first_member[r] = first_member[r].min(k);
+    }
     (0..n as u32)
         .map(|k| {
-            let r = find(&mut parent, k);
-            match best[r as usize] {
+            let r = sets.find(k) as usize;
+            match best[r] {
                 (_, v) if v != u32::MAX => v,
-                _ => first + r,
+                _ => first + first_member[r],
             }
         })
         .collect()

@@ -2,31 +2,23 @@
 //! does not pay again for pipelines an earlier run built (no cold-start tax where the
 //! driver caches compiled pipelines).
 //!
-//! One file per driver and shader set: `pipelines-v1/VENDOR-DEVICE-DRIVER-UUID-SHADERS.bin`
-//! under [`crate::cache::root`] (vendor and device id, driver version, `pipelineCacheUUID`, and
-//! the hash of every shader texgeo embeds), so another driver, device or texgeo build
-//! never reads it. The file is `texgeo pipeline cache 1\n`, the data's length and FNV-1a
-//! hash (u64 little-endian each), then the data `vkGetPipelineCacheData` gave. A file that
-//! is short, has another length or hash (torn, corrupt), or whose Vulkan header (§ "Pipeline
+//! One entry of the cache store [`crate::cache::Store`] (kind `pipelines-v2`) per driver and
+//! shader set: its key hashes the vendor and device id, the driver version, the
+//! `pipelineCacheUUID` and every shader texgeo embeds (path and SPIR-V), so another driver,
+//! device or texgeo build never reads it. The store keeps entries whole and checked (a torn
+//! or corrupt file reads as absent); on top of that, data whose Vulkan header (§ "Pipeline
 //! Cache" of the spec: length, version 1, vendor, device, UUID) does not match the device
 //! is ignored, and the cache starts empty. It is saved when the device is dropped, only if
-//! the driver's data changed, atomically ([`crate::output`]: a temporary file renamed into
-//! place), so concurrent runs each leave one complete file. Failures to read or write it
-//! change nothing but the time.
+//! the driver's data changed. Failures to read or write it change nothing but the time.
 //!
 //! `TEXGEO_CACHE=off` (or `0`) turns it off (tests that must start cold).
 
-use std::path::{Path, PathBuf};
-
 use ash::vk;
 
-const MAGIC: &[u8] = b"texgeo pipeline cache 1\n";
-/// Folder of the entries; bumped if the file layout changes.
-const KIND: &str = "pipelines-v1";
+use crate::cache::{Key, KeyHasher, Store};
 
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
-}
+/// Kind of the store's entries; bumped if what they hold changes.
+const KIND: &str = "pipelines-v2";
 
 /// The identity of a device's pipeline cache data.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,15 +39,18 @@ impl Identity {
         }
     }
 
-    fn file_name(&self) -> String {
-        let uuid: String = self.uuid.iter().map(|b| format!("{b:02x}")).collect();
-        format!(
-            "{:04x}-{:04x}-{:x}-{uuid}-{:016x}.bin",
-            self.vendor,
-            self.device,
-            self.driver,
-            super::shaders::SPIRV_HASH
-        )
+    /// The store key of this device's data for the shaders of this build.
+    fn key(&self) -> Key {
+        let mut h = KeyHasher::new(KIND);
+        for v in [self.vendor, self.device, self.driver] {
+            h.u64(u64::from(v));
+        }
+        h.bytes(&self.uuid);
+        for shader in super::shaders::ALL {
+            h.bytes(shader.path.as_bytes());
+            h.bytes(shader.spirv);
+        }
+        h.finish()
     }
 
     /// Whether `data` starts with a Vulkan pipeline cache header of this device.
@@ -72,34 +67,13 @@ impl Identity {
     }
 }
 
-/// Encodes a cache file.
-fn encode(data: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(MAGIC.len() + 16 + data.len());
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-    out.extend_from_slice(&fnv1a(data).to_le_bytes());
-    out.extend_from_slice(data);
-    out
-}
-
-/// The driver data of a cache file, if it is whole and made for `id`.
-fn decode<'a>(file: &'a [u8], id: &Identity) -> Option<&'a [u8]> {
-    let rest = file.strip_prefix(MAGIC)?;
-    let (len, rest) = rest.split_first_chunk::<8>()?;
-    let (hash, data) = rest.split_first_chunk::<8>()?;
-    (u64::from_le_bytes(*len) == data.len() as u64
-        && u64::from_le_bytes(*hash) == fnv1a(data)
-        && id.matches(data))
-    .then_some(data)
-}
-
 /// A device's `VkPipelineCache` and the file it came from and goes back to.
 pub(crate) struct PipelineCache {
     pub raw: vk::PipelineCache,
-    path: Option<PathBuf>,
+    store: Option<Store>,
     id: Identity,
     /// Hash of the data loaded, to skip saving what did not change.
-    loaded: Option<u64>,
+    loaded: Option<blake3::Hash>,
 }
 
 impl PipelineCache {
@@ -107,23 +81,19 @@ impl PipelineCache {
     /// without a usable file (or when even an empty cache cannot be made) pipelines are
     /// built without one.
     pub fn open(raw: &ash::Device, id: Identity) -> PipelineCache {
-        let path = crate::cache::root().map(|r| r.join(KIND).join(id.file_name()));
-        PipelineCache::open_at(raw, id, path)
-    }
-
-    pub fn open_at(raw: &ash::Device, id: Identity, path: Option<PathBuf>) -> PipelineCache {
-        let file = path.as_deref().and_then(|p| std::fs::read(p).ok());
-        let data = file.as_deref().and_then(|f| decode(f, &id));
+        let store = Store::open(KIND);
+        let file = store.as_ref().and_then(|s| s.get(&id.key()));
+        let data = file.as_deref().filter(|d| id.matches(d));
         let create = |initial: &[u8]| {
             let info = vk::PipelineCacheCreateInfo::default().initial_data(initial);
             // SAFETY: valid device; `initial` was checked against the device's header.
             unsafe { raw.create_pipeline_cache(&info, None) }.ok()
         };
-        let (cache, loaded) = match data.and_then(|d| create(d).map(|c| (c, fnv1a(d)))) {
+        let (cache, loaded) = match data.and_then(|d| create(d).map(|c| (c, blake3::hash(d)))) {
             Some((c, hash)) => (c, Some(hash)),
             None => (create(&[]).unwrap_or(vk::PipelineCache::null()), None),
         };
-        PipelineCache { raw: cache, path, id, loaded }
+        PipelineCache { raw: cache, store, id, loaded }
     }
 
     /// Writes the driver's data back if it changed, then destroys the cache.
@@ -134,23 +104,15 @@ impl PipelineCache {
         // SAFETY: valid device and cache; no pipeline is being created (the device is
         // being dropped).
         let data = unsafe { raw.get_pipeline_cache_data(self.raw) }.ok();
-        if let (Some(path), Some(data)) = (&self.path, data)
+        if let (Some(store), Some(data)) = (&self.store, data)
             && self.id.matches(&data)
-            && self.loaded != Some(fnv1a(&data))
+            && self.loaded != Some(blake3::hash(&data))
         {
-            save(path, &data);
+            store.put(&self.id.key(), &data);
         }
         // SAFETY: as above; the handle is not used again.
         unsafe { raw.destroy_pipeline_cache(self.raw, None) };
         self.raw = vk::PipelineCache::null();
-    }
-}
-
-fn save(path: &Path, data: &[u8]) {
-    if let Some(dir) = path.parent()
-        && std::fs::create_dir_all(dir).is_ok()
-    {
-        let _ = crate::output::write_bytes(path, &encode(data));
     }
 }
 
@@ -173,23 +135,19 @@ mod tests {
     }
 
     #[test]
-    fn only_whole_files_of_the_same_device_are_read() {
+    fn only_data_of_the_same_device_is_used() {
         let data = header(&id(), 100);
-        let file = encode(&data);
-        assert_eq!(decode(&file, &id()), Some(&data[..]));
-        // Torn, corrupt, another device or driver UUID, another format: ignored.
-        assert_eq!(decode(&file[..file.len() - 1], &id()), None);
-        let mut flipped = file.clone();
-        *flipped.last_mut().unwrap() ^= 1;
-        assert_eq!(decode(&flipped, &id()), None);
-        assert_eq!(decode(&file, &Identity { device: 9, ..id() }), None);
-        assert_eq!(decode(&file, &Identity { uuid: [8; 16], ..id() }), None);
-        assert_eq!(decode(b"texgeo pipeline cache 1\n", &id()), None);
-        assert_eq!(decode(b"", &id()), None);
+        assert!(id().matches(&data));
+        // Another device or driver UUID, another header version, short data: ignored.
+        assert!(!Identity { device: 9, ..id() }.matches(&data));
+        assert!(!Identity { uuid: [8; 16], ..id() }.matches(&data));
+        assert!(!id().matches(&data[..31]));
+        assert!(!id().matches(b""));
         let mut bad_version = header(&id(), 0);
         bad_version[4] = 2;
-        assert_eq!(decode(&encode(&bad_version), &id()), None);
-        // The file name changes with the driver and device.
-        assert_ne!(id().file_name(), Identity { driver: 2, ..id() }.file_name());
+        assert!(!id().matches(&bad_version));
+        // The key changes with the driver and device.
+        assert_ne!(id().key(), Identity { driver: 2, ..id() }.key());
+        assert_ne!(id().key(), Identity { device: 1, ..id() }.key());
     }
 }
