@@ -13,7 +13,8 @@
 //! - [`boolean`]: Boolean operations on triangle-mesh solids.
 //! - [`render`]: offscreen pictures of meshes; [`view`]: the interactive viewer.
 //! - [`report`]: benchmarks and the reproduction report; [`sweep`]: one task over a mesh
-//!   collection.
+//!   collection; [`check`]: every shader and pass against its CPU reference on the device
+//!   at hand (`texgeo check`).
 //! - [`output`]: every file written atomically; [`cache`]: the user's cache folder;
 //!   [`scratch`]: private temporary folders for helper processes; [`host`]: the machine
 //!   texgeo runs on; [`random`]: seeded random numbers; [`terminal`]: every message for a
@@ -21,6 +22,7 @@
 
 pub mod boolean;
 pub mod cache;
+pub mod check;
 pub mod exact;
 pub mod gpu;
 pub mod host;

@@ -30,6 +30,7 @@ pub use reduce::{MAX_LAYERS, Reducer, reduce_sum};
 pub use scatter::{Datum, Scatter};
 pub use texture::{TexFormat, Texture};
 pub use timer::Timestamps;
+pub use validation::installed as validation_layer_installed;
 pub use xor::XorRaster;
 
 /// A compiled shader embedded in the binary (see `build.rs`).

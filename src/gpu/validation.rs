@@ -16,6 +16,15 @@ pub(crate) fn requested() -> bool {
     std::env::var("TEXGEO_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0")
 }
 
+/// Whether the Khronos validation layer is installed (the Vulkan loader lists it).
+pub fn installed() -> bool {
+    // SAFETY: loading libvulkan; a failure means no layer either.
+    let Ok(entry) = (unsafe { ash::Entry::load() }) else { return false };
+    // SAFETY: plain enumeration.
+    unsafe { entry.enumerate_instance_layer_properties() }
+        .is_ok_and(|layers| layers.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == LAYER)))
+}
+
 #[derive(Default)]
 pub(crate) struct Log {
     errors: Mutex<Vec<String>>,

@@ -12,6 +12,7 @@ extern crate texgeo;
 mod args;
 mod bench;
 mod boolean;
+mod check;
 mod demo;
 mod inclusion;
 mod info;
@@ -49,6 +50,9 @@ struct Cli {
 enum Command {
     /// Show the Vulkan device texgeo would use: driver, limits, logicOp, texture sizes.
     Info(info::Args),
+    /// Check every shader on this device against the CPU references (the first thing to
+    /// run on a new GPU or driver); exits 1 when a check fails.
+    Check(check::Args),
     /// Inspect and convert meshes (OBJ, OFF, PLY, STL).
     #[command(subcommand)]
     Mesh(mesh::Command),
@@ -129,6 +133,7 @@ fn main() {
     }
     let result = match cli.command {
         Command::Info(a) => info::run(device, a),
+        Command::Check(a) => check::run(device, a),
         Command::Mesh(c) => mesh::run(c),
         Command::Inclusion(a) => inclusion::run(device, a),
         Command::Subdivide(a) => subdivide::run(device, a),
