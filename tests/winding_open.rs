@@ -291,3 +291,49 @@ fn a_sweep_with_the_flag_records_non_solids_with_their_defect() {
         "{csv}"
     );
 }
+
+#[test]
+fn voxelize_closes_every_hole_and_keeps_centres_on_faces_empty() {
+    // A tube open at both ends (two loops of its boundary), two open cubes whose holes face
+    // each other, and an open cube on grids whose centres lie on its faces, edges and rim.
+    let tube = {
+        let m = 12;
+        let ring = |z: f64| {
+            (0..m).map(move |i| {
+                let a = std::f64::consts::TAU * i as f64 / m as f64;
+                DVec3::new(a.cos(), a.sin(), z)
+            })
+        };
+        let positions = ring(-1.0).chain(ring(1.0)).collect();
+        let faces = (0..m).map(|i| vec![i, (i + 1) % m, m + (i + 1) % m, m + i]).collect();
+        Mesh::new(positions, faces).unwrap()
+    };
+    let facing = {
+        let a = open_cube();
+        let turned: Vec<DVec3> =
+            a.positions().iter().map(|p| DVec3::new(p.x + 0.5, p.y, 3.5 - p.z)).collect();
+        let b = Mesh::new(turned, a.faces().map(|f| f.iter().rev().copied().collect()).collect()).unwrap();
+        union(&[a, b])
+    };
+    let fitted = |n: usize, h: f64| Grid::new(n, DVec3::splat(-(n as f64) * h / 2.0), n as f64 * h).unwrap();
+    let cases = [
+        ("tube", tube.clone(), Grid::for_mesh(&tube, 20).unwrap()),
+        ("facing cubes", facing.clone(), Grid::for_mesh(&facing, 23).unwrap()),
+        ("open cube on centres", open_cube(), fitted(5, 1.0)),
+        ("open cube on half centres", open_cube(), fitted(9, 0.5)),
+    ];
+    for (name, mesh, grid) in cases {
+        let fw = FastWinding::new(&mesh, 0).unwrap();
+        let volume = fw.voxelize(&grid).unwrap();
+        let n = grid.n;
+        let mut on_faces = 0;
+        for (i, j, k) in (0..n).flat_map(|j| (0..n).flat_map(move |k| (0..n).map(move |i| (i, j, k)))) {
+            let (class, _) = fw.classify_point(grid.centre(i, j, k));
+            on_faces += (class == Class::OnBoundary) as usize;
+            assert_eq!(volume.get(i, j, k), class == Class::Inside, "{name} ({i},{j},{k}): {class:?}");
+        }
+        if name.contains("centres") {
+            assert!(on_faces > 0, "{name}: no centre on a face");
+        }
+    }
+}

@@ -21,24 +21,31 @@
 //! constant between the sheets. A box that no face comes within 2ε of is labelled whole
 //! when w̃(centre) ± (E + |∇w|·radius) stays [`MARGIN`] away from ½ — the same answer every
 //! point in it would get on its own. Boxes are split in halves down to single cells of a
-//! lattice ([`Lattice`]): for `inclusion` cells of a grid over the mesh's box, sized by
-//! the number of points; for `voxelize` the voxel centres themselves.
+//! lattice ([`Lattice`]) of cells of a grid over the mesh's box, sized by the number of
+//! points.
 //!
 //! **Near the surface.** Crossing the surface from the side its normal points to changes
 //! w by exactly +1, so from an *anchor* Q with a certified estimate,
 //! w(P) = w(Q) + (signed crossings of the segment QP) + drift, |drift| ≤ |∇w| bound × |QP|,
 //! the crossings decided with exact orientation predicates ([`crate::exact`]). A segment
 //! through an edge or a vertex, or a bound that does not decide, sends P to the per-point
-//! path. Undecided `inclusion` cells get their centre as anchor; `voxelize` walks each row
-//! of undecided voxels from one centre to the next (starting from the interval of the
-//! block before it, or a fresh estimate), and takes a fresh estimate where a step does not
-//! decide.
+//! path. Undecided cells get their centre as anchor.
+//!
+//! **Voxels.** `voxelize` closes the surface instead: over each loop of Γ a cone from the
+//! loop's centroid ([`Caps`]), so that surface and caps form a closed chain C. Its winding
+//! number is an integer, counted exactly along each row of voxel centres by the
+//! scanline's signed crossings under its tie rule, as for a solid (the chain may cross
+//! itself: the count is signed, not a parity); and w = w_C − w(caps). The caps are small
+//! when the holes are: beyond a distance of each loop that a cone bound gives,
+//! |w(caps)| ≤ ¼, so w ≥ ½ iff w_C ≥ 1 there, and nearer, w(caps) is evaluated with its
+//! bound. A closed mesh (self-intersecting, nested, inverted) has no caps at all.
 //!
 //! Nothing here assumes a solid, so the meshes the solidity rule refuses — open,
 //! self-intersecting, nested, inverted — all get this answer; on a valid solid w is 0 or 1
 //! and it is the solid's own answer.
 
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -48,10 +55,13 @@ use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::Result;
 use super::multipole::{Estimate, Tree};
 use super::surface::Surface;
-use crate::exact::{closest_point_on_segment, orient2d, orient3d};
+use crate::exact::{closest_point_on_segment, orient3d};
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
-use crate::voxel::{Grid, Volume};
+use crate::mesh::disjoint_sets::UnionFind;
+use crate::voxel::scanline::{self, index_range, z_extent_at};
+use crate::voxel::volume::slab_lists;
+use crate::voxel::{Grid, Solid, Volume};
 
 /// Per-cluster error tolerances of the two tree walks (units of w).
 pub const TOLERANCES: [f64; 2] = [1e-2, 1e-4];
@@ -63,9 +73,6 @@ const MIN_POINTS_FOR_CELLS: usize = 20_000;
 const MAX_CELLS: usize = 96;
 /// Boundary edges per group of the gradient bound.
 const EDGE_GROUP: usize = 32;
-/// `voxelize` does not try to decide blocks of fewer voxels whole: walking their rows
-/// from a neighbour costs less than an estimate.
-const MIN_VOXEL_BLOCK: usize = 256;
 
 /// How a point's label was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,7 +92,7 @@ pub enum Tier {
 #[derive(Clone, Debug)]
 pub struct FastWinding {
     surface: Surface,
-    tree: Tree,
+    tree: OnceLock<Tree>,
     boundary: Boundary,
     cells: Option<Cells>,
     stats: BuildStats,
@@ -96,16 +103,13 @@ impl FastWinding {
     /// sized for about `points` query points (none for few).
     pub fn new(mesh: &Mesh, points: usize) -> Result<FastWinding> {
         let start = Instant::now();
-        let surface = Surface::with_policy(mesh, true)?;
-        let tree = Tree::new(surface.covering());
-        let boundary = Boundary::new(surface.covering());
-        let mut fw = FastWinding { surface, tree, boundary, cells: None, stats: BuildStats::default() };
-        if points >= MIN_POINTS_FOR_CELLS && !fw.tree.is_empty() {
+        let mut fw = FastWinding::for_voxels(mesh)?;
+        if points >= MIN_POINTS_FOR_CELLS && !fw.tree().is_empty() {
             let n = ((points as f64 / 4.0).cbrt().round() as usize).clamp(4, MAX_CELLS);
             fw.cells = Some(fw.cells(n));
         }
         let bytes = fw.surface.bytes()
-            + fw.tree.bytes()
+            + fw.tree().bytes()
             + vec_bytes(&fw.boundary.edges)
             + vec_bytes(&fw.boundary.groups)
             + fw.cells.as_ref().map_or(0, |c| vec_bytes(&c.labels) + vec_bytes(&c.anchors));
@@ -117,8 +121,22 @@ impl FastWinding {
         &self.surface
     }
 
+    /// The classifier for [`Self::voxelize`]: its cluster tree is only built if a voxel
+    /// centre needs it (for a mesh with small holes, or none, usually none does).
+    pub fn for_voxels(mesh: &Mesh) -> Result<FastWinding> {
+        let surface = Surface::with_policy(mesh, true)?;
+        let boundary = Boundary::new(surface.covering());
+        Ok(FastWinding {
+            surface,
+            tree: OnceLock::new(),
+            boundary,
+            cells: None,
+            stats: BuildStats::default(),
+        })
+    }
+
     pub fn tree(&self) -> &Tree {
-        &self.tree
+        self.tree.get_or_init(|| Tree::new(self.surface.covering()))
     }
 
     /// Number of directed edges of the boundary curve Γ (0 for a closed mesh).
@@ -129,7 +147,7 @@ impl FastWinding {
     /// True when `p` is within ε of a face (the shared exact predicate).
     fn on_boundary(&self, p: DVec3) -> bool {
         self.surface.in_bounds(p)
-            && self.tree.any_near(p, p, self.surface.eps(), |t| self.surface.on_boundary_near(t, p))
+            && self.tree().any_near(p, p, self.surface.eps(), |t| self.surface.on_boundary_near(t, p))
     }
 
     /// The label of `p` without the cell grid, and how it was found.
@@ -140,11 +158,11 @@ impl FastWinding {
         let p = self.off_polygon_planes(p);
         let class = |inside: bool| if inside { Class::Inside } else { Class::Outside };
         for (k, &tol) in TOLERANCES.iter().enumerate() {
-            if let Some(inside) = self.tree.winding(p, tol).decides(0.0) {
+            if let Some(inside) = self.tree().winding(p, tol).decides(0.0) {
                 return (class(inside), Tier::Tree(k as u8));
             }
         }
-        let e = self.tree.direct(p);
+        let e = self.tree().direct(p);
         match e.decides(0.0) {
             Some(inside) => (class(inside), Tier::Direct),
             None => (class(e.w >= 0.5), Tier::Undecided),
@@ -160,7 +178,7 @@ impl FastWinding {
             return p;
         }
         let mut near = Vec::new();
-        self.tree.any_near(p, p, self.surface.eps(), |t| {
+        self.tree().any_near(p, p, self.surface.eps(), |t| {
             near.push(t);
             false
         });
@@ -169,7 +187,7 @@ impl FastWinding {
 
     /// The generalized winding number at `p` with its certified bound (first tree walk).
     pub fn estimate(&self, p: DVec3) -> Estimate {
-        self.tree.winding(p, TOLERANCES[0])
+        self.tree().winding(p, TOLERANCES[0])
     }
 
     /// Labels the samples of `lattice` in slices `j` that blocks decide whole (`put(i, j, k,
@@ -220,7 +238,7 @@ impl FastWinding {
     /// An anchor at `p` (off the boundary): the point evaluated and its estimate.
     fn anchor(&self, p: DVec3) -> (DVec3, Estimate) {
         let q = self.off_polygon_planes(p);
-        (q, self.tree.winding(q, TOLERANCES[0]))
+        (q, self.tree().winding(q, TOLERANCES[0]))
     }
 
     /// w(p) from the anchor `q` (off the boundary) with estimate `at_q`: the signed
@@ -228,7 +246,7 @@ impl FastWinding {
     /// when the segment meets an edge or a vertex, or Γ comes too close.
     fn walk(&self, q: DVec3, at_q: Estimate, p: DVec3) -> Option<Estimate> {
         let (mut k, mut degenerate) = (0i32, false);
-        self.tree.any_near(q.min(p), q.max(p), 0.0, |t| {
+        self.tree().any_near(q.min(p), q.max(p), 0.0, |t| {
             match self.crossing(t, q, p) {
                 Some(s) => k += s,
                 None => degenerate = true,
@@ -272,13 +290,13 @@ impl FastWinding {
         let eps = self.surface.eps();
         let lo = lattice.sample(block[0].start, block[1].start, block[2].start) - lattice.pad - eps;
         let hi = lattice.sample(block[0].end - 1, block[1].end - 1, block[2].end - 1) + lattice.pad + eps;
-        if self.tree.may_meet_box(lo - eps, hi + eps) {
+        if self.tree().may_meet_box(lo - eps, hi + eps) {
             return None;
         }
         let c = (lo + hi) * 0.5;
         let radius = (hi - lo).length() * 0.5 * (1.0 + 1e-12);
         let slope = self.boundary.gradient_bound(c, radius)?;
-        let e = self.tree.winding(c, TOLERANCES[0]);
+        let e = self.tree().winding(c, TOLERANCES[0]);
         let spread = Estimate { w: e.w, err: e.err + slope * radius };
         spread.decides(MARGIN).map(|inside| (if inside { Class::Inside } else { Class::Outside }, spread))
     }
@@ -320,165 +338,215 @@ impl FastWinding {
         Cells { lattice, labels, anchors }
     }
 
-    /// The voxels of `grid` whose centre is inside by the rule: the same label `classify`
-    /// gives each centre (centres on the boundary are not occupied).
+    /// The voxels of `grid` whose centre is inside by the rule: the label
+    /// [`Self::classify_point`] gives each centre (centres on the boundary are not occupied).
+    ///
+    /// The covering and its [`Caps`] form a closed chain, whose winding number the
+    /// scanline's signed crossings give exactly along every row
+    /// ([`scanline::winding_steps`]); w = that count − w(caps). Away from the caps
+    /// |w(caps)| ≤ ¼, so the count alone decides (inside iff ≥ 1); near them w(caps) is
+    /// evaluated with its bound. Centres within ε of a face are not occupied; a centre no
+    /// bound decides, on a cap's plane, within ε of the plane of a polygon's covering
+    /// triangle, or on a row whose crossings do not sum to 0, is classified on its own.
     pub fn voxelize(&self, grid: &Grid) -> crate::voxel::Result<Volume> {
         let n = grid.n;
         let mut volume = Volume::new(n)?;
-        let lattice = Lattice { origin: grid.min, h: grid.h(), n, pad: 0.0 };
-        let slab = slab_height(n);
+        let covering = self.surface.covering();
+        let caps = Caps::new(covering, &self.boundary.net);
+        let own = covering.triangles.len();
+        let chain = Solid {
+            triangles: (0..own).map(|t| covering.triangle(t)).chain(caps.triangles.iter().copied()).collect(),
+            // The scanline does not use the apex.
+            apex: DVec3::ZERO,
+        };
+        let (h, eps, wpr) = (grid.h(), self.surface.eps(), n.div_ceil(64));
+        let slab = crate::voxel::volume::slab_height(n);
+        let lists = slab_lists(
+            n,
+            slab,
+            chain.triangles.iter().map(|&[a, b, c]| {
+                index_range(grid.min.y, h, n, a.y.min(b.y).min(c.y) - eps, a.y.max(b.y).max(c.y) + eps)
+            }),
+        );
         volume.par_slabs(slab, |mut s| {
-            let j = s.slices();
-            // Where blocks decide: the voxels, and per row the spans with their interval of w.
-            let mut spans: Vec<(u32, u32, u32, Estimate)> = Vec::new();
-            let mut put = |i: std::ops::Range<usize>, j: usize, k: usize, class: Class, e: Estimate| {
-                if class == Class::Inside {
-                    s.xor_span(j, k, i.start, i.end);
-                }
-                spans.push((j as u32, k as u32, i.end as u32, e));
-            };
-            let (j0, rows) = (j.start, j.len());
-            let left = self.label_slab(&lattice, j, MIN_VOXEL_BLOCK, &mut put);
-            spans.sort_unstable_by_key(|&(j, k, i, _)| (j, k, i));
-            // The undecided voxels as bits per row, read back in row order.
-            let wpr = n.div_ceil(64);
-            let mut bits = vec![0u64; rows * n * wpr];
-            for [i, jj, k] in left {
-                bits[((jj as usize - j0) * n + k as usize) * wpr + i as usize / 64] |= 1 << (i % 64);
-            }
-            let eps = self.surface.eps();
-            let covering = self.surface.covering();
-            let (mut near, mut row, mut steps, mut edge) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            for (r, words) in bits.chunks(wpr).enumerate() {
-                if words.iter().all(|&w| w == 0) {
-                    continue;
-                }
-                row.clear();
-                for (at, &w) in words.iter().enumerate() {
-                    let mut w = w;
-                    while w != 0 {
-                        row.push(at * 64 + w.trailing_zeros() as usize);
-                        w &= w - 1;
-                    }
-                }
-                let (j, k) = (j0 + r / n, r % n);
-                let (first, last) = (row[0], row[row.len() - 1]);
-                // The triangles near this row, from the voxel before its first undecided one.
-                near.clear();
-                let (start, end) =
-                    (lattice.sample(first.saturating_sub(1), j, k), lattice.sample(last, j, k));
-                self.tree.any_near(start - 2.0 * eps, end + 2.0 * eps, 0.0, |t| {
-                    let [a, b, c] = covering.triangle(t);
-                    near.push((t, a.min(b).min(c), a.max(b).max(c)));
-                    false
+            let slices = s.slices();
+            let j0 = slices.start;
+            let list = &lists[j0 / slab];
+            let mut steps = Vec::new();
+            scanline::winding_steps(&chain, grid, list.iter().copied(), slices.clone(), &mut steps);
+            // Centres on the boundary, and centres to classify on their own, as bits by row.
+            let mut boundary = vec![0u64; slices.len() * n * wpr];
+            let mut alone = boundary.clone();
+            for &t in list.iter().filter(|&&t| (t as usize) < own) {
+                self.near_centres(t as usize, grid, slices.clone(), |j, k, i, on| {
+                    let bits = if on { &mut boundary } else { &mut alone };
+                    bits[((j - j0) * n + k) * wpr + i / 64] |= 1 << (i % 64);
                 });
-                // Per voxel from the one before the first: the signed crossings of the step
-                // from the previous centre (`None`: through an edge or a vertex), and whether
-                // it is on the boundary; each triangle visits the few voxels it spans.
-                let base = first.saturating_sub(1);
-                let len = last + 1 - base;
-                steps.clear();
-                steps.resize(len, Some(0i32));
-                edge.clear();
-                edge.resize(len, false);
-                let (h, ox) = (lattice.h, lattice.origin.x);
-                let index = |x: f64| ((x - ox) / h - 0.5).floor();
-                for &(t, lo, hi) in &near {
-                    let from = (index(lo.x - eps) - 1.0).max(base as f64) as usize;
-                    let to = (index(hi.x + eps) + 2.0).min(last as f64);
-                    if to < from as f64 {
+            }
+            let mut ranges: Vec<std::ops::Range<usize>> = Vec::new();
+            let mut at = 0;
+            for j in slices {
+                for k in 0..n {
+                    let first = at;
+                    while at < steps.len() && steps[at].0 as usize == j * n + k {
+                        at += 1;
+                    }
+                    let row_steps = &steps[first..at];
+                    ranges.clear();
+                    ranges.extend(caps.on_row(grid, j, k));
+                    if row_steps.is_empty() && ranges.is_empty() {
                         continue;
                     }
-                    let to = to as usize;
-                    let face = covering.face_of[t] as usize;
-                    let [a, b, c] = covering.triangle(t);
-                    let (y, z) = (start.y, start.z);
-                    let near_yz = lo.y - eps <= y && y <= hi.y + eps && lo.z - eps <= z && z <= hi.z + eps;
-                    if !near_yz {
-                        continue;
-                    }
-                    // The row's line misses the triangle when its point in the yz plane is
-                    // strictly outside the triangle's projection (as `crossing` decides it).
-                    let yz = |v: DVec3| [v.y, v.z];
-                    let nx = orient2d(yz(a), yz(b), yz(c));
-                    let misses = nx != 0
-                        && [(a, b), (b, c), (c, a)]
-                            .iter()
-                            .any(|&(u, v)| orient2d(yz(u), yz(v), [y, z]) == -nx);
-                    // Off the plane by more than ε (with room for rounding): not on the boundary.
-                    let n = (b - a).cross(c - a);
-                    let off_plane = |p: DVec3| {
-                        n.dot(p - a).abs() > (eps * (1.0 + 1e-9) + 1e-12 * p.distance(a)) * n.length()
+                    let point = |i: usize| self.classify_point(grid.centre(i, j, k)).0 == Class::Inside;
+                    let set = |row: &mut [u64], i: usize, inside: bool| {
+                        if inside {
+                            row[i / 64] |= 1 << (i % 64);
+                        } else {
+                            row[i / 64] &= !(1 << (i % 64));
+                        }
                     };
-                    let mut side = None;
-                    for i in from..=to {
-                        let p = lattice.sample(i, j, k);
-                        if !edge[i - base]
-                            && p.x >= lo.x - eps
-                            && p.x <= hi.x + eps
-                            && !off_plane(p)
-                            && self.surface.on_face(face, p)
-                        {
-                            edge[i - base] = true;
+                    if row_steps.iter().map(|x| x.2 as i32).sum::<i32>() != 0 {
+                        // Not for a closed chain; should it happen, every centre on its own.
+                        let row = s.row_mut(j, k);
+                        for i in 0..n {
+                            set(row, i, point(i));
                         }
-                        if misses {
-                            continue;
-                        }
-                        // Only a step whose ends are not strictly on one side may cross.
-                        let here = orient3d(a, b, c, p);
-                        if i > base && (side != Some(here) || here == 0) {
-                            let q = lattice.sample(i - 1, j, k);
-                            steps[i - base] = match (steps[i - base], crossing(a, b, c, q, p)) {
-                                (Some(n), Some(d)) => Some(n + d),
-                                _ => None,
-                            };
-                        }
-                        side = Some(here);
-                    }
-                }
-                let mut anchor: Option<(usize, DVec3, Estimate)> = None;
-                // One gradient bound for the whole stretch of the row, when Γ keeps away.
-                let slope =
-                    self.boundary.gradient_bound((start + end) * 0.5, start.distance(end) * 0.5 + eps);
-                for &i in &row {
-                    let p = lattice.sample(i, j, k);
-                    if edge[i - base] {
-                        anchor = None;
                         continue;
                     }
-                    // From the previous centre, or from a block that ends just before this one.
-                    let prev = anchor.take().filter(|a| a.0 + 1 == i).or_else(|| {
-                        let at =
-                            spans.binary_search_by_key(&(j as u32, k as u32, i as u32), |x| (x.0, x.1, x.2));
-                        at.ok().map(|at| (i - 1, lattice.sample(i - 1, j, k), spans[at].3))
-                    });
-                    let walked = prev
-                        .and_then(|(_, q, e)| {
-                            let step = steps[i - base]?;
-                            if q != lattice.sample(i - 1, j, k) {
-                                return self.walk(q, e, p); // an anchor moved off a polygon's plane
-                            }
-                            match slope {
-                                Some(g) => Some(Estimate {
-                                    w: e.w + step as f64,
-                                    err: e.err + g * q.distance(p) * (1.0 + 1e-12),
-                                }),
-                                None => self.drift(q, e, p, step),
-                            }
-                        })
-                        .filter(|e| e.decides(0.0).is_some());
-                    let (q, e) = match walked {
-                        Some(e) => (p, e),
-                        None => self.anchor(p),
-                    };
-                    if self.decided_or_point(e.decides(0.0), p) == Class::Inside {
-                        s.xor_span(j, k, i, i + 1);
+                    // Centres from..f have the count w.
+                    let (mut w, mut from) = (0i32, 0usize);
+                    for &(_, f, sign) in row_steps {
+                        if w >= 1 {
+                            s.xor_span(j, k, from, f as usize);
+                        }
+                        (w, from) = (w + sign as i32, f as usize);
                     }
-                    anchor = Some((i, q, e));
+                    let r = ((j - j0) * n + k) * wpr;
+                    let (on, alone) = (&boundary[r..r + wpr], &alone[r..r + wpr]);
+                    let row = s.row_mut(j, k);
+                    for (x, &m) in row.iter_mut().zip(on) {
+                        *x &= !m;
+                    }
+                    let taken = |i: usize| (on[i / 64] | alone[i / 64]) >> (i % 64) & 1 == 1;
+                    for (word, (&a, &b)) in alone.iter().zip(on).enumerate() {
+                        let mut m = a & !b;
+                        while m != 0 {
+                            let i = word * 64 + m.trailing_zeros() as usize;
+                            set(row, i, point(i));
+                            m &= m - 1;
+                        }
+                    }
+                    // Near a cap: w = count − w(caps), each centre once.
+                    ranges.sort_unstable_by_key(|r| r.start);
+                    let mut done = 0;
+                    for range in &ranges {
+                        for i in range.start.max(done)..range.end {
+                            if taken(i) {
+                                continue;
+                            }
+                            let count =
+                                row_steps.iter().take_while(|x| x.1 as usize <= i).map(|x| x.2 as i32).sum();
+                            set(row, i, caps.inside(grid.centre(i, j, k), count).unwrap_or_else(|| point(i)));
+                        }
+                        done = done.max(range.end);
+                    }
                 }
             }
         });
         Ok(volume)
+    }
+
+    /// Calls `mark(j, k, i, on)` for the centres (j in `slices`) that may be within ε of
+    /// covering triangle `t`'s face: `on` when the exact predicate says they are; the others
+    /// are reported only for a polygon's triangle, whose plane they are near (where
+    /// [`Self::classify_point`] moves a point off the plane first).
+    fn near_centres(
+        &self,
+        t: usize,
+        grid: &Grid,
+        slices: std::ops::Range<usize>,
+        mut mark: impl FnMut(usize, usize, usize, bool),
+    ) {
+        let covering = self.surface.covering();
+        let (eps, n, h) = (self.surface.eps(), grid.n, grid.h());
+        let [a, b, c] = covering.triangle(t);
+        let (lo, hi) = (a.min(b).min(c) - eps, a.max(b).max(c) + eps);
+        let face = covering.face_of[t] as usize;
+        let polygon = covering.face_triangles(face).len() > 1;
+        let nrm = (b - a).cross(c - a);
+        let (len, l1) = (nrm.length(), nrm.abs().element_sum());
+        // Off the plane by more than ε (with room for rounding): not on the boundary.
+        let off_plane = |p: DVec3| nrm.dot(p - a).abs() > (eps * (1.0 + 1e-9) + 1e-12 * p.distance(a)) * len;
+        let steep = nrm.x.abs() >= 1e-3 * l1;
+        let reach_x = (lo.x - a.x).abs().max((hi.x - a.x).abs());
+        let js = index_range(grid.min.y, h, n, lo.y, hi.y);
+        let ks = index_range(grid.min.z, h, n, lo.z, hi.z);
+        for j in js.start.max(slices.start)..js.end.min(slices.end) {
+            let y = grid.centre_coord(grid.min.y, j);
+            if y < lo.y || y > hi.y {
+                continue;
+            }
+            // A centre within ε of the triangle has its (y, z) within ε of the triangle's
+            // (y, z) projection: z within the projection's z extent over y ± ε, grown by ε
+            // (the extent's ends are convex and concave in y, so the slices at y ± ε and the
+            // corners between them bound it), with room for rounding.
+            let ey = 2.0 * eps + 1e-9 * (y.abs() + h);
+            let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for (l, u) in [y - ey, y + ey].into_iter().filter_map(|yy| z_extent_at(&[a, b, c], yy)) {
+                (zlo, zhi) = (zlo.min(l), zhi.max(u));
+            }
+            for v in [a, b, c].into_iter().filter(|v| (v.y - y).abs() <= ey) {
+                (zlo, zhi) = (zlo.min(v.z), zhi.max(v.z));
+            }
+            if zlo > zhi {
+                continue;
+            }
+            let margin = ey + 1e-9 * (zlo.abs() + zhi.abs() + h);
+            let (zlo, zhi) = ((zlo - margin).max(lo.z), (zhi + margin).min(hi.z));
+            if !(zlo <= zhi) {
+                continue;
+            }
+            let row_ks = index_range(grid.min.z, h, n, zlo, zhi);
+            for k in row_ks.start.max(ks.start)..row_ks.end.min(ks.end) {
+                let z = grid.centre_coord(grid.min.z, k);
+                if z < zlo || z > zhi {
+                    continue;
+                }
+                // A centre that passes `off_plane` has |g + n_x·(x − a.x)| ≤ 2ε|n| (and
+                // rounding), with |x − a.x| ≤ reach_x in the box.
+                let (dy, dz) = ((y - a.y).abs(), (z - a.z).abs());
+                let g = nrm.y * (y - a.y) + nrm.z * (z - a.z);
+                let slack = 1e-9 * l1 * (dy + dz + reach_x);
+                if g.abs() > 2.0 * eps * len + nrm.x.abs() * reach_x + slack {
+                    continue;
+                }
+                let xs = if steep {
+                    // Usually no centre at all: the plane is within ε of the row only near
+                    // x0. The margin covers the rounding of x0 and of the indices.
+                    let x0 = a.x - g / nrm.x;
+                    let half = (2.0 * eps * len + slack) / nrm.x.abs()
+                        + 1e-9 * (a.x.abs() + x0.abs() + grid.min.x.abs() + grid.side);
+                    let first = (((x0 - half).max(lo.x) - grid.min.x) / h - 0.5).ceil().max(0.0);
+                    let last = (((x0 + half).min(hi.x) - grid.min.x) / h - 0.5).floor();
+                    if !(last >= first) {
+                        continue;
+                    }
+                    first as usize..(last as usize + 1).min(n)
+                } else {
+                    index_range(grid.min.x, h, n, lo.x, hi.x)
+                };
+                for i in xs {
+                    let p = DVec3::new(grid.centre_coord(grid.min.x, i), y, z);
+                    if p.x < lo.x || p.x > hi.x || off_plane(p) {
+                        continue;
+                    }
+                    let on = self.surface.on_face(face, p);
+                    if on || polygon {
+                        mark(j, k, i, on);
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -566,6 +634,9 @@ struct Boundary {
     edges: Vec<(DVec3, DVec3, f64)>,
     /// Per group: bounds and Σ multiplicity × length.
     groups: Vec<(DVec3, DVec3, f64)>,
+    /// Γ by covering points: (a, b, m) with a < b, the edge a→b used m (≠ 0) more times
+    /// than b→a.
+    net: Vec<(u32, u32, i32)>,
 }
 
 impl Boundary {
@@ -577,14 +648,17 @@ impl Boundary {
             .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
             .collect();
         uses.par_sort_unstable_by_key(|&(a, b, _)| (a, b));
-        let mut edges = Vec::new();
-        for run in uses.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-            let m: i32 = run.iter().map(|x| x.2).sum();
-            if m != 0 {
-                let (a, b) = (covering.points[run[0].0 as usize], covering.points[run[0].1 as usize]);
-                edges.push((a, b, m.unsigned_abs() as f64));
-            }
-        }
+        let net: Vec<(u32, u32, i32)> = uses
+            .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
+            .map(|run| (run[0].0, run[0].1, run.iter().map(|x| x.2).sum()))
+            .filter(|&(_, _, m)| m != 0)
+            .collect();
+        let mut edges: Vec<(DVec3, DVec3, f64)> = net
+            .iter()
+            .map(|&(a, b, m)| {
+                (covering.points[a as usize], covering.points[b as usize], m.unsigned_abs() as f64)
+            })
+            .collect();
         group(&mut edges);
         let groups = edges
             .chunks(EDGE_GROUP)
@@ -594,7 +668,7 @@ impl Boundary {
                 })
             })
             .collect();
-        Boundary { edges, groups }
+        Boundary { edges, groups, net }
     }
 
     /// A bound of |∇w| over the ball of `radius` about `c` (`None`: Γ comes too close).
@@ -617,6 +691,107 @@ impl Boundary {
         }
         // Relative margin for the rounding of the sum and the distances.
         Some(sum / (4.0 * PI) * (1.0 + 1e-9))
+    }
+}
+
+/// The boundary curve Γ capped: over each of its loops (connected components) the cone
+/// from the loop's vertex centroid, oriented against Γ, so that the covering and the caps
+/// together form a closed chain (every directed edge used as often as its reverse; the
+/// caps may cross the surface).
+#[derive(Clone, Debug)]
+struct Caps {
+    triangles: Vec<[DVec3; 3]>,
+    /// Per loop: its apex, and the distance from it beyond which |w| of its cone is at
+    /// most ¼ / (number of loops).
+    balls: Vec<(DVec3, f64)>,
+    /// The caps' triangles, for their winding number with a bound.
+    tree: Tree,
+}
+
+impl Caps {
+    fn new(covering: &Covering, net: &[(u32, u32, i32)]) -> Caps {
+        let mut sets = UnionFind::new(covering.points.len());
+        for &(a, b, _) in net {
+            sets.union(a, b);
+        }
+        // Per loop: the sum and number of its vertices, and its number of triangles.
+        let (mut loop_of, mut seen) =
+            (vec![u32::MAX; covering.points.len()], vec![false; covering.points.len()]);
+        let mut loops: Vec<(DVec3, usize, usize)> = Vec::new();
+        for &(a, b, m) in net {
+            let root = sets.find(a) as usize;
+            if loop_of[root] == u32::MAX {
+                loop_of[root] = loops.len() as u32;
+                loops.push((DVec3::ZERO, 0, 0));
+            }
+            let l = &mut loops[loop_of[root] as usize];
+            for v in [a as usize, b as usize] {
+                if !std::mem::replace(&mut seen[v], true) {
+                    l.0 += covering.points[v];
+                    l.1 += 1;
+                }
+            }
+            l.2 += m.unsigned_abs() as usize;
+        }
+        let apexes: Vec<DVec3> = loops.iter().map(|&(sum, count, _)| sum / count as f64).collect();
+        let mut radius = vec![0.0f64; loops.len()];
+        let mut triangles = Vec::new();
+        for &(a, b, m) in net {
+            let l = loop_of[sets.find(a) as usize] as usize;
+            let (pa, pb, c) = (covering.points[a as usize], covering.points[b as usize], apexes[l]);
+            radius[l] = radius[l].max(pa.distance(c)).max(pb.distance(c));
+            let t = if m > 0 { [pb, pa, c] } else { [pa, pb, c] };
+            triangles.extend(std::iter::repeat_n(t, m.unsigned_abs() as usize));
+        }
+        // m triangles within ρ of the apex, seen from d > ρ, each fill at most the spherical
+        // cap of half-angle α = asin(ρ/d): |w| ≤ m (1 − cos α) / 2, at most ¼ / L (L loops)
+        // when cos α ≥ 1 − 1/(2 m L). One per cent more for the rounding of ρ and d.
+        let balls = apexes
+            .iter()
+            .zip(&radius)
+            .zip(&loops)
+            .map(|((&c, &rho), &(_, _, m))| {
+                let cos = 1.0 - 0.5 / (m.max(1) * loops.len()) as f64;
+                (c, rho / (1.0 - cos * cos).sqrt() * 1.01)
+            })
+            .collect();
+        let tree = Tree::from_triangles(triangles.iter().copied());
+        Caps { triangles, balls, tree }
+    }
+
+    /// The centres of row (j, k) (index ranges along x, with a margin) within a ball.
+    fn on_row<'a>(
+        &'a self,
+        grid: &'a Grid,
+        j: usize,
+        k: usize,
+    ) -> impl Iterator<Item = std::ops::Range<usize>> + 'a {
+        let (y, z) = (grid.centre_coord(grid.min.y, j), grid.centre_coord(grid.min.z, k));
+        self.balls.iter().filter_map(move |&(c, r)| {
+            let d2 = r * r - (y - c.y) * (y - c.y) - (z - c.z) * (z - c.z);
+            let half = d2.sqrt();
+            (d2 >= 0.0)
+                .then(|| index_range(grid.min.x, grid.h(), grid.n, c.x - half, c.x + half))
+                .filter(|r| !r.is_empty())
+        })
+    }
+
+    /// Whether w ≥ ½ at `p` (off the boundary), where the closed chain winds `count` times
+    /// (under the tie rule): w = count − w(caps), when a bound decides it and `p` is on no
+    /// cap triangle's plane (where w(caps) would jump); `None` otherwise.
+    fn inside(&self, p: DVec3, count: i32) -> Option<bool> {
+        let on_plane = self.tree.any_near(p, p, 0.0, |t| {
+            let [a, b, c] = self.triangles[t];
+            orient3d(a, b, c, p) == 0
+        });
+        if on_plane {
+            return None;
+        }
+        TOLERANCES.iter().find_map(|&tol| {
+            let e = self.tree.winding(p, tol);
+            let k = count as f64;
+            Estimate { w: k - e.w, err: e.err + 2.0 * f64::EPSILON * (k.abs() + e.w.abs()) }.decides(0.0)
+        })
     }
 }
 

@@ -133,15 +133,18 @@ struct Item {
 impl Tree {
     /// Builds the tree of the covering's triangles (in parallel above a few thousand).
     pub fn new(covering: &Covering) -> Tree {
-        let mut items: Vec<Item> = (0..covering.triangles.len())
-            .map(|t| {
-                let [a, b, c] = covering.triangle(t);
-                Item {
-                    corners: [a, b, c],
-                    centroid: (a + b + c) / 3.0,
-                    area: 0.5 * (b - a).cross(c - a),
-                    index: t as u32,
-                }
+        Tree::from_triangles((0..covering.triangles.len()).map(|t| covering.triangle(t)))
+    }
+
+    /// The tree of `triangles` (indices in the order given).
+    pub fn from_triangles(triangles: impl Iterator<Item = [DVec3; 3]>) -> Tree {
+        let mut items: Vec<Item> = triangles
+            .enumerate()
+            .map(|(t, [a, b, c])| Item {
+                corners: [a, b, c],
+                centroid: (a + b + c) / 3.0,
+                area: 0.5 * (b - a).cross(c - a),
+                index: t as u32,
             })
             .collect();
         let mut nodes = Vec::new();

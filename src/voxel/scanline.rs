@@ -64,6 +64,40 @@ fn crossings_into(
     });
 }
 
+/// The signed steps of the winding number of `solid`'s triangles along the rows of slices
+/// `slices`, for a *closed chain* (every directed edge used as often as its reverse; the
+/// triangles may cross each other): `(row, f, s)`, sorted by row then f, says that centres
+/// f.. of the row see one more crossing behind them, whose sign is s (f = N: behind no
+/// centre). Entering a triangle's back side along +x raises the winding number by one, so
+/// s = −nx; with the tie rule the winding number at centre i, exactly, is the sum of the
+/// row's s over f ≤ i, and a row's s sum to 0.
+pub fn winding_steps(
+    solid: &Solid,
+    grid: &Grid,
+    triangles: impl Iterator<Item = u32>,
+    slices: std::ops::Range<usize>,
+    out: &mut Vec<(RowId, u32, Sign)>,
+) {
+    let n = grid.n;
+    let all = (f64::NEG_INFINITY, f64::INFINITY);
+    for t in triangles {
+        triangle_crossings(
+            solid,
+            grid,
+            t,
+            slices.clone(),
+            0..n,
+            all,
+            |_, _| true,
+            |j, k, c| {
+                let f = first_behind(solid, grid, j, k, &c, doubt(grid, &c));
+                out.push(((j * n + k) as RowId, f as u32, -c.nx));
+            },
+        );
+    }
+    out.sort_unstable_by_key(|&(row, f, _)| (row, f));
+}
+
 /// Calls `each(j, k, crossing)` for every row (j, k) with j in `slices`, k in `columns`
 /// and `wanted(j, k)` whose line meets covering triangle `t` (decided exactly, under the
 /// tie rule) at an abscissa that may lie in `window` (rows whose crossing is certainly
@@ -145,7 +179,7 @@ fn triangle_crossings(
 
 /// Indices i (clamped to 0..n) whose centres may lie in [lo, hi], with one index of
 /// margin on each side; callers decide each one exactly.
-fn index_range(min: f64, h: f64, n: usize, lo: f64, hi: f64) -> std::ops::Range<usize> {
+pub(crate) fn index_range(min: f64, h: f64, n: usize, lo: f64, hi: f64) -> std::ops::Range<usize> {
     let (first, last) = index_bounds(min, h, lo, hi);
     if last.is_nan() || first.is_nan() || last < 0.0 || first >= n as f64 || first > last {
         return 0..0;
@@ -160,7 +194,7 @@ fn index_bounds(min: f64, h: f64, lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// The z extent of the triangle's (y, z) projection on the line y = `y` (approximate).
-fn z_extent_at(tri: &[DVec3; 3], y: f64) -> Option<(f64, f64)> {
+pub(crate) fn z_extent_at(tri: &[DVec3; 3], y: f64) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for (p, q) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
         let (ylo, yhi) = (p.y.min(q.y), p.y.max(q.y));

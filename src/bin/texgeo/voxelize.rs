@@ -96,7 +96,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         }
         crate::mesh::warn_non_solid(&args.mesh, defect);
         let t = std::time::Instant::now();
-        let volume = texgeo::inclusion::fast_winding::FastWinding::new(&mesh, 0)?.voxelize(&grid)?;
+        let volume = texgeo::inclusion::fast_winding::FastWinding::for_voxels(&mesh)?.voxelize(&grid)?;
         say!(
             "{}: {}³ voxels, {} occupied, generalized winding number ≥ ½ (fast-winding) in {:.1} ms",
             args.mesh,

@@ -162,7 +162,7 @@ fn winding_rule(mesh: &Mesh, o: &Options, out: &mut Record) -> Result<(), Failur
     let grid = Grid::for_mesh(mesh, o.res).map_err(|e| Failure::refused("flat", e))?;
     out.size("res", o.res);
     let t = Instant::now();
-    let fast = crate::inclusion::fast_winding::FastWinding::new(mesh, 0).map_err(map)?;
+    let fast = crate::inclusion::fast_winding::FastWinding::for_voxels(mesh).map_err(map)?;
     let volume = fast.voxelize(&grid).map_err(|e| Failure::failed("winding", e))?;
     out.time("voxelize", t.elapsed());
     out.size("occupied", volume.count());
