@@ -503,7 +503,7 @@ impl FastWinding {
             }
             let margin = ey + 1e-9 * (zlo.abs() + zhi.abs() + h);
             let (zlo, zhi) = ((zlo - margin).max(lo.z), (zhi + margin).min(hi.z));
-            if !(zlo <= zhi) {
+            if zlo > zhi {
                 continue;
             }
             let row_ks = index_range(grid.min.z, h, n, zlo, zhi);
@@ -528,7 +528,7 @@ impl FastWinding {
                         + 1e-9 * (a.x.abs() + x0.abs() + grid.min.x.abs() + grid.side);
                     let first = (((x0 - half).max(lo.x) - grid.min.x) / h - 0.5).ceil().max(0.0);
                     let last = (((x0 + half).min(hi.x) - grid.min.x) / h - 0.5).floor();
-                    if !(last >= first) {
+                    if last.is_nan() || last < first {
                         continue;
                     }
                     first as usize..(last as usize + 1).min(n)
