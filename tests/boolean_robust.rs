@@ -119,3 +119,17 @@ fn random_placements_of_builtin_solids() {
         );
     }
 }
+
+/// An operand with faces whose corners are not in one plane enters as the same surface
+/// `mesh stats` measures (each such face the fan from its centroid): united with a cube
+/// far away, the result's volume is the sum of the two.
+#[test]
+fn non_planar_faces_keep_their_volume() {
+    let bent = procedural::bent_box();
+    let far = procedural::box_between(DVec3::splat(10.0), DVec3::splat(11.0));
+    let (_, [vu, vi, vd, _]) = check("bent box and a far cube", &bent, &far);
+    let va = volume(&bent);
+    assert!((vu - (va + 1.0)).abs() <= 1e-15 * vu, "{vu} vs {va} + 1");
+    assert!((vd - va).abs() <= 1e-15 * va, "{vd} vs {va}");
+    assert_eq!(vi, 0.0);
+}

@@ -57,9 +57,9 @@ fn obj_off_ply_round_trips_are_exact() {
 
 /// The triangles of `mesh` (as STL gets them) as f32-rounded coordinates.
 fn f32_triangles(mesh: &Mesh) -> Vec<[[f32; 3]; 3]> {
-    let p = mesh.positions();
-    let r = |i: u32| p[i as usize].to_array().map(|c| c as f32);
-    triangulate::triangles(mesh).map(|[a, b, c]| [r(a), r(b), r(c)]).collect()
+    let t = triangulate::triangulated(mesh);
+    let r = |i: u32| t.positions()[i as usize].to_array().map(|c| c as f32);
+    t.faces().map(|f| [r(f[0]), r(f[1]), r(f[2])]).collect()
 }
 
 #[test]
@@ -68,8 +68,9 @@ fn stl_round_trips_are_f32_exact_and_welded() {
         let back = round_trip(&mesh, Format::Stl, name).unwrap();
         assert!(back.is_triangle_mesh());
         assert_eq!(f32_triangles(&back), f32_triangles(&mesh), "{name}");
-        // Welding restores the shared vertices, so the topology survives.
-        assert_eq!(back.num_vertices(), mesh.num_vertices(), "{name}");
+        // Welding restores the shared vertices (and the centres of non-planar faces'
+        // fans), so the topology survives.
+        assert_eq!(back.num_vertices(), triangulate::triangulated(&mesh).num_vertices(), "{name}");
         // Triangulation adds as many edges as triangles beyond the faces: χ and the flags stay.
         let summary = |m: &Mesh| {
             let r = m.report();
@@ -88,11 +89,29 @@ fn ascii_stl_round_trip_is_exact_in_f64() {
         let p = |m: &Mesh| -> Vec<DVec3> {
             m.faces().flat_map(|f| f.iter().map(|&i| m.positions()[i as usize]).collect::<Vec<_>>()).collect()
         };
-        let fan: Vec<DVec3> =
-            triangulate::triangles(&mesh).flatten().map(|i| mesh.positions()[i as usize]).collect();
-        assert_eq!(p(&back), fan, "{name}");
-        assert_eq!(back.num_vertices(), mesh.num_vertices(), "{name}");
+        let t = triangulate::triangulated(&mesh);
+        assert_eq!(p(&back), p(&t), "{name}");
+        assert_eq!(back.num_vertices(), t.num_vertices(), "{name}");
         assert!(back.report().is_closed(), "{name}");
+    }
+}
+
+/// A face whose corners are not in one plane is the fan from its centroid in the STL
+/// export too: the export measures what `mesh stats` measures.
+#[test]
+fn stl_keeps_the_surface_of_non_planar_faces() {
+    let mesh = procedural::bent_box();
+    let stats = Covering::new(&mesh).volume();
+    let writers: [Writer; 2] = [|w, m| stl::write(w, m), |w, m| stl::write_ascii(w, m)];
+    for write in writers {
+        let mut bytes = Vec::new();
+        write(&mut bytes, &mesh).unwrap();
+        let back = stl::read(&bytes, &path("bent.stl")).unwrap();
+        assert!(back.report().is_closed());
+        // The top's fan of 4 triangles, five planar quads of 2.
+        assert_eq!(back.num_faces(), 4 + 5 * 2);
+        let v = Covering::new(&back).volume();
+        assert!((v - stats).abs() <= 1e-15 * stats, "{v} vs {stats}");
     }
 }
 
@@ -140,10 +159,11 @@ fn convert_keeps_area_and_volume_in_every_format() {
             write(&mut bytes, &mesh).unwrap();
             let back = formats::read_bytes(&bytes, format, &path(name)).unwrap();
             let (a, v) = measures(&back);
-            // Binary STL rounds coordinates to f32: compare with the rounded mesh's measures
-            // (the triangulation itself must keep them, checked below).
+            // Binary STL rounds coordinates to f32 (fan centres included): compare with
+            // the rounded triangles' measures (the triangulation itself must keep them:
+            // the ascii STL, exact in f64, is held to the mesh's own).
             let (area, volume) = if label == "stl" {
-                measures(&mesh.map_positions(|p| p.as_vec3().as_dvec3()).unwrap())
+                measures(&triangulate::triangulated(&mesh).map_positions(|p| p.as_vec3().as_dvec3()).unwrap())
             } else {
                 (area, volume)
             };

@@ -147,3 +147,83 @@ fn a_sphere_pierced_by_a_rotated_copy_of_itself() {
         );
     }
 }
+
+/// The cube [0, 2]³ with its top split into two quads at x = 1: the front and back
+/// faces keep their whole top edges, and a face with no area (three corners on one line)
+/// plugs each T-junction. Faces only touch there.
+fn cube_with_plugged_t_junctions() -> Mesh {
+    let mut p: Vec<DVec3> = (0..8)
+        .map(|i| DVec3::new(f64::from(i & 1) * 2.0, f64::from(i >> 1 & 1) * 2.0, f64::from(i >> 2) * 2.0))
+        .collect();
+    p.extend([DVec3::new(1.0, 0.0, 2.0), DVec3::new(1.0, 2.0, 2.0)]);
+    let faces = vec![
+        vec![0, 4, 6, 2], // −x
+        vec![1, 3, 7, 5], // +x
+        vec![0, 1, 5, 4], // −y, with the whole edge 5–4
+        vec![2, 6, 7, 3], // +y, with the whole edge 6–7
+        vec![0, 2, 3, 1], // −z
+        vec![4, 8, 9, 6], // top, x ≤ 1
+        vec![8, 5, 7, 9], // top, x ≥ 1
+        vec![4, 5, 8],    // plugs: no area
+        vec![7, 6, 9],
+    ];
+    Mesh::new(p, faces).unwrap()
+}
+
+#[test]
+fn faces_touching_at_a_plugged_t_junction_do_not_cross() {
+    let m = cube_with_plugged_t_junctions();
+    assert!(m.report().is_closed());
+    assert_eq!(self_intersections(&m, 10), vec![]);
+    assert!(texgeo::mesh::solidity::check(&m).defects.is_empty());
+    // A real crossing next to the junction is still found: a small box through the top.
+    let poked = merged(&[m, boxed([0.9, 0.4, 1.9], [1.1, 0.6, 2.1])]);
+    let pairs = self_intersections(&poked, 10);
+    assert!(
+        !pairs.is_empty() && pairs.iter().all(|&(f, g)| f < 9 && g >= 9 && (f == 5 || f == 6)),
+        "{pairs:?}"
+    );
+}
+
+/// A non-planar face is the fan from its centroid in the check too. The bent box's top
+/// quad reaches z = 4.5 at its centre as a fan (z = 5 as two triangles split along the
+/// diagonal to the raised corner): a small box between the two crosses only the
+/// diagonal split, one around z = 4.5 only the fan.
+#[test]
+fn non_planar_faces_are_checked_as_their_fan() {
+    let bent = procedural::bent_box();
+    let top = 5;
+    let above_fan = merged(&[bent.clone(), boxed([1.9, 1.9, 4.6], [2.1, 2.1, 5.2])]);
+    assert_eq!(self_intersections(&above_fan, 10), vec![]);
+    let through_fan = merged(&[bent, boxed([1.9, 1.9, 4.3], [2.1, 2.1, 4.7])]);
+    let pairs = self_intersections(&through_fan, 10);
+    assert!(!pairs.is_empty() && pairs.iter().all(|&(f, g)| f == top && g >= 6), "{pairs:?}");
+}
+
+/// A non-convex face bent out of its plane whose centroid lies outside it: its fan would
+/// fold through itself, so it is triangulated in its projection plane, and that surface
+/// does not cross itself.
+#[test]
+fn a_folding_fan_is_not_used() {
+    // A bracket opening to the left; its vertex centroid (1.25, 1.5) lies in the notch.
+    // Tilting the notch's lower side (one end up, one down) would make the fan triangle
+    // over that side cross the lower arm's.
+    let bracket = |tilt: f64| {
+        let xy =
+            [(0.0, 0.0), (3.0, 0.0), (3.0, 3.0), (0.0, 3.0), (0.0, 2.0), (2.0, 2.0), (2.0, 1.0), (0.0, 1.0)];
+        let z = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, tilt, -tilt];
+        let p: Vec<DVec3> = xy.iter().zip(z).map(|(&(x, y), z)| DVec3::new(x, y, z)).collect();
+        Mesh::new(p, vec![(0..8).collect()]).unwrap()
+    };
+    for tilt in [0.0, 0.5] {
+        let m = bracket(tilt);
+        assert_eq!(texgeo::mesh::triangulate::fan_centre(m.positions(), m.face(0)), None);
+        assert_eq!(self_intersections(&m, 10), vec![]);
+    }
+    // The bent box's top is convex: fanned.
+    let bent = procedural::bent_box();
+    assert_eq!(
+        texgeo::mesh::triangulate::fan_centre(bent.positions(), bent.face(5)),
+        Some(DVec3::new(2.0, 2.0, 4.5))
+    );
+}

@@ -39,8 +39,8 @@ fn remedy(defect: &solidity::Defect) -> &'static str {
     }
 }
 
-/// Checks one operand and returns its triangles (polygon faces tessellated, vertices
-/// welded by position): the shared solid check of every command, then what refinement
+/// Checks one operand and returns its triangles (polygon faces tessellated as every
+/// command sees them, [`TriangleSoup::new`]; vertices welded by position): the shared solid check of every command, then what refinement
 /// needs on top (faces with area, a volume). `allow_self_intersections` excuses faces that
 /// cross; an inverted operand is refused (the command flips it first when asked).
 pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {

@@ -55,6 +55,14 @@ impl std::fmt::Display for UnbalancedEdge {
     }
 }
 
+/// The vertex centroid of a polygon face, rounded to f64 once: the centre of its covering
+/// fan, and of every other use of a face's fan ([`super::triangulate::fan_centre`]), so
+/// all of them cover the same surface.
+pub fn face_centroid(positions: &[DVec3], face: &[u32]) -> DVec3 {
+    let sum = face.iter().fold(DVec3::ZERO, |s, &i| s + positions[i as usize]);
+    sum / face.len() as f64
+}
+
 /// Signed volume of the tetrahedron (O, A, B, C): det(A−O, B−O, C−O) / 6 (Def. 3.21).
 pub fn signed_tetra_volume(o: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     (a - o).dot((b - o).cross(c - o)) / 6.0
@@ -87,9 +95,8 @@ impl Covering {
                 triangles.push([face[0], face[1], face[2]]);
                 face_of.push(f as u32);
             } else {
-                let sum = face.iter().fold(DVec3::ZERO, |s, &i| s + mesh.positions()[i as usize]);
                 let c = points.len() as u32;
-                points.push(sum / face.len() as f64);
+                points.push(face_centroid(mesh.positions(), face));
                 for (i, &p) in face.iter().enumerate() {
                     triangles.push([c, p, face[(i + 1) % face.len()]]);
                     face_of.push(f as u32);

@@ -10,11 +10,19 @@
 //! what they are entitled to: nothing for faces with no common vertex, the vertex for
 //! faces sharing one, the edge for faces sharing an edge. Vertices are identified by
 //! position, so a mesh whose shells touch at duplicated vertices counts as touching,
-//! not crossing. Polygon faces are tessellated in their plane ([`super::triangulate`],
-//! never the covering's centroid fan, which overlaps itself on non-convex faces);
-//! triangles of one face are not tested against each other, and a face whose outline
-//! crosses itself is reported paired with itself. Candidate pairs come from a uniform
-//! grid over the triangles' boxes ([`super::boxgrid`]).
+//! not crossing. Polygon faces are tessellated as every command sees them
+//! ([`super::triangulate::fan_centre`]): a non-planar face whose centroid fan does not
+//! fold as the fan from its centroid, any other in its plane ([`super::triangulate`]).
+//! Either way no two triangles of a face overlap, so they are not tested against each
+//! other; a face whose outline crosses itself is reported paired with itself.
+//!
+//! A face with no area plugs a T-junction: its corners lie on one line, and its middle
+//! corner lies on the segment between the two others, where the faces on one side have
+//! that whole segment as an edge and those on the other side have its pieces. Those
+//! faces only touch; to tell that from crossing, the triangles with the whole segment
+//! are split at the middle corner before the pair tests ([`split_at_t_junctions`]).
+//! Candidate pairs come from a uniform grid over the triangles' boxes
+//! ([`super::boxgrid`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -160,14 +168,16 @@ pub struct TriangleSoup {
 }
 
 impl TriangleSoup {
-    /// Tessellates every face of `mesh` ([`triangulate::polygon`]) and welds vertices at
-    /// equal positions.
+    /// Tessellates every face of `mesh` and welds vertices at equal positions: a face with
+    /// a [`triangulate::fan_centre`] as the fan from it (the centres are added to
+    /// `positions`, after the mesh's vertices, in face order), any other polygon in its
+    /// plane ([`triangulate::polygon`]).
     pub fn new(mesh: &Mesh) -> TriangleSoup {
-        let weld = weld_by_position(mesh.positions());
-        // A triangle face needs no allocation; polygons are tessellated in their plane.
+        // A triangle face needs no allocation.
         enum Tess {
             One([u32; 3]),
             Many(Vec<[u32; 3]>),
+            Fan(DVec3),
             Failed(TriangulateError),
         }
         let per_face: Vec<Tess> = (0..mesh.num_faces())
@@ -176,34 +186,42 @@ impl TriangleSoup {
             .map(|f| {
                 let face = mesh.face(f);
                 if face.len() == 3 {
-                    return Tess::One([face[0], face[1], face[2]].map(|v| weld[v as usize]));
+                    return Tess::One([face[0], face[1], face[2]]);
+                }
+                if let Some(c) = triangulate::fan_centre(mesh.positions(), face) {
+                    return Tess::Fan(c);
                 }
                 let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
                 match triangulate::polygon(&corners) {
-                    Ok(tris) => Tess::Many(
-                        tris.into_iter().map(|t| t.map(|k| weld[face[k as usize] as usize])).collect(),
-                    ),
+                    Ok(tris) => Tess::Many(tris.into_iter().map(|t| t.map(|k| face[k as usize])).collect()),
                     Err(e) => Tess::Failed(e),
                 }
             })
             .collect();
+        let mut positions = mesh.positions().to_vec();
+        positions.extend(per_face.iter().filter_map(|r| if let Tess::Fan(c) = r { Some(*c) } else { None }));
+        let weld = weld_by_position(&positions);
         let mut soup = TriangleSoup {
-            positions: mesh.positions().to_vec(),
             triangles: Vec::with_capacity(mesh.num_faces()),
             face_of: Vec::with_capacity(mesh.num_faces()),
             failed: Vec::new(),
+            positions,
         };
+        let mut next_centre = mesh.num_vertices() as u32;
         for (f, r) in per_face.into_iter().enumerate() {
+            let mut push = |t: [u32; 3]| {
+                soup.triangles.push(t.map(|v| weld[v as usize]));
+                soup.face_of.push(f as u32);
+            };
             match r {
-                Tess::One(t) => {
-                    soup.triangles.push(t);
-                    soup.face_of.push(f as u32);
-                }
-                Tess::Many(tris) => {
-                    for t in tris {
-                        soup.triangles.push(t);
-                        soup.face_of.push(f as u32);
+                Tess::One(t) => push(t),
+                Tess::Many(tris) => tris.into_iter().for_each(push),
+                Tess::Fan(_) => {
+                    let face = mesh.face(f);
+                    for (i, &v) in face.iter().enumerate() {
+                        push([next_centre, v, face[(i + 1) % face.len()]]);
                     }
+                    next_centre += 1;
                 }
                 Tess::Failed(e) => soup.failed.push((f as u32, e)),
             }
@@ -292,6 +310,73 @@ fn soup_pair_meets(soup: &TriangleSoup, i: usize, j: usize) -> bool {
     }
 }
 
+/// `soup` with its T-junctions made explicit (see the module docs): a triangle with no
+/// area and three distinct corners puts its middle corner on the segment between the two
+/// others, and every triangle with that segment as an edge is split there (again and
+/// again, until no edge carries such a point). The pieces keep their face and cover the
+/// same region. `None` when there is nothing to split.
+fn split_at_t_junctions(soup: &TriangleSoup) -> Option<TriangleSoup> {
+    let pos = |v: u32| soup.positions[v as usize].to_array();
+    // Exactly collinear points are in line order when ordered lexicographically.
+    let order = |x: &u32, y: &u32| pos(*x).partial_cmp(&pos(*y)).unwrap_or(std::cmp::Ordering::Equal);
+    let flat = |t: [u32; 3]| t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
+    let mut on_edge: std::collections::HashMap<(u32, u32), Vec<u32>> = std::collections::HashMap::new();
+    let mut degenerate = vec![false; soup.triangles.len()];
+    for (t, &tri) in soup.triangles.iter().enumerate() {
+        if !is_degenerate(soup.triangle(t)) {
+            continue;
+        }
+        degenerate[t] = true;
+        if flat(tri) {
+            let mut s = tri;
+            s.sort_by(order);
+            on_edge.entry((s[0].min(s[2]), s[0].max(s[2]))).or_default().push(s[1]);
+        }
+    }
+    if on_edge.is_empty() {
+        return None;
+    }
+    let mut out = TriangleSoup {
+        positions: soup.positions.clone(),
+        triangles: Vec::with_capacity(soup.triangles.len()),
+        face_of: Vec::with_capacity(soup.triangles.len()),
+        failed: soup.failed.clone(),
+    };
+    let mut stack = Vec::new();
+    for (t, &tri) in soup.triangles.iter().enumerate() {
+        stack.push(tri);
+        while let Some(tri) = stack.pop() {
+            let split = (0..3).find_map(|k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                on_edge.get(&(a.min(b), a.max(b))).map(|points| (k, points))
+            });
+            match split {
+                Some((k, points)) if !degenerate[t] => {
+                    // Pieces (a, m1, c), (m1, m2, c), …, (mk, b, c): oriented like (a, b, c).
+                    let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                    let mut chain = points.clone();
+                    chain.sort_by(order);
+                    chain.dedup();
+                    if order(&a, &b) == std::cmp::Ordering::Greater {
+                        chain.reverse();
+                    }
+                    chain.push(b);
+                    let mut prev = a;
+                    for m in chain {
+                        stack.push([prev, m, c]);
+                        prev = m;
+                    }
+                }
+                _ => {
+                    out.triangles.push(tri);
+                    out.face_of.push(soup.face_of[t]);
+                }
+            }
+        }
+    }
+    Some(out)
+}
+
 /// Face pairs `(f, g)`, f ≤ g, of `mesh` that intersect more than they may (see the
 /// module docs), at most `limit` of them: the first ones in triangle order, so the
 /// answer is the same on every run. A face whose outline crosses itself is
@@ -313,6 +398,8 @@ pub fn soup_self_intersections(soup: &TriangleSoup, limit: usize) -> Vec<(usize,
         found.truncate(limit);
         return found;
     }
+    let split = split_at_t_junctions(soup);
+    let soup = split.as_ref().unwrap_or(soup);
     let n = soup.triangles.len();
     let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();
     let mut pairs: Vec<(u32, u32)> = box_pairs(&soup.boxes(), None)

@@ -96,6 +96,16 @@ pub fn box_between(lo: DVec3, hi: DVec3) -> Mesh {
     mesh(positions, faces)
 }
 
+/// The box [0, 4]³ with its corner (4, 4, 4) raised to (4, 4, 6): its top quad is not
+/// planar, so its surface is the fan from its centroid (2, 2, 4.5), which is exact here
+/// (as are the corners in f32), for tests that every command and export uses that surface.
+pub fn bent_box() -> Mesh {
+    let b = box_between(DVec3::ZERO, DVec3::splat(4.0));
+    let mut positions = b.positions().to_vec();
+    positions[7].z = 6.0;
+    mesh(positions, b.faces().map(<[u32]>::to_vec).collect())
+}
+
 /// The cube [−1, 1]³: 8 vertices, 6 quads.
 pub fn cube() -> Mesh {
     box_between(DVec3::splat(-1.0), DVec3::splat(1.0))

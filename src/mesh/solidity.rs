@@ -23,7 +23,8 @@
 //!    one inside the other, give w = 2 between them; an inverted solid gives w = −1;
 //! 4. **not self-intersecting**: no two faces cross (overlapping shells give w = 2 where
 //!    they overlap). Detected by [`super::intersect::self_intersections`] (exact
-//!    triangle–triangle tests on the faces tessellated in their planes); shells that
+//!    triangle–triangle tests on the faces as every command sees them: planar ones
+//!    tessellated in their planes, non-planar ones as the fan from their centroid); shells that
 //!    overlap are also named as such when a shell has vertices both inside and outside
 //!    another.
 //!

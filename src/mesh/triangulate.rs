@@ -18,7 +18,8 @@
 use glam::{DVec2, DVec3};
 
 use super::Mesh;
-use crate::exact::orient2d;
+use super::covering::face_centroid;
+use crate::exact::{orient2d, orient3d};
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 /// Why a polygon or a constrained point set could not be triangulated.
@@ -136,10 +137,55 @@ pub fn polygon_or_fan(corners: &[DVec3]) -> Vec<[u32; 3]> {
     polygon(corners).unwrap_or_else(|_| fan())
 }
 
+/// The corners lie in one plane, decided exactly: every corner is coplanar (`orient3d`)
+/// with three of them that are not collinear. Corners that are all collinear count as
+/// planar (they have no area to place anywhere).
+pub fn is_planar(corners: &[DVec3]) -> bool {
+    let Some(&a) = corners.first() else { return true };
+    let Some(&b) = corners.iter().find(|&&p| p != a) else { return true };
+    let collinear = |c: DVec3| {
+        let o = |u: usize, v: usize| {
+            let q = |p: DVec3| DVec2::new(p[u], p[v]);
+            orient2d(q(a), q(b), q(c))
+        };
+        o(1, 2) == 0 && o(2, 0) == 0 && o(0, 1) == 0
+    };
+    let Some(&c) = corners.iter().find(|&&c| !collinear(c)) else { return true };
+    corners.iter().all(|&d| orient3d(a, b, c, d) == 0)
+}
+
+/// The point a polygon face's surface is fanned from: what a face *is* when its corners
+/// do not lie in one plane. texgeo takes the thesis' covering ([`super::covering`]): such
+/// a face is the fan of triangles (C, Pi, Pi+1) from its centroid C ([`face_centroid`],
+/// the same rounded point everywhere), in every command, export and check.
+///
+/// `None` for a triangle, a planar face (any triangulation in its plane covers the same
+/// region as the fan), and a non-planar face whose fan folds (some triangle turns against
+/// the face seen along its normal, as on a non-convex face whose centroid lies outside
+/// it): that fan's triangles overlap each other and reach past the face's outline, where
+/// they would cross its neighbours as soon as rounding lifts the face out of its plane
+/// (a turned L-shaped prism), so such a face is triangulated in its projection plane; only
+/// for those faces do the covering's volume and the triangles differ, by about the face's
+/// distance from a plane times its area.
+pub fn fan_centre(positions: &[DVec3], face: &[u32]) -> Option<DVec3> {
+    if face.len() <= 3 {
+        return None;
+    }
+    let corners: Vec<DVec3> = face.iter().map(|&v| positions[v as usize]).collect();
+    if is_planar(&corners) {
+        return None;
+    }
+    let c = face_centroid(positions, face);
+    let proj = Projection::along(newell_normal(corners.iter().copied()))?;
+    let (c2, p): (DVec2, Vec<DVec2>) = (proj.apply(c), corners.iter().map(|&x| proj.apply(x)).collect());
+    (0..p.len()).all(|i| orient2d(c2, p[i], p[(i + 1) % p.len()]) > 0).then_some(c)
+}
+
 /// The triangles of face `face` of a mesh with `positions` (vertex indices, oriented like
-/// the face): n − 2 triangles that tile it exactly, non-convex faces included (a fan from
-/// the first vertex folds over a non-convex polygon, keeping its signed area but not its
-/// area). The simplicial covering (SPEC §2) is a different thing, see [`super::covering`].
+/// the face), for a planar face: n − 2 triangles that tile it exactly, non-convex faces
+/// included (a fan from the first vertex folds over a non-convex polygon, keeping its
+/// signed area but not its area). Non-planar faces are fanned from their centroid
+/// ([`fan_centre`], [`triangulated`]).
 pub fn face_triangles(positions: &[DVec3], face: &[u32]) -> Vec<[u32; 3]> {
     if face.len() == 3 {
         return vec![[face[0], face[1], face[2]]];
@@ -148,15 +194,23 @@ pub fn face_triangles(positions: &[DVec3], face: &[u32]) -> Vec<[u32; 3]> {
     polygon_or_fan(&corners).into_iter().map(|t| t.map(|i| face[i as usize])).collect()
 }
 
-/// The triangles of every face, in face order.
-pub fn triangles(mesh: &Mesh) -> impl Iterator<Item = [u32; 3]> + '_ {
-    mesh.faces().flat_map(|f| face_triangles(mesh.positions(), f))
-}
-
-/// `mesh` with every face triangulated (same vertices).
+/// `mesh` with every face triangulated: planar faces in their plane over the same
+/// vertices, non-planar ones as the fan from their centroid, which is added as a vertex
+/// (after the mesh's own). The triangles cover exactly the surface every command uses.
 pub fn triangulated(mesh: &Mesh) -> Mesh {
-    let faces = triangles(mesh).map(|t| t.to_vec()).collect();
-    Mesh::new(mesh.positions().to_vec(), faces)
+    let mut positions = mesh.positions().to_vec();
+    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(mesh.num_faces());
+    for face in mesh.faces() {
+        match fan_centre(mesh.positions(), face) {
+            Some(c) => {
+                let ci = positions.len() as u32;
+                positions.push(c);
+                faces.extend((0..face.len()).map(|i| vec![ci, face[i], face[(i + 1) % face.len()]]));
+            }
+            None => faces.extend(face_triangles(mesh.positions(), face).into_iter().map(|t| t.to_vec())),
+        }
+    }
+    Mesh::new(positions, faces)
         .unwrap_or_else(|e| unreachable!("triangles of a valid mesh form a valid mesh: {e}"))
 }
 
@@ -382,7 +436,11 @@ mod tests {
             let m = procedural::by_name(name).unwrap();
             let t = triangulated(&m);
             assert!(t.is_triangle_mesh());
-            assert_eq!(t.num_faces(), m.faces().map(|f| f.len() - 2).sum::<usize>(), "{name}");
+            let want = m
+                .faces()
+                .map(|f| if fan_centre(m.positions(), f).is_some() { f.len() } else { f.len() - 2 })
+                .sum::<usize>();
+            assert_eq!(t.num_faces(), want, "{name}");
             let ((a0, v0), (a1, v1)) = (measures(&m), measures(&t));
             assert!(
                 (a0 - a1).abs() <= 1e-12 * a0 && (v0 - v1).abs() <= 1e-12 * v0.abs(),

@@ -13,7 +13,7 @@
 //! | OBJ | `v`/`f` via `tobj`, polygons kept, groups merged | `v`/`f`, exact decimals |
 //! | OFF | OFF/COFF/NOFF/CNOFF | OFF, exact decimals |
 //! | PLY | ascii, binary little/big endian | binary little endian, `double` (exact) |
-//! | STL | ascii, binary; vertices welded | binary (f32; polygons triangulated, ear clipping when non-convex) |
+//! | STL | ascii, binary; vertices welded | binary (f32; planar polygons triangulated in their plane, non-planar ones fanned from their centroid) |
 
 use std::path::Path;
 

@@ -15,7 +15,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::text::{parse_coord, utf8};
-use crate::mesh::triangulate::triangles;
+use crate::mesh::triangulate::triangulated;
 use crate::mesh::{Mesh, MeshError, Result, error::Location};
 
 const HEADER: usize = 80;
@@ -296,11 +296,19 @@ fn read_ascii(bytes: &[u8], path: &Path) -> Result<Mesh> {
         .map_err(|e| MeshError::parse(path, Location::File, e.to_string()))
 }
 
-/// Writes binary STL. Polygon faces are triangulated ([`crate::mesh::triangulate`]:
-/// convex ones as the fan (v0, vi, vi+1), non-convex ones by ear clipping); STL stores f32,
+/// The triangles STL gets: planar polygons triangulated in their plane, non-planar ones
+/// as the fan from their centroid ([`triangulated`]), so the file holds the surface every
+/// command measures.
+fn triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
+    let t = triangulated(mesh);
+    t.faces().map(|f| [f[0], f[1], f[2]].map(|v| t.positions()[v as usize])).collect()
+}
+
+/// Writes binary STL. Polygon faces are triangulated ([`triangles`]); STL stores f32,
 /// so coordinates are rounded to f32 and a round trip is exact only to f32.
 pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
-    let count_triangles: usize = mesh.faces().map(|f| f.len() - 2).sum();
+    let tris = triangles(mesh);
+    let count_triangles = tris.len();
     let count = u32::try_from(count_triangles).map_err(|_| {
         std::io::Error::other(format!("{count_triangles} triangles are too many for binary STL"))
     })?;
@@ -316,9 +324,7 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     header[..note.len()].copy_from_slice(note);
     w.write_all(&header)?;
     w.write_all(&count.to_le_bytes())?;
-    let pos = mesh.positions();
-    for [a, b, c] in triangles(mesh) {
-        let (a, b, c) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+    for [a, b, c] in tris {
         let n = (b - a).cross(c - a).normalize_or_zero();
         for v in [n, a, b, c] {
             for x in v.to_array() {
@@ -334,10 +340,8 @@ pub fn write(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
 /// texgeo reads them back exactly; other readers round them to f32.
 pub fn write_ascii(out: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
-    let pos = mesh.positions();
     writeln!(w, "solid texgeo")?;
     for [a, b, c] in triangles(mesh) {
-        let (a, b, c) = (pos[a as usize], pos[b as usize], pos[c as usize]);
         let n = (b - a).cross(c - a).normalize_or_zero();
         writeln!(w, "facet normal {} {} {}", n.x as f32, n.y as f32, n.z as f32)?;
         writeln!(w, "  outer loop")?;
