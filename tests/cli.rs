@@ -319,7 +319,7 @@ fn a_gpu_method_without_a_vulkan_driver_suggests_a_cpu_one() {
 }
 
 #[test]
-fn coordinates_that_overflow_area_or_volume_are_refused() {
+fn coordinates_whose_area_or_volume_overflow_are_refused() {
     let dir = TempDir::new("cli-huge");
     let huge = dir.join("huge.off");
     let m = texgeo::mesh::procedural::cube().map_positions(|p| p * 1e200).unwrap();
@@ -333,6 +333,164 @@ fn coordinates_that_overflow_area_or_volume_are_refused() {
     ] {
         assert_refused(&texgeo(&args), &["overflows f64", "1e200"]);
     }
+    // 10⁸⁰: the volume is 8·10²⁴⁰, which f64 holds: measured, not refused.
+    let big = dir.join("big.off");
+    let m = texgeo::mesh::procedural::cube().map_positions(|p| p * 1e80).unwrap();
+    texgeo::mesh::formats::write(&big, &m).unwrap();
+    let big = big.to_str().unwrap();
+    let o = texgeo(&["mesh", "stats", big]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (v, want) = (number_after(&stdout(&o), "volume"), 8.0 * 1e80f64.powi(3));
+    assert!((v - want).abs() <= 1e-12 * want, "{v}");
+    for args in [
+        vec!["inclusion", big, "--random", "10", "--method", "cpu"],
+        vec!["voxelize", big, "--res", "8", "--method", "cpu", "-o", &out],
+    ] {
+        let o = texgeo(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    }
+}
+
+/// `builtin:cube` scaled by `s`, written to `dir/name`.
+fn scaled_cube(dir: &TempDir, name: &str, s: f64) -> String {
+    let path = dir.join(name);
+    let m = texgeo::mesh::procedural::cube().map_positions(|p| p * s).unwrap();
+    texgeo::mesh::formats::write(&path, &m).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// Tiny coordinates: the cube scaled by 2⁻³⁰⁰ (products of coordinates 2⁻⁹⁰⁰) and by
+/// 10⁻¹⁴⁰ (products underflow f64) gets the unit cube's labels at the points scaled the
+/// same way, from every inclusion method, and the unit cube's voxels.
+#[test]
+fn tiny_meshes_get_the_unit_meshes_answers() {
+    let dir = TempDir::new("cli-tiny");
+    let steps = [-1.5, -1.0, -0.5, 0.0, 0.25, 1.0, 1.5];
+    let mut grid: Vec<[f64; 3]> = Vec::new();
+    for x in steps {
+        for y in steps {
+            for z in steps {
+                grid.push([x, y, z]);
+            }
+        }
+    }
+    let points = |name: &str, s: f64| {
+        let path = dir.join(name);
+        let text: String =
+            grid.iter().map(|p| format!("{:e} {:e} {:e}\n", p[0] * s, p[1] * s, p[2] * s)).collect();
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let labels = |mesh: &str, pts: &str, method: &str| {
+        let out = dir.join("labels.txt");
+        let o =
+            texgeo(&["inclusion", mesh, "--points", pts, "--method", method, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{method} {mesh}: {}", stderr(&o));
+        std::fs::read_to_string(&out).unwrap()
+    };
+    let unit_points = points("unit.txt", 1.0);
+    let scales = [2f64.powi(-300), 1e-140];
+    let cases: Vec<(String, String)> = scales
+        .iter()
+        .enumerate()
+        .map(|(i, &s)| (scaled_cube(&dir, &format!("tiny{i}.off"), s), points(&format!("tiny{i}.txt"), s)))
+        .collect();
+    for method in [
+        "auto",
+        "cpu",
+        "bvh",
+        "octants",
+        "tetragrid",
+        "jordan",
+        "jordan-octree",
+        "winding",
+        "voxel-space",
+        "gpu",
+        "cpu+gpu",
+        "gpu+tetragrid",
+    ] {
+        let want = labels("builtin:cube", &unit_points, method);
+        // The centre is inside, a far corner outside: the unit cube's answer is right.
+        let lines: Vec<&str> = want.lines().collect();
+        assert_eq!(lines.len(), grid.len());
+        assert_ne!(lines[grid.iter().position(|p| *p == [0.0; 3]).unwrap()], lines[0], "{method}");
+        for (mesh, pts) in &cases {
+            assert_eq!(labels(mesh, pts, method), want, "{method} on {mesh}");
+        }
+    }
+    // Voxels: the same bytes after the header, whose cube is the unit one's scaled.
+    let binvox = |mesh: &str, method: &str| {
+        let out = dir.join("v.binvox");
+        let o = texgeo(&["voxelize", mesh, "--res", "16", "--method", method, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{method} {mesh}: {}", stderr(&o));
+        let bytes = std::fs::read(&out).unwrap();
+        let at = bytes.windows(5).position(|w| w == b"data\n").unwrap() + 5;
+        let header = String::from_utf8(bytes[..at].to_vec()).unwrap();
+        (number_after(&header, "scale"), bytes[at..].to_vec())
+    };
+    for method in ["cpu", "scanline", "auto", "fgpu"] {
+        let (side, want) = binvox("builtin:cube", method);
+        for ((mesh, _), s) in cases.iter().zip(scales) {
+            let (tiny_side, got) = binvox(mesh, method);
+            assert_eq!(got, want, "{method} on {mesh}");
+            assert_eq!(tiny_side, side * s, "{method} on {mesh}");
+        }
+    }
+}
+
+/// The number after `label` on the line of `text` that has it.
+fn number_after(text: &str, label: &str) -> f64 {
+    let line = text.lines().find(|l| l.contains(label)).unwrap_or_else(|| panic!("no {label:?} in {text}"));
+    let rest = &line[line.find(label).unwrap() + label.len()..];
+    rest.split_whitespace().next().unwrap().trim_end_matches(',').parse().unwrap_or_else(|_| panic!("{line}"))
+}
+
+/// Volumes far from the origin: a cube at 10⁷ and its copy turned 90° about z (exactly:
+/// the coordinates are swapped), two shells 10⁷ apart, volume 16; and the union of the
+/// cube with its copy turned 10° about the origin, 8 + 8 (up to the rotation's rounding).
+#[test]
+fn volumes_far_from_the_origin_are_exact() {
+    let dir = TempDir::new("cli-far");
+    let cube = texgeo::mesh::procedural::cube();
+    let far = cube.map_positions(|p| p + glam::DVec3::new(1e7, 0.0, 0.0)).unwrap();
+    let turned = far.map_positions(|p| glam::DVec3::new(-p.y, p.x, p.z)).unwrap();
+    let (mut positions, mut faces) = (far.positions().to_vec(), Vec::new());
+    positions.extend_from_slice(turned.positions());
+    for f in far.faces() {
+        faces.push(f.to_vec());
+        faces.push(f.iter().map(|&i| i + 8).collect());
+    }
+    let both = texgeo::mesh::Mesh::new(positions, faces).unwrap();
+    let both_path = dir.join("both.off");
+    texgeo::mesh::formats::write(&both_path, &both).unwrap();
+    let o = texgeo(&["mesh", "stats", both_path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = number_after(&stdout(&o), "volume");
+    assert!((v - 16.0).abs() <= 1e-12 * 16.0, "{v}");
+
+    let far_path = dir.join("far.off");
+    texgeo::mesh::formats::write(&far_path, &far).unwrap();
+    let far_path = far_path.to_str().unwrap();
+    let out = dir.join("union.off");
+    let o = texgeo(&[
+        "boolean",
+        far_path,
+        far_path,
+        "--op",
+        "union",
+        "--transform-b",
+        "rotate y 10",
+        "--method",
+        "cpu",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = number_after(&stdout(&o), "volume");
+    assert!((v - 16.0).abs() <= 1e-12 * 16.0, "{v}");
+    let o = texgeo(&["mesh", "stats", out.to_str().unwrap()]);
+    let w = number_after(&stdout(&o), "volume");
+    assert!((w - 16.0).abs() <= 1e-12 * 16.0, "{w}");
 }
 
 #[test]

@@ -7,6 +7,8 @@
 //! refuse them.)
 
 use crate::mesh::Mesh;
+use crate::mesh::covering::Covering;
+use crate::mesh::frame::Frame;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate};
 use crate::mesh::solidity::{self, NotSolid, Policy};
 use crate::mesh::triangulate::TriangulateError;
@@ -39,15 +41,16 @@ fn remedy(defect: &solidity::Defect) -> &'static str {
     }
 }
 
-/// Checks one operand and returns its triangles (polygon faces tessellated as every
-/// command sees them, [`TriangleSoup::new`]; vertices welded by position): the shared solid check of every command, then what refinement
+/// Checks one operand, given in `frame`, and returns its triangles (polygon faces tessellated
+/// as every command sees them, [`TriangleSoup::new`]; vertices welded by position): the
+/// shared solid check of every command, then what refinement
 /// needs on top (faces with area, a volume). `allow_self_intersections` excuses faces that
 /// cross; an inverted operand is refused (the command flips it first when asked).
-pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
+pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
     if mesh.num_faces() == 0 {
         return Err(InputError::Empty);
     }
-    let solid = solidity::check(mesh);
+    let solid = solidity::check_in(mesh, frame);
     let policy = Policy { allow_self_intersections, ..Policy::default() };
     if let Some(defect) = solidity::first_refusal(&solid, policy) {
         return Err(NotSolid { defect: defect.clone() }.into());
@@ -63,7 +66,8 @@ pub fn check(mesh: &Mesh, allow_self_intersections: bool) -> Result<TriangleSoup
     if let Some(t) = (0..soup.triangles.len()).find(|&t| is_degenerate(soup.triangle(t))) {
         return Err(InputError::Degenerate { face: soup.face_of[t] as usize });
     }
-    let volume = solid.volume.unwrap_or(0.0);
+    // In the frame: the volume in the input's units may underflow.
+    let volume = Covering::new(mesh).volume();
     let (lo, hi) = mesh.bounds();
     if volume.abs() <= 1e-12 * (hi - lo).max_element().powi(3) {
         return Err(InputError::Flat);
@@ -88,6 +92,10 @@ mod tests {
         Mesh::new(m.positions().to_vec(), faces).unwrap()
     }
 
+    fn check_unit(m: &Mesh, allow: bool) -> Result<TriangleSoup, InputError> {
+        check(m, Frame::IDENTITY, allow)
+    }
+
     fn defect(r: Result<TriangleSoup, InputError>) -> Defect {
         match r {
             Err(InputError::NotSolid(e)) => e.defect,
@@ -98,16 +106,16 @@ mod tests {
     #[test]
     fn refusals_name_the_reason() {
         let cube = procedural::cube();
-        assert!(check(&cube, false).is_ok());
-        assert!(check(&procedural::two_cubes_sharing_edge(), false).is_ok());
-        assert!(check(&procedural::cube_with_cavity(), false).is_ok());
-        assert!(check(&procedural::l_prism(), false).is_ok());
+        assert!(check_unit(&cube, false).is_ok());
+        assert!(check_unit(&procedural::two_cubes_sharing_edge(), false).is_ok());
+        assert!(check_unit(&procedural::cube_with_cavity(), false).is_ok());
+        assert!(check_unit(&procedural::l_prism(), false).is_ok());
         let open = Mesh::new(cube.positions().to_vec(), cube.faces().skip(1).map(<[u32]>::to_vec).collect())
             .unwrap();
-        assert!(matches!(defect(check(&open, false)), Defect::Open(_)));
-        assert!(matches!(defect(check(&flipped(&cube, |f| f == 2), false)), Defect::Open(_)));
+        assert!(matches!(defect(check_unit(&open, false)), Defect::Open(_)));
+        assert!(matches!(defect(check_unit(&flipped(&cube, |f| f == 2), false)), Defect::Open(_)));
         assert!(
-            matches!(defect(check(&flipped(&cube, |_| true), false)), Defect::Inverted { volume } if (volume + 8.0).abs() < 1e-12)
+            matches!(defect(check_unit(&flipped(&cube, |_| true), false)), Defect::Inverted { volume } if (volume + 8.0).abs() < 1e-12)
         );
         let s = procedural::sphere(6, 8);
         let two = {
@@ -118,12 +126,12 @@ mod tests {
             f.extend(s.faces().map(|x| x.iter().map(|&i| i + n).collect::<Vec<_>>()));
             Mesh::new(p, f).unwrap()
         };
-        let e = check(&two, false).unwrap_err();
+        let e = check_unit(&two, false).unwrap_err();
         assert!(
             matches!(&e, InputError::NotSolid(n) if matches!(n.defect, Defect::SelfIntersecting { .. } | Defect::CrossingShells { .. })),
             "{e}"
         );
         assert!(e.to_string().contains("--allow-self-intersections"), "{e}");
-        assert!(check(&two, true).is_ok());
+        assert!(check_unit(&two, true).is_ok());
     }
 }

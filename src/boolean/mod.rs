@@ -28,6 +28,7 @@ use rayon::prelude::*;
 use crate::gpu::Context;
 use crate::inclusion::{self, Method, solver::Solver};
 use crate::mesh::Mesh;
+use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
 
 pub mod cgal;
@@ -127,6 +128,9 @@ pub struct Evaluation {
     pub timings: Timings,
     /// Name of the inclusion method used.
     pub method: String,
+    /// The operands' common frame ([`crate::mesh::frame`]): everything above is in it,
+    /// [`Evaluation::result`] gives the result back in the operands' units.
+    pub frame: Frame,
 }
 
 /// The two operands' names in messages (e.g. their file names).
@@ -142,21 +146,22 @@ impl Default for Names<'_> {
     }
 }
 
-/// Checks both operands (in parallel) and returns their triangles.
+/// Checks both operands, given in `frame` (in parallel), and returns their triangles.
 pub fn check_operands(
     a: &Mesh,
     b: &Mesh,
     names: Names,
+    frame: Frame,
     allow_self: bool,
 ) -> Result<(TriangleSoup, TriangleSoup)> {
-    let (ra, rb) = rayon::join(|| input::check(a, allow_self), || input::check(b, allow_self));
+    let (ra, rb) = rayon::join(|| input::check(a, frame, allow_self), || input::check(b, frame, allow_self));
     let sa = ra.map_err(|reason| BooleanError::Input { name: names.a.to_string(), reason })?;
     let sb = rb.map_err(|reason| BooleanError::Input { name: names.b.to_string(), reason })?;
     Ok((sa, sb))
 }
 
-/// Evaluates A against B (§6.3): checks, refinement, classification. `ctx` is needed by
-/// the GPU inclusion methods.
+/// Evaluates A against B (§6.3): checks, refinement, classification, in the operands'
+/// common [`Frame`] (scale-free). `ctx` is needed by the GPU inclusion methods.
 pub fn evaluate(
     a: &Mesh,
     b: &Mesh,
@@ -166,7 +171,10 @@ pub fn evaluate(
 ) -> Result<Evaluation> {
     let mut timings = Timings::default();
     let start = Instant::now();
-    let (sa, sb) = check_operands(a, b, names, options.allow_self_intersections)?;
+    let frame = Frame::of(&[a, b]);
+    let (a, b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
+    let (a, b) = (a.as_ref(), b.as_ref());
+    let (sa, sb) = check_operands(a, b, names, frame, options.allow_self_intersections)?;
     timings.check = start.elapsed();
 
     let build = |mesh: &Mesh, name: &str| {
@@ -218,7 +226,7 @@ pub fn evaluate(
     };
     let classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
     timings.classify = start.elapsed();
-    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method })
+    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame })
 }
 
 impl Evaluation {
@@ -226,11 +234,12 @@ impl Evaluation {
     /// result must be closed and consistently oriented; if it is not, that is a bug and
     /// is returned as [`BooleanError::NotClosed`].
     pub fn result(&self, op: Operation, regularized: bool) -> Result<Mesh> {
-        Ok(self.result_by_operand(op, regularized)?.0)
+        Ok(self.frame.mesh_out(self.result_by_operand(op, regularized)?.0)?)
     }
 
-    /// [`Evaluation::result`] and how many of its faces, the first ones, come from A (the
-    /// rest come from B), for pictures that colour faces by operand (Figs. 6-9 … 6-12).
+    /// [`Evaluation::result`] in the operands' frame and how many of its faces, the first
+    /// ones, come from A (the rest come from B), for pictures that colour faces by operand
+    /// (Figs. 6-9 … 6-12).
     pub fn result_by_operand(&self, op: Operation, regularized: bool) -> Result<(Mesh, usize)> {
         let (tris, from_a) = select::select(
             op,
@@ -252,8 +261,8 @@ impl Evaluation {
         Ok((mesh, from_a))
     }
 
-    /// Refined operand A (`b` false) or B (`b` true) as a mesh: its triangles with the cut
-    /// curve among their edges.
+    /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its
+    /// triangles with the cut curve among their edges.
     pub fn refined_operand(&self, b: bool) -> Mesh {
         let r = if b { &self.refinement.b } else { &self.refinement.a };
         select::assemble(&self.refinement.points, &r.triangles)

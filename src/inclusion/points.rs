@@ -19,6 +19,7 @@ use crate::mesh::MeshError;
 use crate::mesh::error::Location;
 use crate::mesh::formats::bounded;
 use crate::mesh::formats::text::{Lines, fast, parse_coord};
+use crate::mesh::frame::Frame;
 
 /// Whether `path` names a NumPy file (by extension).
 pub fn is_npy(path: &Path) -> bool {
@@ -114,6 +115,8 @@ pub struct PointReader {
     read: usize,
     /// Bytes of text per block.
     block: usize,
+    /// The frame the points are handed out in (the mesh's, [`PointReader::in_frame`]).
+    frame: Frame,
 }
 
 enum Source {
@@ -163,12 +166,25 @@ impl PointReader {
                 guard: bounded::Text::new("point-file"),
             }
         };
-        Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1) })
+        Ok(PointReader { path: path.into(), source, read: 0, block: block.max(1), frame: Frame::IDENTITY })
     }
 
     /// Points already in memory (random ones), handed out as one block; `name` names them.
     pub fn from_points(points: Vec<DVec3>, name: &str) -> PointReader {
-        PointReader { path: name.into(), source: Source::Whole(Some(points)), read: 0, block: block_size() }
+        PointReader {
+            path: name.into(),
+            source: Source::Whole(Some(points)),
+            read: 0,
+            block: block_size(),
+            frame: Frame::IDENTITY,
+        }
+    }
+
+    /// Hands the points out in `frame` ([`Frame::point_in`]): the frame of the mesh they
+    /// are classified against.
+    pub fn in_frame(mut self, frame: Frame) -> PointReader {
+        self.frame = frame;
+        self
     }
 
     /// About how many points the file holds: exact for `.npy` and for a text file read
@@ -196,6 +212,13 @@ impl PointReader {
         &mut self,
         f: impl Fn(Vec<DVec3>) -> T + Sync,
     ) -> Result<Option<Vec<T>>, MeshError> {
+        let frame = self.frame;
+        let f = |mut points: Vec<DVec3>| {
+            if !frame.is_identity() {
+                points.iter_mut().for_each(|p| *p = frame.point_in(*p));
+            }
+            f(points)
+        };
         let path = self.path.as_path();
         let io = |error| MeshError::Io { path: path.into(), error };
         let block_size = self.block;

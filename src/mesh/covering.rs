@@ -14,6 +14,61 @@
 use glam::DVec3;
 
 use super::Mesh;
+use super::disjoint_sets::UnionFind;
+use super::frame::Frame;
+
+/// What [`Covering::shell_measures`] finds for one shell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShellMeasures {
+    /// The apex of its tetras: the centre of its bounding box.
+    pub apex: DVec3,
+    /// Signed volume (Alg. 3-1).
+    pub volume: f64,
+    /// First moment Σ Vᵢ·(A+B+C−3·apex)/4 about the apex.
+    pub moment: DVec3,
+    /// Σ |Vᵢ|: the size the volume is small or large against.
+    pub magnitude: f64,
+}
+
+/// Neumaier's compensated sum: the rounding error of each addition is kept and added
+/// back at the end, so the result is as if summed in twice the precision.
+#[derive(Clone, Copy, Debug, Default)]
+struct Compensated {
+    sum: f64,
+    error: f64,
+}
+
+impl Compensated {
+    fn add(&mut self, x: f64) {
+        let t = self.sum + x;
+        self.error += if self.sum.abs() >= x.abs() { (self.sum - t) + x } else { (x - t) + self.sum };
+        self.sum = t;
+    }
+
+    fn value(self) -> f64 {
+        self.sum + self.error
+    }
+}
+
+/// Volume and area of `mesh` in its units, measured in its [`Frame`] (no product
+/// underflows or overflows at any size): what commands report for a mesh they hold.
+pub fn measures(mesh: &Mesh) -> (f64, f64) {
+    if mesh.num_faces() == 0 {
+        return (0.0, 0.0);
+    }
+    let frame = Frame::of(&[mesh]);
+    let c = Covering::new(&frame.mesh_in_ref(mesh));
+    (frame.volume_out(c.volume()), frame.area_out(c.area()))
+}
+
+/// The sum of `values`, compensated ([`Compensated`]): how shell volumes are added up.
+pub fn compensated_sum(values: impl IntoIterator<Item = f64>) -> f64 {
+    let mut sum = Compensated::default();
+    for x in values {
+        sum.add(x);
+    }
+    sum.value()
+}
 
 /// The simplicial covering of a polygon mesh's faces.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,23 +214,81 @@ impl Covering {
         sum / (4.0 * std::f64::consts::PI)
     }
 
-    /// Sum of the signed covering-tetra volumes with apex `o` (Alg. 3-1, §3.6.3).
+    /// Sum of the signed covering-tetra volumes with apex `o` (Alg. 3-1, §3.6.3), summed
+    /// with compensation.
     ///
     /// For a closed, consistently oriented mesh the result does not depend on `o`.
     pub fn signed_volume_about(&self, o: DVec3) -> f64 {
-        (0..self.triangles.len())
-            .map(|t| {
-                let [a, b, c] = self.triangle(t);
-                signed_tetra_volume(o, a, b, c)
-            })
-            .sum()
+        compensated_sum((0..self.triangles.len()).map(|t| {
+            let [a, b, c] = self.triangle(t);
+            signed_tetra_volume(o, a, b, c)
+        }))
     }
 
-    /// Signed volume (Alg. 3-1) with the apex at the centre of the bounding box, which keeps
-    /// the determinants small; positive for outward-facing orientation.
+    /// The faces of each shell (a connected component: faces sharing a vertex are
+    /// connected), ordered by first face. Every edge's twin lies in the same shell, so
+    /// each shell of a closed surface is closed.
+    pub fn shells(&self) -> Vec<Vec<u32>> {
+        let mut sets = UnionFind::new(self.num_mesh_vertices);
+        for f in 0..self.num_faces() {
+            let face = self.polygon(f);
+            for &v in &face[1..] {
+                sets.union(face[0], v);
+            }
+        }
+        let mut shell_of_root = vec![u32::MAX; self.num_mesh_vertices];
+        let mut shells: Vec<Vec<u32>> = Vec::new();
+        for f in 0..self.num_faces() {
+            let r = sets.find(self.polygon(f)[0]) as usize;
+            if shell_of_root[r] == u32::MAX {
+                shell_of_root[r] = shells.len() as u32;
+                shells.push(Vec::new());
+            }
+            shells[shell_of_root[r] as usize].push(f as u32);
+        }
+        shells
+    }
+
+    /// Signed volume and first moment of the faces `faces` (a closed shell), with the apex
+    /// at the centre of their bounding box: the differences to the apex are then (nearly)
+    /// exact however far the shell lies from the origin, and the determinants small. The
+    /// moment Σ Vᵢ·(A+B+C−3O)/4 is taken about that apex, which is returned too.
+    pub fn shell_measures(&self, faces: &[u32]) -> ShellMeasures {
+        let (lo, hi) = faces.iter().flat_map(|&f| self.polygon(f as usize)).fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(lo, hi), &v| {
+                let p = self.points[v as usize];
+                (lo.min(p), hi.max(p))
+            },
+        );
+        let apex = if lo.cmple(hi).all() { (lo + hi) * 0.5 } else { DVec3::ZERO };
+        let mut volume = Compensated::default();
+        let mut magnitude = 0.0;
+        let mut moment = [Compensated::default(), Compensated::default(), Compensated::default()];
+        for t in faces.iter().flat_map(|&f| self.face_triangles(f as usize)) {
+            let [a, b, c] = self.triangle(t);
+            let (a, b, c) = (a - apex, b - apex, c - apex);
+            let v = a.dot(b.cross(c)) / 6.0;
+            volume.add(v);
+            magnitude += v.abs();
+            let m = v * (a + b + c) * 0.25;
+            for (k, sum) in moment.iter_mut().enumerate() {
+                sum.add(m[k]);
+            }
+        }
+        ShellMeasures {
+            apex,
+            volume: volume.value(),
+            moment: DVec3::new(moment[0].value(), moment[1].value(), moment[2].value()),
+            magnitude,
+        }
+    }
+
+    /// Signed volume (Alg. 3-1), positive for outward-facing orientation: each shell's
+    /// volume about the centre of its own bounding box ([`Covering::shell_measures`]),
+    /// summed with compensation. Every command's volume is this one.
     pub fn volume(&self) -> f64 {
-        let (lo, hi) = self.bounds();
-        self.signed_volume_about((lo + hi) * 0.5)
+        compensated_sum(self.shells().iter().map(|s| self.shell_measures(s).volume))
     }
 
     /// Signed area of every covering triangle, measured along its face's vector area: a
@@ -208,25 +321,21 @@ impl Covering {
         self.face_vector_areas().iter().map(|v| v.length()).collect()
     }
 
-    /// Total surface area.
+    /// Total surface area, summed with compensation.
     pub fn area(&self) -> f64 {
-        self.face_areas().iter().sum()
+        compensated_sum(self.face_areas())
     }
 
-    /// The volume centroid Σ Vᵢ·(O+A+B+C)/4 / V over the covering tetras; `None` when the
-    /// volume is zero (relative to the bounding box).
+    /// The volume centroid Σ Vᵢ·(O+A+B+C)/4 / V over the covering tetras, each shell's
+    /// moment taken about its own apex ([`Covering::shell_measures`]); `None` when the
+    /// volume is zero (relative to Σ |Vᵢ|).
     pub fn centroid(&self) -> Option<DVec3> {
-        let (lo, hi) = self.bounds();
-        let o = (lo + hi) * 0.5;
-        let (mut v, mut m) = (0.0, DVec3::ZERO);
-        for t in 0..self.triangles.len() {
-            let [a, b, c] = self.triangle(t);
-            let vt = signed_tetra_volume(o, a, b, c);
-            v += vt;
-            m += vt * (o + a + b + c) * 0.25;
-        }
-        let scale = (hi - lo).max_element().powi(3);
-        (v.abs() > 1e-12 * scale).then(|| m / v)
+        let shells: Vec<ShellMeasures> = self.shells().iter().map(|s| self.shell_measures(s)).collect();
+        let v = compensated_sum(shells.iter().map(|s| s.volume));
+        let magnitude: f64 = shells.iter().map(|s| s.magnitude).sum();
+        // Σ (Vₛ·Oₛ + Mₛ) / V, as Σ Vₛ/V·Oₛ + Mₛ/V: no product of a volume and a far apex.
+        (v.abs() > 1e-12 * magnitude)
+            .then(|| shells.iter().fold(DVec3::ZERO, |g, s| g + s.apex * (s.volume / v) + s.moment / v))
     }
 
     /// The thesis' centroid (§3.6.1): face centroids weighted by their vertex counts,
@@ -301,6 +410,23 @@ mod tests {
         assert!(close(c.volume(), 8.0, 1e-13));
         assert!((c.centroid().unwrap() - DVec3::new(2.0, 2.5, 5.0)).length() < 1e-13);
         assert!((c.face_weighted_centroid().unwrap() - DVec3::new(2.0, 2.5, 5.0)).length() < 1e-13);
+    }
+
+    #[test]
+    fn shells_far_apart_measure_exactly() {
+        // Two unit-size boxes 10⁷ apart: about one apex between them the tetras reach 10¹³
+        // and the volume loses 10⁻⁴; each about its own box centre it is exact.
+        let a = quad_box(DVec3::new(1e7 - 1.0, -1.0, -1.0), DVec3::new(1e7 + 1.0, 1.0, 1.0));
+        let b = quad_box(DVec3::new(-1.0, 1e7 - 1.0, -1.0), DVec3::new(1.0, 1e7 + 1.0, 1.0));
+        let mut positions = a.positions().to_vec();
+        positions.extend_from_slice(b.positions());
+        let faces =
+            a.faces().map(<[u32]>::to_vec).chain(b.faces().map(|f| f.iter().map(|&i| i + 8).collect()));
+        let c = Covering::new(&Mesh::new(positions, faces.collect()).unwrap());
+        assert_eq!(c.shells().len(), 2);
+        assert_eq!(c.volume(), 16.0);
+        assert_eq!(c.area(), 48.0);
+        assert_eq!(c.centroid().unwrap(), DVec3::new(5e6, 5e6, 0.0));
     }
 
     #[test]

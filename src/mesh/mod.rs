@@ -8,6 +8,7 @@ pub mod covering;
 pub mod disjoint_sets;
 pub mod error;
 pub mod formats;
+pub mod frame;
 pub mod intersect;
 pub mod procedural;
 pub mod solidity;

@@ -15,7 +15,8 @@
 //!
 //! 1. **closed and consistently oriented**: every directed edge a→b is matched by a twin
 //!    b→a (non-manifold edges are fine when they pair up);
-//! 2. **measurable**: its area and volume are finite in f64;
+//! 2. **measurable**: its area and volume are finite in f64 (measured in the mesh's
+//!    [`Frame`], then scaled back: every size whose measures fit f64 is measurable);
 //! 3. **outward**: every shell (a connected component of faces) faces away from the
 //!    region it bounds, so that w = 0 outside and 1 inside. An outer shell has positive
 //!    volume, a shell inside it faces inwards (a cavity, negative volume), an island in
@@ -50,8 +51,9 @@
 
 use glam::DVec3;
 
-use super::covering::{Covering, UnbalancedEdge, signed_tetra_volume};
+use super::covering::{Covering, UnbalancedEdge, compensated_sum};
 use super::disjoint_sets::UnionFind;
+use super::frame::Frame;
 use super::{Mesh, intersect};
 
 /// Vertices sampled per shell to find how deep it is nested.
@@ -172,8 +174,40 @@ impl std::fmt::Display for Solidity {
     }
 }
 
-/// Measures `mesh` against the rule of the module docs and lists its defects.
+/// Measures `mesh` against the rule of the module docs and lists its defects, in the
+/// mesh's [`Frame`] (scale-free); the measures are in the mesh's units.
 pub fn check(mesh: &Mesh) -> Solidity {
+    let frame = Frame::of(&[mesh]);
+    check_in(&frame.mesh_in_ref(mesh), frame)
+}
+
+/// [`check`] of a mesh already in `frame`: its measures are reported in the input's
+/// units, and it is not measurable when they overflow there.
+pub fn check_in(mesh: &Mesh, frame: Frame) -> Solidity {
+    let mut report = check_framed(mesh);
+    let area = frame.area_out(report.area);
+    let volume = report.volume.map(|v| frame.volume_out(v));
+    if !area.is_finite() || volume.is_some_and(|v| !v.is_finite()) {
+        let largest = mesh.positions().iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
+        // Point 2 of the rule: after an open surface, before the rest.
+        let at = usize::from(matches!(report.defects.first(), Some(Defect::Open(_))));
+        report.defects.insert(at, Defect::Overflow { largest: frame.length_out(largest) });
+    }
+    report.area = area;
+    report.volume = volume;
+    for shell in &mut report.shells {
+        shell.volume = frame.volume_out(shell.volume);
+    }
+    for d in &mut report.defects {
+        if let Defect::Inverted { volume } = d {
+            *volume = frame.volume_out(*volume);
+        }
+    }
+    report
+}
+
+/// [`check`] in the mesh's own units.
+fn check_framed(mesh: &Mesh) -> Solidity {
     let covering = Covering::new(mesh);
     let area = covering.area();
     let mut report = Solidity { area, volume: None, shells: Vec::new(), defects: Vec::new() };
@@ -181,23 +215,9 @@ pub fn check(mesh: &Mesh) -> Solidity {
     if let Some(e) = unbalanced {
         report.defects.push(Defect::Open(e));
     }
-    let (lo, hi) = mesh.bounds();
-    let apex = (lo + hi) * 0.5;
-    let groups = shells_of(mesh);
-    let volumes: Vec<f64> = groups
-        .iter()
-        .map(|faces| {
-            faces
-                .iter()
-                .flat_map(|&f| covering.face_triangles(f as usize))
-                .map(|t| {
-                    let [a, b, c] = covering.triangle(t);
-                    signed_tetra_volume(apex, a, b, c)
-                })
-                .sum()
-        })
-        .collect();
-    let volume: f64 = volumes.iter().sum();
+    let groups = covering.shells();
+    let volumes: Vec<f64> = groups.iter().map(|faces| covering.shell_measures(faces).volume).collect();
+    let volume = compensated_sum(volumes.iter().copied());
     report.shells = groups
         .iter()
         .zip(&volumes)
@@ -208,11 +228,6 @@ pub fn check(mesh: &Mesh) -> Solidity {
             depth: None,
         })
         .collect();
-    if !area.is_finite() || !volume.is_finite() {
-        let largest = mesh.positions().iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
-        report.defects.push(Defect::Overflow { largest });
-        return report;
-    }
     if unbalanced.is_some() {
         return report;
     }
@@ -225,28 +240,6 @@ pub fn check(mesh: &Mesh) -> Solidity {
         report.defects.push(Defect::SelfIntersecting { a, b });
     }
     report
-}
-
-/// The faces of each shell (vertex-connected components), ordered by first face.
-fn shells_of(mesh: &Mesh) -> Vec<Vec<u32>> {
-    let n = mesh.num_vertices();
-    let mut sets = UnionFind::new(n);
-    for face in mesh.faces() {
-        for &v in &face[1..] {
-            sets.union(face[0], v);
-        }
-    }
-    let mut shell_of_root = vec![u32::MAX; n];
-    let mut shells: Vec<Vec<u32>> = Vec::new();
-    for (f, face) in mesh.faces().enumerate() {
-        let r = sets.find(face[0]) as usize;
-        if shell_of_root[r] == u32::MAX {
-            shell_of_root[r] = shells.len() as u32;
-            shells.push(Vec::new());
-        }
-        shells[shell_of_root[r] as usize].push(f as u32);
-    }
-    shells
 }
 
 /// Fills each shell's depth: the winding number of the other shells around a few of its
@@ -430,8 +423,11 @@ pub fn first_refusal(solidity: &Solidity, policy: Policy) -> Option<&Defect> {
 /// A mesh a command may work on.
 #[derive(Clone, Debug)]
 pub struct Accepted {
-    /// The mesh to use: the input, or its [`flipped`] copy.
+    /// The mesh to use: the input, or its [`flipped`] copy, in [`Accepted::frame`].
     pub mesh: Mesh,
+    /// The scale the command works at: query points enter it, reported positions and
+    /// measures leave it ([`Frame`]).
+    pub frame: Frame,
     pub solidity: Solidity,
     /// The faces were reversed (`--flip-inverted`).
     pub flipped: bool,
@@ -459,7 +455,14 @@ pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
     let key = store.as_ref().map(|_| verdict_key(&mesh));
     if let (Some(store), Some(key)) = (&store, &key) {
         if let Some(solidity) = store.get(key).and_then(|b| decode_solid(&b)) {
-            return Ok(Accepted { mesh, solidity, flipped: false, non_solid: None });
+            let frame = Frame::of(&[&mesh]);
+            return Ok(Accepted {
+                mesh: frame.mesh_in(mesh),
+                frame,
+                solidity,
+                flipped: false,
+                non_solid: None,
+            });
         }
     }
     let accepted = require_solid_uncached(mesh, policy)?;
@@ -473,8 +476,9 @@ pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
 
 /// Names the rules of this module in every cached verdict's key: change it whenever what
 /// counts as a solid (or what [`check`] measures) changes, and old verdicts are not used.
-pub const RULES: &str = "texgeo solidity rules 1 (closed, measurable, outward, not self-intersecting)";
-const CACHE_KIND: &str = "solidity-v1";
+pub const RULES: &str =
+    "texgeo solidity rules 2 (closed, measurable, outward, not self-intersecting; in the mesh's frame)";
+const CACHE_KIND: &str = "solidity-v2";
 
 /// The cache key of `mesh`: its positions (bit for bit) and faces, under [`RULES`].
 pub fn verdict_key(mesh: &Mesh) -> crate::cache::Key {
@@ -541,23 +545,25 @@ fn decode_solid(b: &[u8]) -> Option<Solidity> {
 
 /// [`require_solid`] without the cache: always runs [`check`].
 pub fn require_solid_uncached(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
-    let solidity = check(&mesh);
+    let frame = Frame::of(&[&mesh]);
+    let mesh = frame.mesh_in(mesh);
+    let solidity = check_in(&mesh, frame);
     if let Some(d) = first_refusal(&solidity, policy) {
         return Err(NotSolid { defect: d.clone() });
     }
     if policy.flip_inverted && solidity.defects.iter().any(|d| matches!(d, Defect::Inverted { .. })) {
         let mesh = flipped(&mesh);
-        let solidity = check(&mesh);
+        let solidity = check_in(&mesh, frame);
         return match first_refusal(&solidity, Policy { flip_inverted: false, ..policy }) {
             None => {
                 let non_solid = solidity.defects.first().cloned();
-                Ok(Accepted { mesh, solidity, flipped: true, non_solid })
+                Ok(Accepted { mesh, frame, solidity, flipped: true, non_solid })
             }
             Some(d) => Err(NotSolid { defect: d.clone() }),
         };
     }
     let non_solid = solidity.defects.first().cloned();
-    Ok(Accepted { mesh, solidity, flipped: false, non_solid })
+    Ok(Accepted { mesh, frame, solidity, flipped: false, non_solid })
 }
 
 #[cfg(test)]
@@ -617,6 +623,26 @@ mod tests {
         // Two overlapping cubes: some vertices of each lie inside the other.
         let overlap = union(&[cube.clone(), box_between(DVec3::splat(0.0), DVec3::splat(2.0))]);
         assert!(matches!(check(&overlap).defects[..], [Defect::CrossingShells { .. }, ..]));
+    }
+
+    #[test]
+    fn any_size_is_checked_in_its_frame() {
+        let cube = procedural::cube();
+        // 2⁻³⁰⁰: products of coordinates are 2⁻⁹⁰⁰, yet the checks run at unit size.
+        let tiny = cube.map_positions(|p| p * 2f64.powi(-300)).unwrap();
+        let s = check(&tiny);
+        assert!(s.is_solid(), "{:?}", s.defects);
+        assert_eq!(s.volume, Some(8.0 * 2f64.powi(-900)));
+        let ok = require_solid(tiny, Policy::default()).unwrap();
+        assert_eq!((ok.frame.exponent(), &ok.mesh), (300, &cube));
+        // 10⁻¹⁴⁰: the volume underflows f64, the verdict does not.
+        let s = check(&cube.map_positions(|p| p * 1e-140).unwrap());
+        assert!(s.is_solid(), "{:?}", s.defects);
+        // 10⁸⁰: volume 8·10²⁴⁰, finite.
+        let s = check(&cube.map_positions(|p| p * 1e80).unwrap());
+        assert!(s.is_solid(), "{:?}", s.defects);
+        let want = 8.0 * 1e80f64.powi(3);
+        assert!((s.volume.unwrap() - want).abs() <= 1e-14 * want, "{:?}", s.volume);
     }
 
     #[test]

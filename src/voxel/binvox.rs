@@ -81,8 +81,8 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
 }
 
 fn header(out: &mut impl Write, grid: &Grid) -> std::io::Result<()> {
-    let (n, m) = (grid.n, grid.min);
-    write!(out, "#binvox 1\ndim {n} {n} {n}\ntranslate {} {} {}\nscale {}\ndata\n", m.x, m.y, m.z, grid.side)
+    let (n, (m, side)) = (grid.n, grid.cube_out());
+    write!(out, "#binvox 1\ndim {n} {n} {n}\ntranslate {} {} {}\nscale {}\ndata\n", m.x, m.y, m.z, side)
 }
 
 /// How [`write_scanline`] produced its file.

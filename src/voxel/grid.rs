@@ -11,6 +11,7 @@ use glam::DVec3;
 
 use super::error::{Result, VoxelError};
 use crate::mesh::Mesh;
+use crate::mesh::frame::Frame;
 
 /// Largest resolution texgeo voxelizes.
 pub const MAX_RES: usize = 1024;
@@ -24,6 +25,9 @@ pub struct Grid {
     pub min: DVec3,
     /// The cube's side (binvox `scale`).
     pub side: f64,
+    /// The frame `min` and `side` are in (the mesh's, [`crate::mesh::frame`]); binvox
+    /// headers give them back in the input's units.
+    pub frame: Frame,
 }
 
 impl Grid {
@@ -33,14 +37,14 @@ impl Grid {
         check_resolution(n)?;
         let (lo, hi) = mesh.bounds();
         if mesh.num_faces() == 0 {
-            return Ok(Grid { n, min: lo, side: 1.0 });
+            return Ok(Grid { n, min: lo, side: 1.0, frame: Frame::IDENTITY });
         }
         let side = (hi - lo).max_element();
         if side.is_nan() || side <= 0.0 || !side.is_finite() {
             return Err(VoxelError::Mesh(format!("its bounding box {lo} .. {hi} has no extent")));
         }
         let min = (lo + hi) * 0.5 - DVec3::splat(side * 0.5);
-        Ok(Grid { n, min, side })
+        Ok(Grid { n, min, side, frame: Frame::IDENTITY })
     }
 
     /// A grid with an explicit cube (e.g. from a binvox header).
@@ -49,7 +53,17 @@ impl Grid {
         if side.is_nan() || side <= 0.0 || !side.is_finite() || !min.is_finite() {
             return Err(VoxelError::Usage(format!("bad grid cube: min {min}, side {side}")));
         }
-        Ok(Grid { n, min, side })
+        Ok(Grid { n, min, side, frame: Frame::IDENTITY })
+    }
+
+    /// This grid, its cube being in `frame` (that of the mesh it was made for).
+    pub fn in_frame(self, frame: Frame) -> Grid {
+        Grid { frame, ..self }
+    }
+
+    /// The cube's minimum corner and side in the input's units (the binvox header).
+    pub fn cube_out(&self) -> (DVec3, f64) {
+        (self.frame.point_out(self.min), self.frame.length_out(self.side))
     }
 
     /// Voxel size h = s/N.

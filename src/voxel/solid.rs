@@ -47,14 +47,6 @@ impl Solid {
         Ok(Solid { triangles, apex })
     }
 
-    /// Signed volume Σ det(A−O, B−O, C−O)/6 over the covering (Alg. 3-1).
-    pub fn volume(&self) -> f64 {
-        self.triangles
-            .iter()
-            .map(|t| (t[0] - self.apex).dot((t[1] - self.apex).cross(t[2] - self.apex)) / 6.0)
-            .sum()
-    }
-
     /// The tetras (O, A, B, C) in grid units, vertices sorted by y, highest first (ties
     /// by x, then z), as the slicing of SPEC §4.2 wants them.
     pub fn sorted_tetras(&self, grid: &Grid) -> Vec<[DVec3; 4]> {

@@ -8,7 +8,8 @@ use texgeo::boolean::{self, Evaluation, Grouping, Names, Operation, Options, Tra
 use texgeo::gpu::Context;
 use texgeo::inclusion::Method;
 use texgeo::mesh::formats::{self, Format};
-use texgeo::mesh::{Mesh, covering::Covering, solidity};
+use texgeo::mesh::frame::Frame;
+use texgeo::mesh::{Mesh, covering, covering::Covering, solidity};
 use texgeo::render::{self, Look, Model, Renderer, View};
 
 use crate::mesh::MeshArg;
@@ -107,8 +108,13 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             Some(t) => t.apply(&m).with_context(|| format!("transforming {spec}"))?,
             None => m,
         };
-        // The operand checks refuse an inverted solid; asked to, flip it first.
-        Ok(if args.flip_inverted && Covering::new(&m).volume() < 0.0 { solidity::flipped(&m) } else { m })
+        // The operand checks refuse an inverted solid; asked to, flip it first (its sign
+        // taken in its frame, where the volume cannot underflow).
+        let inverted = || {
+            let frame = Frame::of(&[&m]);
+            Covering::new(&frame.mesh_in_ref(&m)).volume() < 0.0
+        };
+        Ok(if args.flip_inverted && inverted() { solidity::flipped(&m) } else { m })
     };
     let (a, b) = rayon::join(|| load(&args.a, ta), || load(&args.b, tb));
     let (a, b) = (a?, b?);
@@ -150,7 +156,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let write = write.elapsed();
 
     for (op, path, mesh) in &results {
-        let volume = if mesh.num_faces() == 0 { 0.0 } else { Covering::new(mesh).volume() };
+        let (volume, _) = covering::measures(mesh);
         say!(
             "A {} B{}: {} triangles, volume {volume} -> {}",
             op.symbol(),

@@ -99,14 +99,18 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         }
         crate::mesh::warn_non_solid(&args.mesh, defect);
     }
+    // Points are given in the mesh's units and classified in its frame.
+    let frame = solid.frame;
     let mut source = match (&args.points, args.random) {
         (Some(file), _) => points::PointReader::open(file)?,
         (_, Some(n)) => {
             let (lo, hi) = mesh.bounds();
+            let (lo, hi) = (frame.point_out(lo), frame.point_out(hi));
             points::PointReader::from_points(Rng::new(args.seed).points_in_box(n, lo, hi), "--random")
         }
         (None, None) => anyhow::bail!("give --points FILE or --random N"),
-    };
+    }
+    .in_frame(frame);
     let first = source.next_block()?;
     let ctx = if args.method.is_cpu() { None } else { Some(crate::open_context_for(device, "cpu")?) };
     let options = Options {

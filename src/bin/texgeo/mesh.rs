@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
+use texgeo::mesh::frame::Frame;
 use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
 use texgeo::mesh::{Mesh, formats, procedural};
 use texgeo::subdiv::Features;
@@ -187,7 +188,9 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
 
 /// Volume, area and centroids from the simplicial covering (SPEC §2).
 fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
-    let c = Covering::new(m);
+    // Measured in the mesh's frame (scale-free), reported in its units.
+    let frame = Frame::of(&[m]);
+    let c = Covering::new(&frame.mesh_in_ref(m));
     let (lo, hi) = m.bounds();
     say!("bounding box           {lo} .. {hi}");
     // + 0.0: an empty sum is −0.
@@ -196,7 +199,7 @@ fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
         Some(v) => {
             say!("volume                 {v} (signed tetrahedra, Alg. 3-1)");
             if let Some(g) = c.centroid() {
-                say!("centroid               {g} (volume)");
+                say!("centroid               {} (volume)", frame.point_out(g));
             }
         }
         None => {
@@ -207,6 +210,6 @@ fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
         }
     }
     if let Some(g) = c.face_weighted_centroid() {
-        say!("centroid               {g} (face vertices, thesis §3.6.1)");
+        say!("centroid               {} (face vertices, thesis §3.6.1)", frame.point_out(g));
     }
 }

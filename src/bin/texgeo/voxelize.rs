@@ -83,7 +83,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     let mesh = solid.mesh;
-    let grid = Grid::for_mesh(&mesh, args.res)?;
+    let grid = Grid::for_mesh(&mesh, args.res)?.in_frame(solid.frame);
     if let Some(defect) = &solid.non_solid {
         if let Choice::Method(m) = args.method {
             if m.uses_gpu() {

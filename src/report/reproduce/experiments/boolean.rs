@@ -9,7 +9,6 @@ use std::time::Duration;
 use super::{Model, Quantity, both, comparison, curve, models_table, num, ratio_curve, stand_ins};
 use crate::boolean::{Grouping, cgal};
 use crate::inclusion::Method;
-use crate::mesh::covering::Covering;
 use crate::mesh::{Mesh, procedural};
 use crate::report::Samples;
 use crate::report::Table;
@@ -40,7 +39,7 @@ fn quick_models() -> Vec<Model> {
 }
 
 fn volume(m: &Mesh) -> f64 {
-    if m.num_faces() == 0 { 0.0 } else { Covering::new(m).volume() }
+    crate::mesh::covering::measures(m).0
 }
 
 /// Element-wise sums of timed runs (the same runs of one evaluation's parts).
