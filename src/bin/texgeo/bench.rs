@@ -316,15 +316,9 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
                 let armadillo = models_dir.join("armadillo.off");
                 if armadillo.exists() { armadillo.into() } else { "builtin:knot".into() }
             });
-            let inclusion = Model {
-                name: mesh.to_string(),
-                mesh: crate::mesh::load_solid(&mesh, Default::default(), &[])?.mesh,
-            };
+            let inclusion = Model { name: mesh.to_string(), mesh: solid_in_its_units(&mesh)? };
             let voxel = match voxel_mesh {
-                Some(v) => Model {
-                    name: v.to_string(),
-                    mesh: crate::mesh::load_solid(&v, Default::default(), &[])?.mesh,
-                },
+                Some(v) => Model { name: v.to_string(), mesh: solid_in_its_units(&v)? },
                 None => Model { name: inclusion.name.clone(), mesh: inclusion.mesh.clone() },
             };
             anyhow::ensure!(points.iter().all(|&n| n > 0), "--points takes counts ≥ 1");
@@ -403,4 +397,11 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
             finish(bench::subdiv::run(&ctx, &list, settings)?, &common)
         }
     }
+}
+
+/// A mesh that must be a solid, in its own units (the benchmark writes its voxels and
+/// times the methods on the mesh as given).
+fn solid_in_its_units(spec: &crate::mesh::MeshArg) -> anyhow::Result<texgeo::mesh::Mesh> {
+    let solid = crate::mesh::load_solid(spec, Default::default(), &[])?;
+    Ok(solid.frame.mesh_out(solid.mesh)?)
 }
