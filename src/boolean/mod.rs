@@ -18,6 +18,8 @@
 //! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
 //!    not, picked from the same refinement and classification, then compacted.
 //!
+//! [`expr`] evaluates CSG expressions (`(a | b) - c`) as a tree of these operations.
+//!
 //! [`cgal`] runs the independent reference (CGAL corefinement with an exact kernel).
 
 use std::time::{Duration, Instant};
@@ -33,6 +35,7 @@ use crate::mesh::intersect::TriangleSoup;
 
 pub mod cgal;
 pub mod classify;
+pub mod expr;
 pub mod index;
 pub mod input;
 pub mod intersect;
