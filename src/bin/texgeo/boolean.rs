@@ -1,9 +1,12 @@
-//! `texgeo boolean`: Boolean operations on two closed solids (2006 thesis Ch. 6).
+//! `texgeo boolean`: Boolean operations on two closed solids (2006 thesis Ch. 6), or one
+//! operation folded over more; and the evaluation of expressions that `texgeo csg` shares.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
+use rayon::prelude::*;
+use texgeo::boolean::expr::{self, Expr};
 use texgeo::boolean::{self, Evaluation, Grouping, Names, Operation, Options, Transform};
 use texgeo::gpu::Context;
 use texgeo::inclusion::Method;
@@ -16,10 +19,11 @@ use crate::mesh::MeshArg;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The first solid: a closed mesh file or `builtin:NAME`.
-    a: MeshArg,
-    /// The second solid.
-    b: MeshArg,
+    /// The solids: closed mesh files or `builtin:NAME`. Every option takes two (A and B);
+    /// more than two are combined from the left with --op and -o: `A B C --op difference`
+    /// is (A − B) − C (like `texgeo csg "a - b - c"`).
+    #[arg(num_args = 2.., required = true, value_name = "SOLID")]
+    operands: Vec<MeshArg>,
     /// union, intersection, difference (A − B) or symmetric-difference.
     #[arg(long, required_unless_present = "all")]
     op: Option<String>,
@@ -34,6 +38,27 @@ pub struct Args {
     /// Transform of B (same steps as --transform-a).
     #[arg(long, value_name = "STEPS", allow_hyphen_values = true)]
     transform_b: Option<String>,
+    #[command(flatten)]
+    evaluate: Evaluate,
+    /// Output mesh (.obj .off .ply .stl) of --op.
+    #[arg(short, long, conflicts_with = "all", required_unless_present = "all")]
+    output: Option<PathBuf>,
+    /// Write every operation from the one refinement into DIR (union.EXT, …).
+    #[arg(long, value_name = "DIR")]
+    all: Option<PathBuf>,
+    /// File extension for --all.
+    #[arg(long, default_value = "off", requires = "all")]
+    format: String,
+    /// Also draw each written operation into DIR/OP.png (2006 thesis Figs. 6-9 … 6-12: the
+    /// operands in two colours with the cut curve, and beside them the result, its faces
+    /// coloured by operand).
+    #[arg(long, value_name = "DIR")]
+    pictures: Option<PathBuf>,
+}
+
+/// How `boolean` and `csg` evaluate and report.
+#[derive(clap::Args)]
+pub struct Evaluate {
     /// Inclusion method for the point tests: octants, gpu, cpu+gpu, gpu+tetragrid, cpu,
     /// bvh, tetragrid, jordan, jordan-octree, winding. The default is the fastest exact one
     /// for the few points grouped classification tests (measured: `texgeo bench boolean`);
@@ -50,34 +75,220 @@ pub struct Args {
     /// instead of refusing it.
     #[arg(long)]
     flip_inverted: bool,
-    /// Output mesh (.obj .off .ply .stl) of --op.
-    #[arg(short, long, conflicts_with = "all", required_unless_present = "all")]
-    output: Option<PathBuf>,
-    /// Write every operation from the one refinement into DIR (union.EXT, …).
-    #[arg(long, value_name = "DIR")]
-    all: Option<PathBuf>,
-    /// File extension for --all.
-    #[arg(long, default_value = "off", requires = "all")]
-    format: String,
-    /// Print triangle counts, cut triangles, groups, point tests saved and phase times.
+    /// Print triangle counts, cut triangles, groups, point tests saved and phase times
+    /// (of each operation, for several).
     #[arg(long)]
     stats: bool,
-    /// Also draw each written operation into DIR/OP.png (2006 thesis Figs. 6-9 … 6-12: the
-    /// operands in two colours with the cut curve, and beside them the result, its faces
-    /// coloured by operand).
-    #[arg(long, value_name = "DIR")]
-    pictures: Option<PathBuf>,
+}
+
+impl Evaluate {
+    fn options(&self) -> Options {
+        Options {
+            method: self.method,
+            grouping: if self.plain { Grouping::Plain } else { Grouping::Grouped },
+            allow_self_intersections: self.allow_self_intersections,
+            ..Options::default()
+        }
+    }
+}
+
+/// An operand of an expression as the command line gives it.
+pub struct Operand {
+    /// Its name in the expression.
+    pub name: String,
+    /// Its name in messages.
+    pub label: String,
+    pub mesh: MeshArg,
+    pub transform: Option<Transform>,
+}
+
+/// Checks that `path` can take a mesh (format by extension, not one of `inputs`).
+pub fn check_mesh_output(path: &Path, inputs: &[&MeshArg]) -> anyhow::Result<()> {
+    Format::from_path(path).with_context(|| format!("output {}", path.display()))?;
+    texgeo::output::check_output(path, &MeshArg::files(inputs.iter().copied()))?;
+    Ok(())
+}
+
+/// Reads an operand, transformed, and (asked to) with an inverted solid's faces reversed:
+/// the operand checks refuse an inverted solid.
+fn load_operand(spec: &MeshArg, t: Option<Transform>, flip_inverted: bool) -> anyhow::Result<Mesh> {
+    let m = crate::mesh::load(spec)?;
+    let m = match t {
+        Some(t) => t.apply(&m).with_context(|| format!("transforming {spec}"))?,
+        None => m,
+    };
+    // The operand checks refuse an inverted solid; asked to, flip it first (its sign taken
+    // in its frame, where the volume cannot underflow).
+    let inverted = || {
+        let frame = Frame::of(&[&m]);
+        Covering::new(&frame.mesh_in_ref(&m)).volume() < 0.0
+    };
+    Ok(if flip_inverted && inverted() { solidity::flipped(&m) } else { m })
+}
+
+/// The `--stats` lines of one evaluation of A against B, before its times.
+fn evaluation_lines(a: &str, b: &str, ev: &Evaluation) -> [String; 3] {
+    let r = &ev.refinement.stats;
+    let c = &ev.classification.stats;
+    [
+        format!(
+            "A: {a}  ({} triangles) | B: {b}  ({} triangles)",
+            ev.a.triangles.len(),
+            ev.b.triangles.len()
+        ),
+        format!(
+            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points ({} merged), cut triangles A {} B {}, refined triangles A {} B {}",
+            r.candidate_pairs,
+            r.meeting_pairs,
+            r.coplanar_pairs,
+            r.new_points,
+            r.merged_points,
+            r.cut_a,
+            r.cut_b,
+            ev.refinement.a.triangles.len(),
+            ev.refinement.b.triangles.len()
+        ),
+        format!(
+            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved), {} exact fallbacks",
+            ev.method,
+            c.triangles,
+            c.on,
+            c.groups,
+            c.point_tests,
+            100.0 * c.saved_share(),
+            c.exact_fallbacks
+        ),
+    ]
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn volume(mesh: &Mesh) -> f64 {
+    if mesh.num_faces() == 0 { 0.0 } else { covering::measures(mesh).0 }
+}
+
+/// Evaluates `expr` over `operands` (checked against it by the caller) into `output`
+/// (checked too): the body of `csg` and of `boolean` with more than two operands. `title`
+/// names the result in the report line.
+pub fn run_expression(
+    device: Option<&str>,
+    expr: &Expr,
+    operands: &[Operand],
+    output: &Path,
+    evaluate: &Evaluate,
+    title: &str,
+) -> anyhow::Result<()> {
+    let total = Instant::now();
+    let read = Instant::now();
+    let meshes: Vec<anyhow::Result<Mesh>> =
+        operands.par_iter().map(|o| load_operand(&o.mesh, o.transform, evaluate.flip_inverted)).collect();
+    let mut named = Vec::with_capacity(operands.len());
+    for (o, mesh) in operands.iter().zip(meshes) {
+        named.push(expr::Operand { name: o.name.clone(), label: o.label.clone(), mesh: mesh? });
+    }
+    let read = read.elapsed();
+
+    let ctx = if evaluate.method.is_cpu() { None } else { Some(crate::open_context(device)?) };
+    let mut lines = Vec::new();
+    let steps = expr.operations();
+    let result = expr::evaluate(expr, &named, &evaluate.options(), ctx.as_ref(), |s| {
+        if !evaluate.stats {
+            return;
+        }
+        let t = &s.evaluation.timings;
+        lines.push(format!(
+            "step {}/{steps}: {} {} {} = {}: {} triangles",
+            s.index,
+            s.names.a,
+            s.op.symbol(),
+            s.names.b,
+            s.expr,
+            s.result.num_faces()
+        ));
+        lines.extend(evaluation_lines(s.names.a, s.names.b, s.evaluation).map(|l| format!("  {l}")));
+        lines.push(format!(
+            "  time: checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly {:.1} ms)",
+            ms(t.check),
+            ms(t.refine),
+            ms(t.classifiers),
+            ms(t.classify),
+            ms(s.assemble)
+        ));
+    })?;
+    let booleans = total.elapsed() - read;
+    let write = Instant::now();
+    write_mesh(output, &result)?;
+    let write = write.elapsed();
+    say!("{title}: {} triangles, volume {} -> {}", result.num_faces(), volume(&result), output.display());
+    if evaluate.stats {
+        for l in &lines {
+            say!("{l}");
+        }
+        say!(
+            "time: read {:.1} ms, {steps} operation(s) {:.1} ms, write {:.1} ms, total {:.1} ms",
+            ms(read),
+            ms(booleans),
+            ms(write),
+            ms(total.elapsed())
+        );
+        if let Some(ctx) = &ctx {
+            say!("device: {}", ctx.info().label());
+        }
+    }
+    Ok(())
+}
+
+/// `boolean` with more than two operands: the left fold of --op, as an expression.
+fn run_many(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    let refused = [
+        (args.all.is_some(), "--all"),
+        (args.pictures.is_some(), "--pictures"),
+        (args.non_regularized, "--non-regularized"),
+        (args.transform_a.is_some(), "--transform-a"),
+        (args.transform_b.is_some(), "--transform-b"),
+    ];
+    if let Some((_, flag)) = refused.iter().find(|(given, _)| *given) {
+        anyhow::bail!(
+            "{flag} takes exactly two operands (for a transform of each of more, use `texgeo csg` with NAME=MESH@STEPS)"
+        );
+    }
+    let op: Operation = args.op.as_deref().context("--op is needed")?.parse().map_err(anyhow::Error::msg)?;
+    let output = args.output.as_deref().context("-o is needed")?;
+    check_mesh_output(output, &args.operands.iter().collect::<Vec<_>>())?;
+    // Operands are A, B, C, … in the report (A27, … past Z).
+    let letter =
+        |i: usize| if i < 26 { char::from(b'A' + i as u8).to_string() } else { format!("A{}", i + 1) };
+    let operands: Vec<Operand> = args
+        .operands
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| Operand {
+            name: letter(i),
+            label: spec.to_string(),
+            mesh: spec.clone(),
+            transform: None,
+        })
+        .collect();
+    let expr = Expr::fold(op, operands.iter().map(|o| o.name.clone())).context("no operands")?;
+    let title =
+        operands.iter().map(|o| o.name.as_str()).collect::<Vec<_>>().join(&format!(" {} ", op.symbol()));
+    run_expression(device, &expr, &operands, output, &args.evaluate, &title)
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    if args.operands.len() > 2 {
+        return run_many(device, args);
+    }
     let total = Instant::now();
     // Everything a user can get wrong is checked before any work.
-    let method = args.method;
+    let method = args.evaluate.method;
+    let (arg_a, arg_b) = (&args.operands[0], &args.operands[1]);
     let op: Option<Operation> = args.op.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
     let outputs: Vec<(Operation, PathBuf)> = match (&args.output, &args.all) {
         (Some(path), _) => {
-            Format::from_path(path).with_context(|| format!("output {}", path.display()))?;
-            texgeo::output::check_output(path, &MeshArg::files([&args.a, &args.b]))?;
+            check_mesh_output(path, &[arg_a, arg_b])?;
             let op = op.context("--op is needed with -o")?;
             vec![(op, path.clone())]
         }
@@ -89,7 +300,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             let paths: Vec<(Operation, PathBuf)> =
                 ops.into_iter().map(|o| (o, dir.join(format!("{}.{}", o.name(), args.format)))).collect();
             for (_, path) in &paths {
-                texgeo::output::check_not_input(path, &MeshArg::files([&args.a, &args.b]))?;
+                texgeo::output::check_not_input(path, &MeshArg::files([arg_a, arg_b]))?;
             }
             paths
         }
@@ -102,32 +313,14 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let tb = args.transform_b.as_deref().map(Transform::parse).transpose().map_err(anyhow::Error::msg)?;
 
     let read = Instant::now();
-    let load = |spec: &MeshArg, t: Option<Transform>| -> anyhow::Result<Mesh> {
-        let m = crate::mesh::load(spec)?;
-        let m = match t {
-            Some(t) => t.apply(&m).with_context(|| format!("transforming {spec}"))?,
-            None => m,
-        };
-        // The operand checks refuse an inverted solid; asked to, flip it first (its sign
-        // taken in its frame, where the volume cannot underflow).
-        let inverted = || {
-            let frame = Frame::of(&[&m]);
-            Covering::new(&frame.mesh_in_ref(&m)).volume() < 0.0
-        };
-        Ok(if args.flip_inverted && inverted() { solidity::flipped(&m) } else { m })
-    };
-    let (a, b) = rayon::join(|| load(&args.a, ta), || load(&args.b, tb));
+    let flip = args.evaluate.flip_inverted;
+    let (a, b) = rayon::join(|| load_operand(arg_a, ta, flip), || load_operand(arg_b, tb, flip));
     let (a, b) = (a?, b?);
     let read = read.elapsed();
 
     let ctx = if method.is_cpu() { None } else { Some(crate::open_context(device)?) };
-    let options = Options {
-        method,
-        grouping: if args.plain { Grouping::Plain } else { Grouping::Grouped },
-        allow_self_intersections: args.allow_self_intersections,
-        ..Options::default()
-    };
-    let (a_name, b_name) = (args.a.to_string(), args.b.to_string());
+    let options = args.evaluate.options();
+    let (a_name, b_name) = (arg_a.to_string(), arg_b.to_string());
     let names = Names { a: &a_name, b: &b_name };
     let ev = boolean::evaluate(&a, &b, names, &options, ctx.as_ref())?;
 
@@ -156,49 +349,20 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let write = write.elapsed();
 
     for (op, path, mesh) in &results {
-        let (volume, _) = covering::measures(mesh);
         say!(
-            "A {} B{}: {} triangles, volume {volume} -> {}",
+            "A {} B{}: {} triangles, volume {} -> {}",
             op.symbol(),
             if regularized { "" } else { " (non-regularized)" },
             mesh.num_faces(),
+            volume(mesh),
             path.display()
         );
     }
-    if args.stats {
-        let r = &ev.refinement.stats;
-        let c = &ev.classification.stats;
+    if args.evaluate.stats {
         let t = &ev.timings;
-        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-        say!(
-            "A: {}  ({} triangles) | B: {}  ({} triangles)",
-            args.a,
-            ev.a.triangles.len(),
-            args.b,
-            ev.b.triangles.len()
-        );
-        say!(
-            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points ({} merged), cut triangles A {} B {}, refined triangles A {} B {}",
-            r.candidate_pairs,
-            r.meeting_pairs,
-            r.coplanar_pairs,
-            r.new_points,
-            r.merged_points,
-            r.cut_a,
-            r.cut_b,
-            ev.refinement.a.triangles.len(),
-            ev.refinement.b.triangles.len()
-        );
-        say!(
-            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved), {} exact fallbacks",
-            ev.method,
-            c.triangles,
-            c.on,
-            c.groups,
-            c.point_tests,
-            100.0 * c.saved_share(),
-            c.exact_fallbacks
-        );
+        for line in evaluation_lines(&a_name, &b_name, &ev) {
+            say!("{line}");
+        }
         say!(
             "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly {:.1} ms), write {:.1} ms, total {:.1} ms",
             ms(read),

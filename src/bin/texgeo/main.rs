@@ -13,6 +13,7 @@ mod args;
 mod bench;
 mod boolean;
 mod check;
+mod csg;
 mod demo;
 mod inclusion;
 mod info;
@@ -76,8 +77,10 @@ enum Command {
     /// Every experiment of both theses in one report: tables beside the thesis', plots,
     /// pictures and a verdict on every claim (`--compare OLD NEW` compares two runs).
     Reproduce(reproduce::Args),
-    /// Boolean operations on two closed solids: union, intersection, difference, symmetric difference.
+    /// Boolean operations on closed solids: union, intersection, difference, symmetric difference.
     Boolean(boolean::Args),
+    /// A CSG expression over named solids: "(a | b) - c" with Python's set operators.
+    Csg(csg::Args),
 }
 
 /// Opens the device chosen by `--device` / `TEXGEO_DEVICE`.
@@ -145,6 +148,7 @@ fn main() {
         Command::View(a) => view::run(device, a),
         Command::Reproduce(a) => reproduce::run(device, a),
         Command::Boolean(a) => boolean::run(device, a),
+        Command::Csg(a) => csg::run(device, a),
     };
     if let Err(e) = result {
         note!("texgeo: error: {}", one_line(&e));
