@@ -321,7 +321,8 @@ pub fn evaluate(
     let mut count = 0;
     let (mesh, label) = eval(expr, operands, options, ctx, &mut count, &mut step)?;
     if let Cow::Borrowed(m) = &mesh {
-        super::input::check(m, options.allow_self_intersections)
+        let frame = crate::mesh::frame::Frame::of(&[m]);
+        super::input::check(&frame.mesh_in_ref(m), frame, options.allow_self_intersections)
             .map_err(|reason| BooleanError::Input { name: label, reason })?;
     }
     Ok(mesh.into_owned())
