@@ -40,29 +40,6 @@ fn on_lattice(inner: Mesh) -> Mesh {
     union(&[inner, cube_at(0.0, 1.0), cube_at(31.0, 32.0)])
 }
 
-/// The octahedron |x−o|+|y−o|+|z−o| ≤ r (8 triangles).
-fn octahedron(o: DVec3, r: f64) -> Mesh {
-    let p = vec![
-        o + DVec3::X * r,
-        o - DVec3::X * r,
-        o + DVec3::Y * r,
-        o - DVec3::Y * r,
-        o + DVec3::Z * r,
-        o - DVec3::Z * r,
-    ];
-    let f = vec![
-        vec![0, 2, 4],
-        vec![2, 1, 4],
-        vec![1, 3, 4],
-        vec![3, 0, 4],
-        vec![2, 0, 5],
-        vec![1, 2, 5],
-        vec![3, 1, 5],
-        vec![0, 3, 5],
-    ];
-    Mesh::new(p, f).unwrap()
-}
-
 /// A prism over the counter-clockwise polygon `xz` between y = y0 and y1, caps as n-gons.
 fn prism(xz: &[(f64, f64)], y0: f64, y1: f64) -> Mesh {
     let n = xz.len() as u32;
@@ -291,7 +268,7 @@ fn the_tie_rule_on_slanted_faces_edges_and_vertices() {
     // vertices pass through voxel centres.
     let mut v = Voxelizer::new(Some(gpu()));
     for (o, r) in [(16.0, 10.5), (15.0, 6.5), (16.0, 3.5)] {
-        let mesh = on_lattice(octahedron(DVec3::splat(o), r));
+        let mesh = on_lattice(procedural::octahedron(DVec3::splat(o), r));
         let (_, solid, expected) = exact_volume(&mesh, 32);
         // Cross-check the ray oracle with the tetra oracle on every centre.
         let grid = Grid::for_mesh(&mesh, 32).unwrap();

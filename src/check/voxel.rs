@@ -60,31 +60,6 @@ fn on_lattice(inner: Mesh) -> Result<Mesh, Stop> {
     union(&[inner, cube(0.0), cube(31.0)])
 }
 
-/// The octahedron |x−o|+|y−o|+|z−o| ≤ r: with o on a voxel corner and r a half-integer,
-/// its faces, edges and vertices pass through voxel centres.
-fn octahedron(o: f64, r: f64) -> Result<Mesh, Stop> {
-    let o = DVec3::splat(o);
-    let p = vec![
-        o + DVec3::X * r,
-        o - DVec3::X * r,
-        o + DVec3::Y * r,
-        o - DVec3::Y * r,
-        o + DVec3::Z * r,
-        o - DVec3::Z * r,
-    ];
-    let f = vec![
-        vec![0, 2, 4],
-        vec![2, 1, 4],
-        vec![1, 3, 4],
-        vec![3, 0, 4],
-        vec![2, 0, 5],
-        vec![1, 2, 5],
-        vec![3, 1, 5],
-        vec![0, 3, 5],
-    ];
-    Ok(Mesh::new(p, f)?)
-}
-
 /// The exact occupancy of every voxel centre by ray parity (the tie rule of `exact`).
 fn exact_volume(solid: &Solid, grid: &Grid) -> Result<Volume, Stop> {
     let mut v = Volume::new(grid.n)?;
@@ -128,7 +103,7 @@ fn method(ctx: &Context, method: Method, zone: Zone) -> Step {
     v.fallback = true;
     // Slanted faces, edges and vertices through centres; then a curved solid.
     for (o, r) in [(16.0, 10.5), (15.0, 6.5)] {
-        let mesh = on_lattice(octahedron(o, r)?)?;
+        let mesh = on_lattice(procedural::octahedron(DVec3::splat(o), r))?;
         let (grid, solid) = (Grid::for_mesh(&mesh, N)?, Solid::new(&mesh)?);
         let expected = exact_volume(&solid, &grid)?;
         let case = format!("octahedron at {o} of radius {r}");

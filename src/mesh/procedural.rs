@@ -122,6 +122,20 @@ pub fn tetrahedron() -> Mesh {
     mesh(positions, vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]])
 }
 
+/// The octahedron |x−o.x| + |y−o.y| + |z−o.z| ≤ r: 6 vertices, 8 triangles.
+pub fn octahedron(o: DVec3, r: f64) -> Mesh {
+    let positions = vec![
+        o + DVec3::X * r,
+        o - DVec3::X * r,
+        o + DVec3::Y * r,
+        o - DVec3::Y * r,
+        o + DVec3::Z * r,
+        o - DVec3::Z * r,
+    ];
+    let faces = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    mesh(positions, faces.iter().map(|f| f.to_vec()).collect())
+}
+
 /// A square pyramid: base [−1, 1]² at z = −1, apex (0, 0, 1); one quad and 4 triangles.
 pub fn pyramid() -> Mesh {
     let positions = vec![
