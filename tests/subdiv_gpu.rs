@@ -159,26 +159,11 @@ fn fragment_layout_on_the_cpu_equals_the_reference() {
     }
 }
 
-/// A cone over a 40-gon, triangulated: the apex has valence 40. With 64-texel rows every
-/// fragment around it spans several rows (the row split), and the result still matches.
-fn cone(sides: u32) -> Mesh {
-    let mut positions: Vec<DVec3> = (0..sides)
-        .map(|i| {
-            let a = std::f64::consts::TAU * f64::from(i) / f64::from(sides);
-            DVec3::new(a.cos(), a.sin(), 0.0)
-        })
-        .collect();
-    positions.push(DVec3::new(0.0, 0.0, 1.0));
-    let mut faces: Vec<Vec<u32>> = (0..sides).map(|i| vec![i, (i + 1) % sides, sides]).collect();
-    faces.push((0..sides).rev().collect());
-    Mesh::new(positions, faces).unwrap()
-}
-
 #[test]
 fn high_valence_fragments_span_rows() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
-    let mesh = cone(40);
+    let mesh = procedural::cone(40);
     let fragments = FragmentMesh::new(&mesh, 4).unwrap();
     let widest = fragments.runs().iter().map(|r| r.class.len(2)).max().unwrap();
     assert!(widest > 64 * 3, "the apex fragment ({widest} texels) should span several 64-texel rows");
@@ -192,10 +177,10 @@ fn limits_give_clear_errors() {
     let ctx = ctx();
     let mut sub = Subdivider::new(&ctx).unwrap();
     // One fragment over 2^24 texels: the cone's valence-40 apex at 12 fragment levels.
-    let fragments = FragmentMesh::new(&cone(40), 14).unwrap();
+    let fragments = FragmentMesh::new(&procedural::cone(40), 14).unwrap();
     let err = Packing::new(&fragments, 12, 16384, None).unwrap_err();
     assert!(matches!(err, SubdivError::GpuLimit(_)) && err.to_string().contains("valence 40"), "{err}");
-    let err = sub.refine(&ctx, &cone(40), 14, &Options::default()).unwrap_err();
+    let err = sub.refine(&ctx, &procedural::cone(40), 14, &Options::default()).unwrap_err();
     assert!(matches!(err, SubdivError::GpuLimit(_)), "{err}");
     // More texels than a texture holds.
     let err = Packing::new(&fragments, 3, 64, None).unwrap_err();

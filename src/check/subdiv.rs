@@ -210,28 +210,14 @@ fn boundary(ctx: &Context) -> Step {
     each(ctx, cases)
 }
 
-/// A cone over a `sides`-gon, triangulated: the apex has valence `sides`.
-fn cone(sides: u32) -> Result<Mesh, Stop> {
-    let mut positions: Vec<DVec3> = (0..sides)
-        .map(|i| {
-            let a = std::f64::consts::TAU * f64::from(i) / f64::from(sides);
-            DVec3::new(a.cos(), a.sin(), 0.0)
-        })
-        .collect();
-    positions.push(DVec3::new(0.0, 0.0, 1.0));
-    let mut faces: Vec<Vec<u32>> = (0..sides).map(|i| vec![i, (i + 1) % sides, sides]).collect();
-    faces.push((0..sides).rev().collect());
-    Ok(Mesh::new(positions, faces)?)
-}
-
 fn valence(ctx: &Context) -> Step {
     let narrow = Options { row_width: Some(64), ..Options::default() };
     each(
         ctx,
         vec![
-            ("cone(8)".into(), Surface::smooth(cone(8)?), 3, Options::default()),
-            ("cone(40), 64-texel rows".into(), Surface::smooth(cone(40)?), 3, narrow),
-            ("cone(40)".into(), Surface::smooth(cone(40)?), 3, Options::default()),
+            ("cone(8)".into(), Surface::smooth(procedural::cone(8)), 3, Options::default()),
+            ("cone(40), 64-texel rows".into(), Surface::smooth(procedural::cone(40)), 3, narrow),
+            ("cone(40)".into(), Surface::smooth(procedural::cone(40)), 3, Options::default()),
         ],
     )
 }

@@ -136,6 +136,21 @@ pub fn octahedron(o: DVec3, r: f64) -> Mesh {
     mesh(positions, faces.iter().map(|f| f.to_vec()).collect())
 }
 
+/// A cone over a regular `sides`-gon in z = 0 (its base one n-gon), apex (0, 0, 1), sides
+/// triangulated: the apex has valence `sides` (high-valence subdivision cases).
+pub fn cone(sides: u32) -> Mesh {
+    let mut positions: Vec<DVec3> = (0..sides)
+        .map(|i| {
+            let a = TAU * f64::from(i) / f64::from(sides);
+            DVec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    positions.push(DVec3::new(0.0, 0.0, 1.0));
+    let mut faces: Vec<Vec<u32>> = (0..sides).map(|i| vec![i, (i + 1) % sides, sides]).collect();
+    faces.push((0..sides).rev().collect());
+    mesh(positions, faces)
+}
+
 /// A square pyramid: base [−1, 1]² at z = −1, apex (0, 0, 1); one quad and 4 triangles.
 pub fn pyramid() -> Mesh {
     let positions = vec![
