@@ -1,0 +1,459 @@
+//! Implicit points: a point that is not stored as coordinates but as the input
+//! primitives that define it, so that predicates on it stay exact (Attene's indirect
+//! predicates). An intersection point rounded to f64 moves off the segment and the plane
+//! that define it; kept implicit, it lies on both exactly, and every orientation or
+//! order decided on it is the one of the real point.
+//!
+//! A point is either explicit (an f64 input vertex) or the crossing of a segment pq with
+//! the plane through a, b, c, written in homogeneous coordinates
+//!
+//! ```text
+//! (X, Y, Z, W) = (dp·q − dq·p, dp − dq),   dp = ((b − a) × (c − a))·(p − a), same for dq,
+//! ```
+//!
+//! whose entries are polynomials in the input coordinates. Two coplanar segments that
+//! cross are the same kind of point: pq against the plane through r, s and any point off
+//! their common plane.
+//!
+//! Each predicate evaluates its determinant first with interval arithmetic rounded
+//! outward (the filter: decided when the interval excludes zero), else exactly with
+//! expansions ([`Exact`]); the homogeneous coordinates are computed once per point for
+//! either. The sign convention is that of [`super::predicates`]: the predicates here
+//! agree with [`orient2d`](super::orient2d) and [`orient3d`](super::orient3d) on explicit
+//! points. Inputs are assumed to lie in a normalized frame (coordinates within 2^±60 or
+//! so, as [`crate::mesh::frame`] makes them): the exact path's products must neither
+//! overflow nor fall below f64's normal range.
+
+use std::cmp::Ordering;
+use std::sync::OnceLock;
+
+use glam::DVec3;
+
+use super::expansion::Exact;
+use super::predicates::{Sign, orient3d};
+
+/// A closed interval [lo, hi] that contains the exact value of what it was computed from:
+/// every operation rounds its ends outward by one ulp. NaN (∞ − ∞, 0·∞) never decides.
+#[derive(Clone, Copy, Debug)]
+struct Interval {
+    lo: f64,
+    hi: f64,
+}
+
+impl Interval {
+    fn point(x: f64) -> Interval {
+        Interval { lo: x, hi: x }
+    }
+
+    fn add(self, o: Interval) -> Interval {
+        Interval { lo: (self.lo + o.lo).next_down(), hi: (self.hi + o.hi).next_up() }
+    }
+
+    fn sub(self, o: Interval) -> Interval {
+        Interval { lo: (self.lo - o.hi).next_down(), hi: (self.hi - o.lo).next_up() }
+    }
+
+    fn mul(self, o: Interval) -> Interval {
+        let p = [self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi];
+        let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        // An exact product (a point times a point with no rounding) needs no widening,
+        // but telling costs more than the ulp.
+        Interval { lo: lo.next_down(), hi: hi.next_up() }
+    }
+
+    /// The sign when the interval vouches for it.
+    fn sign(self) -> Option<Sign> {
+        if self.lo > 0.0 {
+            Some(1)
+        } else if self.hi < 0.0 {
+            Some(-1)
+        } else if self.lo == 0.0 && self.hi == 0.0 {
+            Some(0)
+        } else {
+            None
+        }
+    }
+}
+
+/// The arithmetic the determinants are written in once: intervals for the filter,
+/// expansions for the exact value.
+trait Ring: Clone {
+    fn of(x: f64) -> Self;
+    fn plus(&self, o: &Self) -> Self;
+    fn minus(&self, o: &Self) -> Self;
+    fn times(&self, o: &Self) -> Self;
+}
+
+impl Ring for Interval {
+    fn of(x: f64) -> Self {
+        Interval::point(x)
+    }
+    fn plus(&self, o: &Self) -> Self {
+        self.add(*o)
+    }
+    fn minus(&self, o: &Self) -> Self {
+        self.sub(*o)
+    }
+    fn times(&self, o: &Self) -> Self {
+        self.mul(*o)
+    }
+}
+
+impl Ring for Exact {
+    fn of(x: f64) -> Self {
+        Exact::from_f64(x)
+    }
+    fn plus(&self, o: &Self) -> Self {
+        self + o
+    }
+    fn minus(&self, o: &Self) -> Self {
+        self - o
+    }
+    fn times(&self, o: &Self) -> Self {
+        self * o
+    }
+}
+
+/// What defines a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Definition {
+    /// An input vertex.
+    Explicit(DVec3),
+    /// Where segment pq crosses the plane through the three points (p and q strictly on
+    /// opposite sides of it).
+    EdgePlane { p: DVec3, q: DVec3, plane: [DVec3; 3] },
+}
+
+/// A point with exact predicates; see the module documentation.
+#[derive(Debug)]
+pub struct Point {
+    definition: Definition,
+    approx: [Interval; 4],
+    exact: OnceLock<[Exact; 4]>,
+}
+
+impl Clone for Point {
+    fn clone(&self) -> Point {
+        Point { definition: self.definition, approx: self.approx, exact: self.exact.clone() }
+    }
+}
+
+/// Why a point could not be made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ImplicitError {
+    #[error("the segment does not cross the plane: its ends are not strictly on opposite sides")]
+    NoCrossing,
+    #[error("the segments are not coplanar")]
+    NotCoplanar,
+    #[error("the point that should lie off the segments' plane lies in it")]
+    OffInPlane,
+}
+
+impl Point {
+    /// An input vertex.
+    pub fn explicit(p: DVec3) -> Point {
+        Point::new(Definition::Explicit(p))
+    }
+
+    /// Where segment pq crosses the plane through `plane` (exact test that p and q lie
+    /// strictly on opposite sides).
+    pub fn edge_plane(p: DVec3, q: DVec3, plane: [DVec3; 3]) -> Result<Point, ImplicitError> {
+        let [a, b, c] = plane;
+        if orient3d(a, b, c, p) * orient3d(a, b, c, q) >= 0 {
+            return Err(ImplicitError::NoCrossing);
+        }
+        Ok(Point::new(Definition::EdgePlane { p, q, plane }))
+    }
+
+    /// Where the coplanar segments pq and rs cross, `off` being any point off their common
+    /// plane (e.g. a vertex of the other mesh, or a point moved along the plane's normal):
+    /// pq against the plane through r, s and `off`. The segments must properly cross
+    /// (each one's ends strictly on opposite sides of the other's line).
+    pub fn edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3, off: DVec3) -> Result<Point, ImplicitError> {
+        if orient3d(p, q, r, s) != 0 {
+            return Err(ImplicitError::NotCoplanar);
+        }
+        if orient3d(p, q, r, off) == 0 {
+            return Err(ImplicitError::OffInPlane);
+        }
+        Point::edge_plane(p, q, [r, s, off])
+    }
+
+    fn new(definition: Definition) -> Point {
+        Point { definition, approx: homogeneous::<Interval>(&definition), exact: OnceLock::new() }
+    }
+
+    pub fn definition(&self) -> &Definition {
+        &self.definition
+    }
+
+    fn exact(&self) -> &[Exact; 4] {
+        self.exact.get_or_init(|| homogeneous::<Exact>(&self.definition))
+    }
+
+    /// The sign of W (never zero): homogeneous determinants are multiplied by it.
+    fn w_sign(&self) -> Sign {
+        match self.approx[3].sign() {
+            Some(s) => s,
+            None => self.exact()[3].sign(),
+        }
+    }
+
+    /// The coordinates rounded to f64 (within a few ulps of the real point): for output and
+    /// for constructions, never for decisions.
+    pub fn position(&self) -> DVec3 {
+        match self.definition {
+            Definition::Explicit(p) => p,
+            Definition::EdgePlane { .. } => {
+                let [x, y, z, w] = self.exact().each_ref().map(Exact::approx);
+                DVec3::new(x / w, y / w, z / w)
+            }
+        }
+    }
+}
+
+/// (X, Y, Z, W) of a definition, in the ring R.
+fn homogeneous<R: Ring>(d: &Definition) -> [R; 4] {
+    match *d {
+        Definition::Explicit(p) => [R::of(p.x), R::of(p.y), R::of(p.z), R::of(1.0)],
+        Definition::EdgePlane { p, q, plane: [a, b, c] } => {
+            let v = |x: DVec3| [R::of(x.x), R::of(x.y), R::of(x.z)];
+            let diff = |x: &[R; 3], y: &[R; 3]| -> [R; 3] { std::array::from_fn(|i| x[i].minus(&y[i])) };
+            let (a3, b3, c3, p3, q3) = (v(a), v(b), v(c), v(p), v(q));
+            let (u, w) = (diff(&b3, &a3), diff(&c3, &a3));
+            let n: [R; 3] = std::array::from_fn(|i| {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                u[j].times(&w[k]).minus(&u[k].times(&w[j]))
+            });
+            let dot = |x: &[R; 3]| n[0].times(&x[0]).plus(&n[1].times(&x[1])).plus(&n[2].times(&x[2]));
+            let dp = dot(&diff(&p3, &a3));
+            let dq = dot(&diff(&q3, &a3));
+            let coord = |i: usize| dp.times(&q3[i]).minus(&dq.times(&p3[i]));
+            [coord(0), coord(1), coord(2), dp.minus(&dq)]
+        }
+    }
+}
+
+fn det2<R: Ring>(a: &R, b: &R, c: &R, d: &R) -> R {
+    a.times(d).minus(&b.times(c))
+}
+
+/// det [[a0 a1 a2] [b0 b1 b2] [c0 c1 c2]].
+fn det3<R: Ring>(a: [&R; 3], b: [&R; 3], c: [&R; 3]) -> R {
+    let m0 = det2(b[1], b[2], c[1], c[2]);
+    let m1 = det2(b[0], b[2], c[0], c[2]);
+    let m2 = det2(b[0], b[1], c[0], c[1]);
+    a[0].times(&m0).minus(&a[1].times(&m1)).plus(&a[2].times(&m2))
+}
+
+/// det of the 4×4 matrix with rows a, b, c, d.
+fn det4<R: Ring>(r: [&[R; 4]; 4]) -> R {
+    let minor = |skip: usize, col: usize| {
+        let rows: Vec<[&R; 3]> = (0..4)
+            .filter(|&i| i != skip)
+            .map(|i| {
+                let mut k = 0;
+                std::array::from_fn(|_| {
+                    if k == col {
+                        k += 1;
+                    }
+                    let e = &r[i][k];
+                    k += 1;
+                    e
+                })
+            })
+            .collect();
+        det3(rows[0], rows[1], rows[2])
+    };
+    // Expansion along the last column (W), which is 1 for explicit points.
+    let terms: Vec<R> = (0..4).map(|i| r[i][3].times(&minor(i, 3))).collect();
+    terms[1].minus(&terms[0]).plus(&terms[3].minus(&terms[2]))
+}
+
+/// Decides a determinant's sign: the filter first, the exact value when it cannot.
+fn decide(filter: impl FnOnce() -> Interval, exact: impl FnOnce() -> Exact) -> Sign {
+    filter().sign().unwrap_or_else(|| exact().sign())
+}
+
+/// [`orient3d`] on implicit points: positive when d lies on the side the normal
+/// (b − a) × (c − a) points to, zero when the four points are coplanar.
+pub fn orient3d_implicit(a: &Point, b: &Point, c: &Point, d: &Point) -> Sign {
+    let w = a.w_sign() * b.w_sign() * c.w_sign() * d.w_sign();
+    // det4 of rows (x, y, z, 1) is −((b − a) × (c − a))·(d − a); homogeneous rows scale it
+    // by the product of the W's.
+    -w * decide(
+        || det4([&a.approx, &b.approx, &c.approx, &d.approx]),
+        || det4([a.exact(), b.exact(), c.exact(), d.exact()]),
+    )
+}
+
+/// [`orient2d`](super::orient2d) of the projections of three implicit points on the
+/// plane of coordinates `axes` = [u, v]: positive when they turn counter-clockwise.
+pub fn orient2d_implicit(axes: [usize; 2], a: &Point, b: &Point, c: &Point) -> Sign {
+    let [u, v] = axes;
+    let w = a.w_sign() * b.w_sign() * c.w_sign();
+    let rows = |p: &[Interval; 4]| [p[u], p[v], p[3]];
+    let (ra, rb, rc) = (rows(&a.approx), rows(&b.approx), rows(&c.approx));
+    w * decide(
+        || det3([&ra[0], &ra[1], &ra[2]], [&rb[0], &rb[1], &rb[2]], [&rc[0], &rc[1], &rc[2]]),
+        || {
+            let (ea, eb, ec) = (a.exact(), b.exact(), c.exact());
+            det3([&ea[u], &ea[v], &ea[3]], [&eb[u], &eb[v], &eb[3]], [&ec[u], &ec[v], &ec[3]])
+        },
+    )
+}
+
+/// The order of two points along coordinate `axis`.
+pub fn compare_implicit(axis: usize, a: &Point, b: &Point) -> Ordering {
+    let w = a.w_sign() * b.w_sign();
+    let s = w * decide(
+        || a.approx[axis].mul(b.approx[3]).sub(b.approx[axis].mul(a.approx[3])),
+        || {
+            let (ea, eb) = (a.exact(), b.exact());
+            &(&ea[axis] * &eb[3]) - &(&eb[axis] * &ea[3])
+        },
+    );
+    s.cmp(&0)
+}
+
+/// True when two points are the same point.
+pub fn same_point(a: &Point, b: &Point) -> bool {
+    (0..3).all(|axis| compare_implicit(axis, a, b) == Ordering::Equal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::orient2d;
+    use crate::random::Rng;
+
+    fn rand_point(rng: &mut Rng) -> DVec3 {
+        rng.point_in_box(DVec3::splat(-1.0), DVec3::splat(1.0))
+    }
+
+    #[test]
+    fn explicit_points_agree_with_the_explicit_predicates() {
+        let mut rng = Rng::new(7);
+        for _ in 0..2000 {
+            let p: Vec<DVec3> = (0..4).map(|_| rand_point(&mut rng)).collect();
+            let e: Vec<Point> = p.iter().map(|&x| Point::explicit(x)).collect();
+            assert_eq!(orient3d_implicit(&e[0], &e[1], &e[2], &e[3]), orient3d(p[0], p[1], p[2], p[3]));
+            for axes in [[0, 1], [1, 2], [2, 0]] {
+                let q = |x: DVec3| [x[axes[0]], x[axes[1]]];
+                assert_eq!(orient2d_implicit(axes, &e[0], &e[1], &e[2]), orient2d(q(p[0]), q(p[1]), q(p[2])));
+            }
+        }
+        // Degenerate explicit cases, which only the exact path decides.
+        let (a, b) = (DVec3::new(0.1, 0.2, 0.3), DVec3::new(0.7, 0.5, 0.3));
+        let mid = Point::explicit(a + (b - a) * 0.5);
+        let (ea, eb) = (Point::explicit(a), Point::explicit(b));
+        assert_eq!(
+            orient2d_implicit([0, 1], &ea, &eb, &mid),
+            orient2d([a.x, a.y], [b.x, b.y], [mid.position().x, mid.position().y])
+        );
+    }
+
+    /// The crossing of pq with a plane lies exactly on line pq and exactly on the plane,
+    /// although its rounded coordinates do neither.
+    #[test]
+    fn an_edge_plane_point_lies_exactly_on_its_segment_and_its_plane() {
+        let mut rng = Rng::new(11);
+        let mut rounded_off = 0;
+        for _ in 0..500 {
+            let plane = [rand_point(&mut rng), rand_point(&mut rng), rand_point(&mut rng)];
+            let (p, q) = (rand_point(&mut rng), rand_point(&mut rng));
+            let Ok(x) = Point::edge_plane(p, q, plane) else { continue };
+            let [a, b, c] = plane.map(Point::explicit);
+            let (ep, eq) = (Point::explicit(p), Point::explicit(q));
+            assert_eq!(orient3d_implicit(&a, &b, &c, &x), 0);
+            for axes in [[0, 1], [1, 2], [2, 0]] {
+                assert_eq!(orient2d_implicit(axes, &ep, &eq, &x), 0);
+            }
+            let r = rand_point(&mut rng);
+            assert_eq!(orient3d_implicit(&ep, &eq, &Point::explicit(r), &x), 0);
+            // Strictly between p and q along every axis where they differ.
+            for axis in 0..3 {
+                let (lo, hi) = if p[axis] < q[axis] { (&ep, &eq) } else { (&eq, &ep) };
+                if p[axis] != q[axis] {
+                    assert_eq!(compare_implicit(axis, lo, &x), Ordering::Less);
+                    assert_eq!(compare_implicit(axis, &x, hi), Ordering::Less);
+                }
+            }
+            let at = x.position();
+            rounded_off += (orient3d(plane[0], plane[1], plane[2], at) != 0) as usize;
+        }
+        // The rounded points mostly miss the plane: that is what the implicit ones fix.
+        assert!(rounded_off > 100, "{rounded_off}");
+    }
+
+    #[test]
+    fn the_same_point_reached_two_ways_is_the_same() {
+        // Segment pq crosses the plane z = 0 at (0.25, 0.5, 0) — a dyadic point — and so
+        // does segment rs, through two different planes holding that point.
+        let p = DVec3::new(0.0, 0.0, -1.0);
+        let q = DVec3::new(0.5, 1.0, 1.0);
+        let flat = [DVec3::new(-3.0, 0.1, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(0.3, 5.0, 0.0)];
+        let x = Point::edge_plane(p, q, flat).unwrap();
+        let target = Point::explicit(DVec3::new(0.25, 0.5, 0.0));
+        assert!(same_point(&x, &target));
+        assert_eq!(x.position(), DVec3::new(0.25, 0.5, 0.0));
+        let tilted = [DVec3::new(0.25, 0.5, 0.0), DVec3::new(1.0, 0.0, 0.375), DVec3::new(-0.5, 0.75, -2.0)];
+        let y = Point::edge_plane(p, q, tilted).unwrap();
+        assert!(same_point(&x, &y));
+        assert_eq!(orient3d_implicit(&x, &y, &Point::explicit(p), &Point::explicit(q)), 0);
+        // Nearby but not the same.
+        let near = Point::explicit(DVec3::new(0.25, 0.5f64.next_up(), 0.0));
+        assert!(!same_point(&x, &near));
+        assert_eq!(compare_implicit(1, &x, &near), Ordering::Less);
+    }
+
+    #[test]
+    fn coplanar_segments_cross_at_one_exact_point() {
+        // Two segments in the plane x + y + z = 1 (not axis-aligned; dyadic coordinates,
+        // so that the inputs are exactly in it), crossing.
+        let on = |x: f64, y: f64| DVec3::new(x, y, 1.0 - x - y);
+        let (p, q) = (on(0.125, 0.25), on(0.75, 0.1875));
+        let (r, s) = (on(0.375, 0.0), on(0.3125, 0.625));
+        let off = DVec3::new(5.0, 5.0, 5.0);
+        let x = Point::edge_edge(p, q, r, s, off).unwrap();
+        let (ep, eq, er, es) =
+            (Point::explicit(p), Point::explicit(q), Point::explicit(r), Point::explicit(s));
+        assert_eq!(orient3d_implicit(&ep, &eq, &er, &x), 0);
+        for axes in [[0, 1], [1, 2], [2, 0]] {
+            assert_eq!(orient2d_implicit(axes, &ep, &eq, &x), 0);
+            assert_eq!(orient2d_implicit(axes, &er, &es, &x), 0);
+        }
+        // Another point off the plane names the same crossing.
+        let y = Point::edge_edge(r, s, p, q, DVec3::new(-2.0, 1.0, 0.5)).unwrap();
+        assert!(same_point(&x, &y));
+        assert_eq!(Point::edge_edge(p, q, r, s, on(0.875, 0.5)).unwrap_err(), ImplicitError::OffInPlane);
+        assert_eq!(Point::edge_edge(p, q, r, off, s).unwrap_err(), ImplicitError::NotCoplanar);
+        assert_eq!(Point::edge_plane(p, p, [r, s, off]).unwrap_err(), ImplicitError::NoCrossing);
+    }
+
+    /// Orientation tests among several implicit points agree with a direct evaluation on
+    /// points far enough from degenerate that rounding cannot matter.
+    #[test]
+    fn orientations_of_implicit_points_agree_with_their_rounded_positions_when_far_from_zero() {
+        let mut rng = Rng::new(3);
+        let mut pts = Vec::new();
+        while pts.len() < 40 {
+            let plane = [rand_point(&mut rng), rand_point(&mut rng), rand_point(&mut rng)];
+            if let Ok(x) = Point::edge_plane(rand_point(&mut rng), rand_point(&mut rng), plane) {
+                pts.push(x);
+            }
+        }
+        let mut decided = 0;
+        for w in pts.windows(4) {
+            let [a, b, c, d] = [&w[0], &w[1], &w[2], &w[3]].map(Point::position);
+            let v = ((b - a).cross(c - a)).dot(d - a);
+            let scale = (b - a).length() * (c - a).length() * (d - a).length();
+            if v.abs() > 1e-9 * scale && scale < 1e6 {
+                decided += 1;
+                assert_eq!(orient3d_implicit(&w[0], &w[1], &w[2], &w[3]), v.signum() as Sign);
+            }
+        }
+        assert!(decided > 20);
+    }
+}
