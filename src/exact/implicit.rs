@@ -46,11 +46,11 @@ impl Interval {
     }
 
     fn add(self, o: Interval) -> Interval {
-        Interval { lo: (self.lo + o.lo).next_down(), hi: (self.hi + o.hi).next_up() }
+        Interval { lo: (self.lo + o.lo).down(), hi: (self.hi + o.hi).up() }
     }
 
     fn sub(self, o: Interval) -> Interval {
-        Interval { lo: (self.lo - o.hi).next_down(), hi: (self.hi - o.lo).next_up() }
+        Interval { lo: (self.lo - o.hi).down(), hi: (self.hi - o.lo).up() }
     }
 
     fn mul(self, o: Interval) -> Interval {
@@ -59,7 +59,7 @@ impl Interval {
         let hi = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         // An exact product (a point times a point with no rounding) needs no widening,
         // but telling costs more than the ulp.
-        Interval { lo: lo.next_down(), hi: hi.next_up() }
+        Interval { lo: lo.down(), hi: hi.up() }
     }
 
     /// The sign when the interval vouches for it.
@@ -73,6 +73,30 @@ impl Interval {
         } else {
             None
         }
+    }
+}
+
+/// One ulp outward (`f64::next_up`/`next_down`, newer than the toolchain texgeo supports).
+trait Ulp {
+    fn up(self) -> f64;
+    fn down(self) -> f64;
+}
+
+impl Ulp for f64 {
+    fn up(self) -> f64 {
+        if self.is_nan() || self == f64::INFINITY {
+            self
+        } else if self == 0.0 {
+            f64::from_bits(1)
+        } else if self > 0.0 {
+            f64::from_bits(self.to_bits() + 1)
+        } else {
+            f64::from_bits(self.to_bits() - 1)
+        }
+    }
+
+    fn down(self) -> f64 {
+        -(-self).up()
     }
 }
 
@@ -403,7 +427,7 @@ mod tests {
         assert!(same_point(&x, &y));
         assert_eq!(orient3d_implicit(&x, &y, &Point::explicit(p), &Point::explicit(q)), 0);
         // Nearby but not the same.
-        let near = Point::explicit(DVec3::new(0.25, 0.5f64.next_up(), 0.0));
+        let near = Point::explicit(DVec3::new(0.25, 0.5f64.up(), 0.0));
         assert!(!same_point(&x, &near));
         assert_eq!(compare_implicit(1, &x, &near), Ordering::Less);
     }

@@ -4,6 +4,7 @@
 use glam::DVec3;
 
 pub mod boxgrid;
+pub mod constrained;
 pub mod covering;
 pub mod disjoint_sets;
 pub mod error;
