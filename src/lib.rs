@@ -20,6 +20,10 @@
 //!   texgeo runs on; [`random`]: seeded random numbers; [`terminal`]: every message for a
 //!   person.
 
+// Nothing a user can influence may panic through an unwrap: the library returns errors
+// (tests may unwrap).
+#![cfg_attr(not(test), deny(clippy::unwrap_used))]
+
 pub mod boolean;
 pub mod cache;
 pub mod check;
