@@ -6,7 +6,6 @@
 //! - [`gpu`]: every Vulkan object — device, textures, render targets, ping-pong, reduction,
 //!   readback, pipelines from reflected SPIR-V.
 //! - [`mesh`]: the polygon mesh, its file formats, validation and solidity checks.
-//! - [`tetragrid`]: the grid of cells listing the tetras that may touch each one.
 //! - [`inclusion`]: point in solid (Feito-Torres on the simplicial covering, and its peers).
 //! - [`voxel`]: solid voxelization by slicing tetras with XOR.
 //! - [`subdiv`]: Catmull-Clark subdivision with fragment meshes, checked against OpenSubdiv.
@@ -40,6 +39,5 @@ pub mod scratch;
 pub mod subdiv;
 pub mod sweep;
 pub mod terminal;
-pub mod tetragrid;
 pub mod view;
 pub mod voxel;

@@ -6,9 +6,9 @@ use std::path::Path;
 
 use glam::DVec3;
 use texgeo::gpu::Context;
+use texgeo::inclusion::cells::{Cells, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::mesh::procedural;
 use texgeo::random::Rng;
-use texgeo::tetragrid::{Cells, Growth, MIN_OFFSET, SPEC_OFFSET, TetraGrid, tetra_box_overlap};
 use texgeo::voxel::aspect::{self, Aspect, Material};
 use texgeo::voxel::{Grid, Method, binvox, pictures, voxelize};
 

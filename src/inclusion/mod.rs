@@ -53,6 +53,7 @@
 
 pub mod auto;
 pub mod bvh;
+pub mod cells;
 pub mod classifier;
 pub mod cpu;
 pub mod error;

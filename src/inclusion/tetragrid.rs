@@ -4,7 +4,7 @@
 //!
 //! Which cells a tetra touches is a *cover* function. The default is
 //! [`conservative_cover`], the conservative tetra rasterization of §4.4/§5.5.1
-//! ([`crate::tetragrid`]); the first cover, [`box_cover`] (the tetra's grown box, minus
+//! ([`super::cells`]); the first cover, [`box_cover`] (the tetra's grown box, minus
 //! cells clearly beyond one of its planes), stays available through
 //! [`GridClassifier::with_cover`]. A cover may list extra cells, never miss one: it must
 //! list every cell holding a point for which the tetra's verdict is not `Outside`.
@@ -14,11 +14,11 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+use super::cells::{Cells, Growth, TetraGrid};
 use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::cpu::FeitoTorres;
 use super::error::{InclusionError, Result};
 use super::tetra::{CompactPlanes, Kind, TetraPlanes};
-use crate::tetragrid::{Cells, Growth, TetraGrid};
 
 pub const DEFAULT_RESOLUTION: usize = 32;
 pub const RESOLUTIONS: Range<usize> = 2..65;

@@ -41,12 +41,12 @@ use std::time::Instant;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::cells::{Cells, TetraGrid};
 use super::classifier::{BuildStats, Class, Classifier, vec_bytes};
 use super::error::{InclusionError, Result};
 use super::surface::Surface;
 use crate::exact::orient2d;
 use crate::mesh::Mesh;
-use crate::tetragrid::{Cells, TetraGrid};
 use crate::voxel::exact::{crossing_ahead, inside_yz};
 
 /// Resolutions the method accepts (n³ cells).

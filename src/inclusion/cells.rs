@@ -1,7 +1,7 @@
 //! The TetraGrid (SPEC §3.2 item 4, §4.4; thesis §4.3.2.4, §5.5.1): an n³ grid of cubic
 //! cells, each listing every tetra that may touch it, filled by conservative
 //! rasterization of the tetras. The inclusion optimizer tests a point only against its
-//! cell's list ([`crate::inclusion::tetragrid`], on the CPU and the GPU); the voxelizer's
+//! cell's list ([`super::tetragrid`], on the CPU and the GPU); the voxelizer's
 //! slicing is where the rasterization comes from. This module depends on neither.
 //!
 //! ## Conservative rasterization
