@@ -360,7 +360,11 @@ impl FastWinding {
             apex: DVec3::ZERO,
         };
         let (h, eps, wpr) = (grid.h(), self.surface.eps(), n.div_ceil(64));
-        let slab = crate::voxel::volume::slab_height(n);
+        // A triangle's setup is paid once per slab it meets: slabs as tall as keeps every
+        // thread busy (eight per thread, as the scanline's planes), never below the
+        // rasterizers' height. Rows do not depend on the slabs, so neither does the volume.
+        let threads = rayon::current_num_threads();
+        let slab = n.div_ceil(8 * threads).max(crate::voxel::volume::slab_height(n));
         let lists = slab_lists(
             n,
             slab,
@@ -378,7 +382,8 @@ impl FastWinding {
             let mut boundary = vec![0u64; slices.len() * n * wpr];
             let mut alone = boundary.clone();
             for &t in list.iter().filter(|&&t| (t as usize) < own) {
-                self.near_centres(t as usize, grid, slices.clone(), |j, k, i, on| {
+                let corners = chain.triangles[t as usize];
+                self.near_centres(t as usize, corners, grid, slices.clone(), |j, k, i, on| {
                     let bits = if on { &mut boundary } else { &mut alone };
                     bits[((j - j0) * n + k) * wpr + i / 64] |= 1 << (i % 64);
                 });
@@ -457,30 +462,74 @@ impl FastWinding {
     }
 
     /// Calls `mark(j, k, i, on)` for the centres (j in `slices`) that may be within ε of
-    /// covering triangle `t`'s face: `on` when the exact predicate says they are; the others
-    /// are reported only for a polygon's triangle, whose plane they are near (where
-    /// [`Self::classify_point`] moves a point off the plane first).
+    /// covering triangle `t`'s face (`corners`, as [`Covering::triangle`] gives them): `on`
+    /// when the exact predicate says they are; the others are reported only for a polygon's
+    /// triangle, whose plane they are near (where [`Self::classify_point`] moves a point off
+    /// the plane first).
     fn near_centres(
         &self,
         t: usize,
+        corners: [DVec3; 3],
         grid: &Grid,
         slices: std::ops::Range<usize>,
         mut mark: impl FnMut(usize, usize, usize, bool),
     ) {
         let covering = self.surface.covering();
         let (eps, n, h) = (self.surface.eps(), grid.n, grid.h());
-        let [a, b, c] = covering.triangle(t);
+        let [a, b, c] = corners;
         let (lo, hi) = (a.min(b).min(c) - eps, a.max(b).max(c) + eps);
-        let face = covering.face_of[t] as usize;
-        let polygon = covering.face_triangles(face).len() > 1;
         let nrm = (b - a).cross(c - a);
         let (len, l1) = (nrm.length(), nrm.abs().element_sum());
         // Off the plane by more than ε (with room for rounding): not on the boundary.
         let off_plane = |p: DVec3| nrm.dot(p - a).abs() > (eps * (1.0 + 1e-9) + 1e-12 * p.distance(a)) * len;
-        let steep = nrm.x.abs() >= 1e-3 * l1;
-        let reach_x = (lo.x - a.x).abs().max((hi.x - a.x).abs());
         let js = index_range(grid.min.y, h, n, lo.y, hi.y);
         let ks = index_range(grid.min.z, h, n, lo.z, hi.z);
+        // Every centre reported below lies in the box [lo, hi] and passes `off_plane`. Most
+        // triangles have no such centre (ε is far below a voxel), and a pass over the few
+        // centres of the box shows it before the rows are walked: whatever their distance
+        // to a, those centres' `off_plane` thresholds are at most `threshold` (rounding is
+        // monotone), so a centre whose |n·(p − a)|, computed as `off_plane` computes it,
+        // exceeds `threshold` is off the plane.
+        let inner = |axis: usize, r: std::ops::Range<usize>| {
+            let (min, mut r) = (grid.min[axis], r);
+            while r.start < r.end && grid.centre_coord(min, r.start) < lo[axis] {
+                r.start += 1;
+            }
+            while r.start < r.end && grid.centre_coord(min, r.end - 1) > hi[axis] {
+                r.end -= 1;
+            }
+            r
+        };
+        let box_is = inner(0, index_range(grid.min.x, h, n, lo.x, hi.x));
+        let box_js = inner(1, js.start.max(slices.start)..js.end.min(slices.end));
+        let box_ks = inner(2, ks.clone());
+        if box_is.is_empty() || box_js.is_empty() || box_ks.is_empty() {
+            return;
+        }
+        let reach = |axis: usize, r: &std::ops::Range<usize>| {
+            let at = |i: usize| (grid.centre_coord(grid.min[axis], i) - a[axis]).abs();
+            at(r.start).max(at(r.end - 1))
+        };
+        let far = DVec3::new(reach(0, &box_is), reach(1, &box_js), reach(2, &box_ks)).length();
+        let threshold = (eps * (1.0 + 1e-9) + 1e-12 * far) * len;
+        let near_plane = box_js.clone().any(|j| {
+            let y = grid.centre_coord(grid.min.y, j);
+            box_ks.clone().any(|k| {
+                let z = grid.centre_coord(grid.min.z, k);
+                // Written so that NaN counts as near.
+                box_is.clone().any(|i| {
+                    let p = DVec3::new(grid.centre_coord(grid.min.x, i), y, z);
+                    !(nrm.dot(p - a).abs() > threshold)
+                })
+            })
+        });
+        if !near_plane {
+            return;
+        }
+        let face = covering.face_of[t] as usize;
+        let polygon = covering.face_triangles(face).len() > 1;
+        let steep = nrm.x.abs() >= 1e-3 * l1;
+        let reach_x = (lo.x - a.x).abs().max((hi.x - a.x).abs());
         for j in js.start.max(slices.start)..js.end.min(slices.end) {
             let y = grid.centre_coord(grid.min.y, j);
             if y < lo.y || y > hi.y {

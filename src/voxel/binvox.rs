@@ -60,8 +60,9 @@ pub fn write_to(out: &mut impl Write, grid: &Grid, volume: &Volume) -> std::io::
     // group holds the columns of all its x values (8·64·N² bits, 64 MiB at 1024³), so with
     // more threads each group gets fewer words and at most 8 groups are in memory at once:
     // the encoder never needs more than half the volume's size besides the volume.
+    // Small volumes are split too, so that every thread gets a group.
     let threads = rayon::current_num_threads().clamp(1, 8);
-    let g = (8 / threads).max(1);
+    let g = (8 / threads).min(wpr.div_ceil(threads)).max(1);
     let groups: Vec<usize> = (0..wpr).step_by(g).collect();
     for batch in groups.chunks(threads) {
         use rayon::prelude::*;
