@@ -196,6 +196,25 @@ fn voxelize_labels_every_centre_as_inclusion_does() {
     }
 }
 
+#[test]
+fn voxelize_gives_the_same_bits_for_any_thread_count() {
+    // The slabs are taller with fewer threads; the rows do not depend on them.
+    for (name, mesh) in non_solids() {
+        let fw = FastWinding::new(&mesh, 0).unwrap();
+        for n in [7, 33, 70] {
+            let grid = Grid::for_mesh(&mesh, n).unwrap();
+            let in_pool = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| fw.voxelize(&grid).unwrap())
+            };
+            let one = in_pool(1);
+            for threads in [2, 3, 5] {
+                assert_eq!(in_pool(threads), one, "{name} {n}³, {threads} threads");
+            }
+        }
+    }
+}
+
 fn save(dir: &TempDir, name: &str, mesh: &Mesh) -> String {
     let path = dir.join(name);
     formats::write(&path, mesh).unwrap();

@@ -512,17 +512,18 @@ impl FastWinding {
         };
         let far = DVec3::new(reach(0, &box_is), reach(1, &box_js), reach(2, &box_ks)).length();
         let threshold = (eps * (1.0 + 1e-9) + 1e-12 * far) * len;
-        let near_plane = box_js.clone().any(|j| {
-            let y = grid.centre_coord(grid.min.y, j);
-            box_ks.clone().any(|k| {
-                let z = grid.centre_coord(grid.min.z, k);
-                // Written so that NaN counts as near.
-                box_is.clone().any(|i| {
-                    let p = DVec3::new(grid.centre_coord(grid.min.x, i), y, z);
-                    !(nrm.dot(p - a).abs() > threshold)
+        // NaN counts as near.
+        let near_plane = threshold.is_nan()
+            || box_js.clone().any(|j| {
+                let y = grid.centre_coord(grid.min.y, j);
+                box_ks.clone().any(|k| {
+                    let z = grid.centre_coord(grid.min.z, k);
+                    box_is.clone().any(|i| {
+                        let d = nrm.dot(DVec3::new(grid.centre_coord(grid.min.x, i), y, z) - a).abs();
+                        d.is_nan() || d <= threshold
+                    })
                 })
-            })
-        });
+            });
         if !near_plane {
             return;
         }
