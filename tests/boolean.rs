@@ -295,3 +295,29 @@ fn bad_operands_are_refused_with_the_reason() {
         assert!(e.contains("second.off") && e.contains(want), "{e}");
     }
 }
+
+#[test]
+fn the_empty_solid_is_an_operand_and_a_result() {
+    let empty = Mesh::new(Vec::new(), Vec::new()).unwrap();
+    let cube = procedural::cube();
+    let (v, s) = (volume(&cube), area(&cube));
+    // A op ∅ and ∅ op A: (A ∪ ∅, A ∩ ∅, A − ∅, A ⊖ ∅) = (A, ∅, A, A), (∅ − A) = ∅.
+    for (a, b, a_is_cube) in [(&cube, &empty, true), (&empty, &cube, false), (&empty, &empty, false)] {
+        let ev = evaluate(a, b, Method::Octants, None);
+        for op in Operation::ALL {
+            let r = ev.result(op, true).unwrap_or_else(|e| panic!("{op}: {e}"));
+            let b_is_cube = !a_is_cube && b.num_faces() > 0;
+            let want = match op {
+                Operation::Union | Operation::SymmetricDifference => a_is_cube || b_is_cube,
+                Operation::Intersection => false,
+                Operation::Difference => a_is_cube,
+            };
+            if want {
+                assert!(r.report().is_closed(), "{op}");
+                assert!(close(volume(&r), v, v) && close(area(&r), s, s), "{op}: {}", volume(&r));
+            } else {
+                assert_eq!(r.num_faces(), 0, "{op}");
+            }
+        }
+    }
+}

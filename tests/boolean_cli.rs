@@ -181,3 +181,60 @@ fn bad_operands_exit_2_and_write_nothing() {
     }
     assert!(!Path::new("x.off").exists() && !Path::new("out.xyz").exists());
 }
+
+#[test]
+fn empty_results_are_written_in_every_format_and_read_back_as_operands() {
+    let sphere_volume = {
+        let out = temp("sphere.off");
+        assert!(texgeo(&["mesh", "convert", "builtin:sphere", out.to_str().unwrap()]).status.success());
+        volume(&out)
+    };
+    for ext in ["off", "obj", "ply", "stl"] {
+        // A − A, and A ∩ B of disjoint solids: no faces, a well-formed file.
+        for (name, transform, op) in
+            [("minus-itself", "scale 1", "difference"), ("disjoint", "translate 5 0 0", "intersection")]
+        {
+            let empty = temp(&format!("{name}.{ext}"));
+            let o = texgeo(&[
+                "boolean",
+                "builtin:cube",
+                "builtin:cube",
+                "--transform-b",
+                transform,
+                "--op",
+                op,
+                "-o",
+                empty.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{name}.{ext}: {}", stderr(&o));
+            assert_eq!(formats::read(&empty).unwrap().num_faces(), 0, "{name}.{ext}");
+            let o = texgeo(&["mesh", "stats", empty.to_str().unwrap()]);
+            assert!(stdout(&o).contains("solid: yes (empty)"), "{name}.{ext}: {}", stdout(&o));
+            // As an operand: sphere ∪ ∅ = sphere, ∅ − sphere = ∅.
+            let union = temp(&format!("{name}-{ext}-union.off"));
+            let o = texgeo(&[
+                "boolean",
+                "builtin:sphere",
+                empty.to_str().unwrap(),
+                "--op",
+                "union",
+                "-o",
+                union.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{name}.{ext}: {}", stderr(&o));
+            assert!((volume(&union) - sphere_volume).abs() <= 1e-12 * sphere_volume, "{name}.{ext}");
+            let none = temp(&format!("{name}-{ext}-none.off"));
+            let o = texgeo(&[
+                "boolean",
+                empty.to_str().unwrap(),
+                "builtin:sphere",
+                "--op",
+                "difference",
+                "-o",
+                none.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{name}.{ext}: {}", stderr(&o));
+            assert_eq!(formats::read(&none).unwrap().num_faces(), 0, "{name}.{ext}");
+        }
+    }
+}

@@ -1,10 +1,13 @@
 //! What a Boolean operand must be, checked before any work: a closed, consistently
-//! oriented solid of positive volume whose faces do not cross each other. Non-manifold
-//! solids (two cubes sharing an edge), cavities and polygon faces are fine.
+//! oriented solid of positive volume whose faces do not cross each other, or the empty
+//! solid (no faces). Non-manifold solids (two cubes sharing an edge), cavities and
+//! polygon faces are fine.
 //!
 //! Each refusal names the operand and the reason; the command exits with status 2 and
 //! writes nothing. (NaN and infinite coordinates never get this far: the mesh readers
 //! refuse them.)
+
+use glam::DVec3;
 
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
@@ -16,8 +19,6 @@ use crate::mesh::triangulate::TriangulateError;
 /// Why an operand is refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum InputError {
-    #[error("it has no faces")]
-    Empty,
     /// Not a valid solid by the rule every command follows ([`crate::mesh::solidity`]):
     /// open, inconsistently oriented, inverted, badly nested or self-intersecting.
     #[error("{}{}", .0.defect, remedy(&.0.defect))]
@@ -48,7 +49,8 @@ fn remedy(defect: &solidity::Defect) -> &'static str {
 /// cross; an inverted operand is refused (the command flips it first when asked).
 pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
     if mesh.num_faces() == 0 {
-        return Err(InputError::Empty);
+        // The empty solid: A ∪ ∅ = A, A ∩ ∅ = ∅, and so on, from the same steps.
+        return Ok(TriangleSoup::new(mesh));
     }
     let solid = solidity::check_in(mesh, frame);
     let policy = Policy { allow_self_intersections, ..Policy::default() };
@@ -69,16 +71,20 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
     // In the frame: the volume in the input's units may underflow.
     let volume = Covering::new(mesh).volume();
     let (lo, hi) = mesh.bounds();
-    if volume.abs() <= 1e-12 * (hi - lo).max_element().powi(3) {
+    if is_flat(volume, lo, hi) {
         return Err(InputError::Flat);
     }
     Ok(soup)
 }
 
+/// "It encloses no volume": |`volume`| at most 1e-12 × the cube of the largest extent of
+/// the box `lo`..`hi` (a solid flattened to a sheet, whatever its size).
+pub fn is_flat(volume: f64, lo: DVec3, hi: DVec3) -> bool {
+    volume.abs() <= 1e-12 * (hi - lo).max_element().powi(3)
+}
+
 #[cfg(test)]
 mod tests {
-    use glam::DVec3;
-
     use super::*;
     use crate::mesh::procedural;
     use crate::mesh::solidity::Defect;

@@ -20,6 +20,9 @@
 //!
 //! [`expr`] evaluates CSG expressions (`(a | b) - c`) as a tree of these operations.
 //!
+//! A mesh without faces is the empty solid, a valid operand and result: A ∪ ∅ = A,
+//! A ∩ ∅ = ∅, A − ∅ = A, ∅ − A = ∅, A ⊖ ∅ = A come out of the same steps.
+//!
 //! [`cgal`] runs the independent reference (CGAL corefinement with an exact kernel).
 
 use std::time::{Duration, Instant};
