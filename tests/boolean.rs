@@ -321,3 +321,28 @@ fn the_empty_solid_is_an_operand_and_a_result() {
         }
     }
 }
+
+#[test]
+fn a_sliver_difference_is_repaired_into_a_valid_operand() {
+    // The thin slivers of a sphere minus its copy turned 1e-6°: rounded to f64, some of
+    // their faces cross; the output check collapses the short edges there.
+    let sphere = procedural::sphere(16, 32);
+    let turned = moved(&sphere, DAffine3::from_axis_angle(DVec3::X, 1e-6f64.to_radians()));
+    let ev = evaluate(&sphere, &turned, Method::Octants, None);
+    let out = ev.output(Operation::Difference, true).unwrap_or_else(|e| panic!("{e}"));
+    assert!(out.repair.crossings > 0 && out.repair.collapsed_edges > 0, "{}", out.repair);
+    // A valid operand: the full check every operand gets (crossings, nesting, no area, volume).
+    let frame = texgeo::mesh::frame::Frame::of(&[&out.mesh]);
+    boolean::input::check(&frame.mesh_in_ref(&out.mesh), frame, false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(texgeo::mesh::solidity::check(&out.mesh).is_solid());
+    // The repair moved points by far less than the slivers are thick: the volume is the
+    // selected triangles' (the unchecked, non-regularized selection is the same here).
+    let selected = ev.result(Operation::Difference, false).unwrap();
+    let (got, want) = (volume(&out.mesh), volume(&selected));
+    assert!((got - want).abs() <= 1e-6 * want, "{got} vs {want}");
+    // And as an operand again: within a box around it, the slivers are what they were.
+    let around = boxed([-3.0; 3], [3.0; 3], false);
+    let again = evaluate(&out.mesh, &around, Method::Octants, None);
+    let r = again.result(Operation::Intersection, true).unwrap_or_else(|e| panic!("{e}"));
+    assert!(close(volume(&r), got, got), "{} vs {got}", volume(&r));
+}

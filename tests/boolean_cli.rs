@@ -238,3 +238,41 @@ fn empty_results_are_written_in_every_format_and_read_back_as_operands() {
         }
     }
 }
+
+#[test]
+fn a_sliver_difference_is_repaired_says_so_and_is_an_operand() {
+    // A sphere minus its copy turned 1e-6°: thin slivers whose faces cross once the
+    // intersection points are rounded, unless the output is repaired.
+    let out = temp("slivers.off");
+    let o = texgeo(&[
+        "boolean",
+        "builtin:sphere",
+        "builtin:sphere",
+        "--transform-b",
+        "rotate x 1e-6",
+        "--op",
+        "difference",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line =
+        stdout(&o).lines().find(|l| l.starts_with("difference after rounding")).unwrap_or("").to_string();
+    assert!(line.contains(" edges collapsed") && !line.contains(" 0 edges collapsed"), "{}", stdout(&o));
+    let stats = texgeo(&["mesh", "stats", out.to_str().unwrap()]);
+    assert!(stdout(&stats).contains("solid: yes"), "{}", stdout(&stats));
+    let again = temp("slivers-union.off");
+    let o = texgeo(&[
+        "boolean",
+        out.to_str().unwrap(),
+        "builtin:cube",
+        "--transform-b",
+        "translate 5 0 0",
+        "--op",
+        "union",
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

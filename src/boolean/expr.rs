@@ -18,7 +18,7 @@
 use std::borrow::Cow;
 use std::fmt;
 
-use super::{BooleanError, Evaluation, Names, Operation, Options};
+use super::{BooleanError, Evaluation, Names, Operation, Options, Repair};
 use crate::gpu::Context;
 use crate::mesh::Mesh;
 
@@ -294,6 +294,8 @@ pub struct Step<'a> {
     pub names: Names<'a>,
     pub evaluation: &'a Evaluation,
     pub result: &'a Mesh,
+    /// What the check of the result after rounding found and repaired.
+    pub repair: Repair,
     /// Wall time of picking and assembling the result.
     pub assemble: std::time::Duration,
 }
@@ -352,7 +354,7 @@ fn eval<'o>(
             let ev = super::evaluate(&a, &b, names, options, ctx)?;
             drop((a, b));
             let start = std::time::Instant::now();
-            let result = ev.result(*op, true)?;
+            let super::Output { mesh: result, repair, .. } = ev.output(*op, true)?;
             *count += 1;
             step(&Step {
                 index: *count,
@@ -361,6 +363,7 @@ fn eval<'o>(
                 names,
                 evaluation: &ev,
                 result: &result,
+                repair,
                 assemble: start.elapsed(),
             });
             Ok((Cow::Owned(result), format!("({expr})")))

@@ -17,6 +17,9 @@
 //!    classification tests; on lavapipe the GPU test's set-up alone costs more).
 //! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
 //!    not, picked from the same refinement and classification, then compacted.
+//! 4. **Output** — [`output`]: a regularized result is checked as an operand would be,
+//!    once rounded to f64, and repaired where rounding alone made faces cross or fold;
+//!    one that cannot be made valid is an error, never written.
 //!
 //! [`expr`] evaluates CSG expressions (`(a | b) - c`) as a tree of these operations.
 //!
@@ -42,6 +45,7 @@ pub mod expr;
 pub mod index;
 pub mod input;
 pub mod intersect;
+pub mod output;
 pub mod refine;
 pub mod select;
 pub mod snap;
@@ -49,6 +53,7 @@ pub mod transform;
 
 pub use classify::{Class, Classification, ClassifyStats, Grouping};
 pub use input::InputError;
+pub use output::{InvalidResult, Repair};
 pub use refine::{RefineStats, Refinement, Side};
 pub use select::Operation;
 pub use transform::Transform;
@@ -100,6 +105,10 @@ pub enum BooleanError {
         "internal error: the {op} is not closed ({boundary} boundary edge(s), {misoriented} misoriented); please report it"
     )]
     NotClosed { op: Operation, boundary: usize, misoriented: usize },
+    /// A regularized result that rounding to f64 left invalid and that could not be
+    /// repaired ([`output`]).
+    #[error("the {op} cannot be written as a valid solid: {reason}")]
+    Invalid { op: Operation, reason: InvalidResult },
 }
 
 pub type Result<T, E = BooleanError> = std::result::Result<T, E>;
@@ -235,36 +244,80 @@ pub fn evaluate(
     Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame })
 }
 
+/// One operation's result, as it is written.
+#[derive(Clone, Debug)]
+pub struct Output {
+    pub mesh: Mesh,
+    /// How many of its faces, the first ones, come from A (the rest come from B).
+    pub from_a: usize,
+    /// What the check after rounding found and repaired (nothing for non-regularized
+    /// results, which are not checked).
+    pub repair: Repair,
+}
+
 impl Evaluation {
-    /// The result of `op` (regularized or not) as a mesh of triangles. A regularized
-    /// result must be closed and consistently oriented; if it is not, that is a bug and
-    /// is returned as [`BooleanError::NotClosed`].
+    /// The result of `op` (regularized or not) as a mesh of triangles in the operands'
+    /// units: [`Evaluation::output`].
     pub fn result(&self, op: Operation, regularized: bool) -> Result<Mesh> {
-        Ok(self.frame.mesh_out(self.result_by_operand(op, regularized)?.0)?)
+        Ok(self.output(op, regularized)?.mesh)
     }
 
     /// [`Evaluation::result`] in the operands' frame and how many of its faces, the first
     /// ones, come from A (the rest come from B), for pictures that colour faces by operand
     /// (Figs. 6-9 … 6-12).
     pub fn result_by_operand(&self, op: Operation, regularized: bool) -> Result<(Mesh, usize)> {
-        let (tris, from_a) = select::select(
-            op,
-            regularized,
-            (&self.refinement.a.triangles, &self.classification.a),
-            (&self.refinement.b.triangles, &self.classification.b),
-        );
-        let mesh = select::assemble(&self.refinement.points, &tris);
-        if regularized {
-            let report = mesh.report();
-            if !report.is_closed() {
-                return Err(BooleanError::NotClosed {
-                    op,
-                    boundary: report.boundary_edges,
-                    misoriented: report.misoriented_edges,
-                });
+        let out = self.output_in_frame(op, regularized)?;
+        Ok((out.mesh, out.from_a))
+    }
+
+    /// The result of `op` in the operands' units. A regularized result must be closed and
+    /// consistently oriented (if it is not, that is a bug, returned as
+    /// [`BooleanError::NotClosed`]), and is checked and repaired after rounding
+    /// ([`output`]; [`BooleanError::Invalid`] when it cannot be made valid).
+    pub fn output(&self, op: Operation, regularized: bool) -> Result<Output> {
+        let out = self.output_in_frame(op, regularized)?;
+        Ok(Output { mesh: self.frame.mesh_out(out.mesh)?, ..out })
+    }
+
+    /// [`Evaluation::output`] in the operands' frame (a power-of-two scale: the rounding,
+    /// and so the check, is the same in the operands' units).
+    fn output_in_frame(&self, op: Operation, regularized: bool) -> Result<Output> {
+        let (r, c) = (&self.refinement, &self.classification);
+        let (tris, from_a) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
+        if !regularized {
+            let mesh = select::assemble(&r.points, &tris);
+            return Ok(Output { mesh, from_a, repair: Repair::default() });
+        }
+        let report = select::assemble(&r.points, &tris).report();
+        if !report.is_closed() {
+            return Err(BooleanError::NotClosed {
+                op,
+                boundary: report.boundary_edges,
+                misoriented: report.misoriented_edges,
+            });
+        }
+        // The same walk as `select`: which selected triangles are uncut input triangles.
+        let mut changed = Vec::with_capacity(tris.len());
+        for (from_a, side, classes) in [(true, &r.a, &c.a), (false, &r.b, &c.b)] {
+            for (t, &class) in classes.iter().enumerate() {
+                if op.keeps(from_a, class, regularized).is_some() {
+                    changed.push(side.cut[side.parent[t] as usize]);
+                }
             }
         }
-        Ok((mesh, from_a))
+        let first_new = (self.a.positions.len() + self.b.positions.len()) as u32;
+        let (lo, hi) = self
+            .a
+            .positions
+            .iter()
+            .chain(&self.b.positions)
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let diagonal = (hi - lo).length();
+        let done = output::finish(&r.points, first_new, &tris, &changed, diagonal)
+            .map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
+        let from_a = done.origin.iter().filter(|&&o| (o as usize) < from_a).count();
+        let repair = Repair { moved: self.frame.length_out(done.repair.moved), ..done.repair };
+        Ok(Output { mesh: select::assemble(&r.points, &done.triangles), from_a, repair })
     }
 
     /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its

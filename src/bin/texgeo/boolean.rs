@@ -208,8 +208,9 @@ pub fn run_expression(
             s.result.num_faces()
         ));
         lines.extend(evaluation_lines(s.names.a, s.names.b, s.evaluation).map(|l| format!("  {l}")));
+        lines.push(format!("  after rounding to f64: {}", s.repair));
         lines.push(format!(
-            "  time: checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly {:.1} ms)",
+            "  time: checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms)",
             ms(t.check),
             ms(t.refine),
             ms(t.classifiers),
@@ -326,14 +327,14 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
 
     let assemble = Instant::now();
     let regularized = !args.non_regularized;
-    let results: Vec<(Operation, PathBuf, Mesh)> = outputs
+    let results: Vec<(Operation, PathBuf, boolean::Output)> = outputs
         .into_iter()
-        .map(|(op, path)| Ok((op, path, ev.result(op, regularized)?)))
+        .map(|(op, path)| Ok((op, path, ev.output(op, regularized)?)))
         .collect::<anyhow::Result<_>>()?;
     let assemble = assemble.elapsed();
     let write = Instant::now();
-    for (_, path, mesh) in &results {
-        write_mesh(path, mesh)?;
+    for (_, path, out) in &results {
+        write_mesh(path, &out.mesh)?;
     }
     if let Some(dir) = &args.pictures {
         let ctx = match &ctx {
@@ -348,7 +349,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     }
     let write = write.elapsed();
 
-    for (op, path, mesh) in &results {
+    for (op, path, out) in &results {
+        let mesh = &out.mesh;
         say!(
             "A {} B{}: {} triangles, volume {} -> {}",
             op.symbol(),
@@ -363,8 +365,11 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         for line in evaluation_lines(&a_name, &b_name, &ev) {
             say!("{line}");
         }
+        for (op, _, out) in results.iter().filter(|_| regularized) {
+            say!("{op} after rounding to f64: {}", out.repair);
+        }
         say!(
-            "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly {:.1} ms), write {:.1} ms, total {:.1} ms",
+            "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms), write {:.1} ms, total {:.1} ms",
             ms(read),
             ms(t.check),
             ms(t.refine),

@@ -212,6 +212,7 @@ fn refusal(e: BooleanError) -> Failure {
         BooleanError::Input { reason: InputError::NotSolid(n), .. } => Failure::not_solid(n),
         BooleanError::Input { .. } => Failure::refused("invalid-operand", e),
         BooleanError::NotClosed { .. } => Failure::failed("open-result", e),
+        BooleanError::Invalid { .. } => Failure::failed("invalid-result", e),
         BooleanError::Refine(_) => Failure::failed("refine", e),
         BooleanError::Classify(_) | BooleanError::Inclusion { .. } => Failure::failed("classify", e),
         BooleanError::Mesh(_) => Failure::failed("mesh", e),

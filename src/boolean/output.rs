@@ -1,0 +1,448 @@
+//! The result as it is written: checked the way an operand is, once its points are
+//! rounded to f64, and repaired where the rounding alone made it invalid.
+//!
+//! The selected triangles bound a valid solid exactly, but the intersection points among
+//! their corners are stored rounded to f64. Where the surfaces meet at a tiny angle (a
+//! copy turned by 1e-6°) the slivers between them are thinner than that rounding near
+//! the cut curve, and a few of their triangles come to cross a neighbour or lose their
+//! area. So every regularized result is checked with the operand checks' exact tests
+//! ([`crate::mesh::intersect`]), restricted to what rounding can have changed:
+//!
+//! - faces that cross: only pairs with a *changed* triangle (one that is not an uncut
+//!   input triangle). Uncut triangles of one operand do not cross (the operand was
+//!   checked) and uncut ones of different operands were found apart by the refinement's
+//!   exact tests;
+//! - faces with no area, among the changed triangles;
+//! - the operand rule's volume, per shell and for the whole result.
+//!
+//! Closedness is checked by the caller. Nesting and orientation of shells are those of
+//! the exact result: rounding could change them only by making faces cross.
+//!
+//! **Repair.** For every crossing pair or flat triangle, its shortest edge with an
+//! intersection point at one end is collapsed if it is shorter than [`COLLAPSE`] × the
+//! operands' diagonal: the intersection point moves onto the other end (an input vertex
+//! never moves). A collapse keeps every directed edge balanced — the triangles on the
+//! edge vanish and their other edges pair up — so the result stays closed and oriented;
+//! two triangles that come to coincide with opposite orientations cancel. The moved
+//! triangles are checked again, for a few rounds. A shell that encloses no volume by the
+//! operand rule (a sliver flattened by rounding) is dropped whole. Anything still
+//! invalid is an error naming the faces and the place: never a silently invalid result.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::input::is_flat;
+use crate::mesh::covering::signed_tetra_volume;
+use crate::mesh::disjoint_sets::UnionFind;
+use crate::mesh::frame::Frame;
+use crate::mesh::intersect::{TriangleSoup, is_degenerate, soup_self_intersections_near, weld_by_position};
+
+/// Longest edge a repair collapses, relative to the operands' bounding-box diagonal: far
+/// below any feature of a real model (the volume moved is of the order of its square
+/// times the sliver's length), far above the slivers' widths near the cut curve.
+pub const COLLAPSE: f64 = 1e-7;
+
+/// Rounds of collapse and re-check before giving up.
+const ROUNDS: usize = 8;
+
+/// What the check found and the repair did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Repair {
+    /// Triangles tested against the others (those that are not uncut input triangles).
+    pub tested: usize,
+    /// Crossing triangle pairs found after rounding, before any repair.
+    pub crossings: usize,
+    /// Triangles without area after rounding, before any repair.
+    pub flat_triangles: usize,
+    /// Edges collapsed.
+    pub collapsed_edges: usize,
+    /// Triangles removed by the collapses (those on a collapsed edge, cancelling pairs).
+    pub removed_triangles: usize,
+    /// Shells dropped because they enclose no volume.
+    pub dropped_shells: usize,
+    /// Farthest any point moved.
+    pub moved: f64,
+}
+
+impl Repair {
+    /// True when the result was written as selected.
+    pub fn is_clean(&self) -> bool {
+        self.crossings == 0 && self.flat_triangles == 0 && self.dropped_shells == 0
+    }
+}
+
+impl std::fmt::Display for Repair {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} edges collapsed \
+             ({} triangles removed, points moved at most {:e}), {} flat shells dropped",
+            self.tested,
+            self.crossings,
+            self.flat_triangles,
+            self.collapsed_edges,
+            self.removed_triangles,
+            self.moved,
+            self.dropped_shells
+        )
+    }
+}
+
+/// Why a result could not be made valid.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum InvalidResult {
+    #[error(
+        "faces {a} and {b} cross near ({}, {}, {}) once rounded to f64, and no short edge there could be collapsed",
+        near.x, near.y, near.z
+    )]
+    Crossing { a: usize, b: usize, near: DVec3 },
+    #[error(
+        "face {face} near ({}, {}, {}) has no area once rounded to f64, and no short edge there could be collapsed",
+        near.x, near.y, near.z
+    )]
+    Flat { face: usize, near: DVec3 },
+    #[error("it encloses no volume once rounded to f64 (volume {volume}) but is not empty")]
+    NoVolume { volume: f64 },
+}
+
+impl InvalidResult {
+    /// The same, with its place and volume given in the operands' units.
+    pub fn out_of(self, frame: Frame) -> InvalidResult {
+        match self {
+            InvalidResult::Crossing { a, b, near } => InvalidResult::Crossing { a, b, near: frame.point_out(near) },
+            InvalidResult::Flat { face, near } => InvalidResult::Flat { face, near: frame.point_out(near) },
+            InvalidResult::NoVolume { volume } => InvalidResult::NoVolume { volume: frame.volume_out(volume) },
+        }
+    }
+}
+
+/// The triangles to write, for each the index in the selection it comes from, and what
+/// was done.
+#[derive(Clone, Debug)]
+pub struct Finished {
+    pub triangles: Vec<[u32; 3]>,
+    pub origin: Vec<u32>,
+    pub repair: Repair,
+}
+
+/// Checks (and repairs) the result triangles `tris` over `points`, whose ids from
+/// `first_new` on are intersection points. `changed[t]` is false for uncut input
+/// triangles; `diagonal` is the operands' bounding-box diagonal.
+pub fn finish(
+    points: &[DVec3],
+    first_new: u32,
+    tris: &[[u32; 3]],
+    changed: &[bool],
+    diagonal: f64,
+) -> Result<Finished, InvalidResult> {
+    let mut repair = Repair::default();
+    if tris.is_empty() {
+        return Ok(Finished { triangles: Vec::new(), origin: Vec::new(), repair });
+    }
+    // Points are identified by position, as when the file is read back.
+    let weld = weld_by_position(points);
+    let mut soup = TriangleSoup {
+        positions: points.to_vec(),
+        triangles: tris.iter().map(|t| t.map(|v| weld[v as usize])).collect(),
+        face_of: (0..tris.len() as u32).collect(),
+        failed: Vec::new(),
+    };
+    let mut origin: Vec<u32> = (0..tris.len() as u32).collect();
+    let mut changed = changed.to_vec();
+    repair.tested = changed.iter().filter(|&&c| c).count();
+    let limit = COLLAPSE * diagonal;
+    let is_new = |v: u32| v >= first_new;
+    for round in 0..=ROUNDS {
+        let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
+        let flat: Vec<usize> = (0..soup.triangles.len())
+            .into_par_iter()
+            .filter(|&t| changed[t] && is_degenerate(soup.triangle(t)))
+            .collect();
+        if round == 0 {
+            repair.crossings = crossings.len();
+            repair.flat_triangles = flat.len();
+        }
+        if crossings.is_empty() && flat.is_empty() {
+            break;
+        }
+        // Per defect, the shortest collapsible edge of its triangles: (length, keep, gone).
+        let shortest = |faces: &[usize]| -> Option<(f64, u32, u32)> {
+            faces
+                .iter()
+                .flat_map(|&f| {
+                    let t = soup.triangles[f];
+                    (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
+                })
+                .filter(|&(p, q)| is_new(p) || is_new(q))
+                .map(|(p, q)| {
+                    let (keep, gone) = if !is_new(p) {
+                        (p, q)
+                    } else if !is_new(q) {
+                        (q, p)
+                    } else {
+                        (p.min(q), p.max(q))
+                    };
+                    (points[p as usize].distance(points[q as usize]), keep, gone)
+                })
+                .filter(|e| e.0 <= limit)
+                .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
+        };
+        let crossing = |&(a, b): &(usize, usize)| InvalidResult::Crossing {
+            a,
+            b,
+            near: soup.triangle(a).iter().sum::<DVec3>() / 3.0,
+        };
+        let flat_face = |&face: &usize| InvalidResult::Flat {
+            face,
+            near: soup.triangle(face).iter().sum::<DVec3>() / 3.0,
+        };
+        let mut edges = Vec::new();
+        let mut stuck = None;
+        for c in &crossings {
+            match shortest(&[c.0, c.1]) {
+                Some(e) => edges.push(e),
+                None => stuck = stuck.or_else(|| Some(crossing(c))),
+            }
+        }
+        for f in &flat {
+            match shortest(&[*f]) {
+                Some(e) => edges.push(e),
+                None => stuck = stuck.or_else(|| Some(flat_face(f))),
+            }
+        }
+        if round == ROUNDS || edges.is_empty() {
+            return Err(stuck
+                .or_else(|| crossings.first().map(crossing))
+                .unwrap_or_else(|| flat_face(&flat[0])));
+        }
+        // Shortest first; each point takes part in one collapse per round, and goes
+        // the way (onto either end when both are intersection points) after which the
+        // triangles around it cross the fewest others — if that is fewer than before.
+        edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        let mut map: HashMap<u32, u32> = HashMap::new();
+        let mut busy = std::collections::HashSet::new();
+        let boxes = soup.boxes();
+        for (length, keep, gone) in edges {
+            if busy.contains(&keep) || busy.contains(&gone) {
+                continue;
+            }
+            let ways: &[(u32, u32)] =
+                if is_new(keep) { &[(keep, gone), (gone, keep)] } else { &[(keep, gone)] };
+            let Some((_, keep, gone)) = ways
+                .iter()
+                .filter_map(|&(keep, gone)| {
+                    let (before, after) = local_crossings(&soup, &boxes, keep, gone);
+                    (after < before).then_some((after, keep, gone))
+                })
+                .min_by_key(|w| w.0)
+            else {
+                continue;
+            };
+            busy.insert(keep);
+            busy.insert(gone);
+            map.insert(gone, keep);
+            repair.collapsed_edges += 1;
+            repair.moved = repair.moved.max(length);
+        }
+        if map.is_empty() {
+            return Err(stuck
+                .or_else(|| crossings.first().map(crossing))
+                .unwrap_or_else(|| flat_face(&flat[0])));
+        }
+        collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
+    }
+    drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
+    Ok(Finished { triangles: soup.triangles, origin, repair })
+}
+
+/// Crossings and triangles without area at `gone` and `keep` before and after `gone`
+/// collapses onto `keep`: their triangles against those whose boxes meet theirs.
+fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gone: u32) -> (usize, usize) {
+    let around: Vec<usize> = (0..soup.triangles.len())
+        .filter(|&t| soup.triangles[t].contains(&gone) || soup.triangles[t].contains(&keep))
+        .collect();
+    let (lo, hi) = around.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &t| {
+        (lo.min(boxes[t].0), hi.max(boxes[t].1))
+    });
+    // The collapse moves the triangles at `gone` towards `keep`, inside this box.
+    let local: Vec<usize> = (0..soup.triangles.len())
+        .filter(|&t| boxes[t].0.cmple(hi).all() && lo.cmple(boxes[t].1).all())
+        .collect();
+    let mut sub = TriangleSoup {
+        positions: Vec::new(),
+        triangles: Vec::with_capacity(local.len()),
+        face_of: (0..local.len() as u32).collect(),
+        failed: Vec::new(),
+    };
+    let mut ids: HashMap<u32, u32> = HashMap::new();
+    for &t in &local {
+        let tri = soup.triangles[t].map(|v| {
+            *ids.entry(v).or_insert_with(|| {
+                sub.positions.push(soup.positions[v as usize]);
+                sub.positions.len() as u32 - 1
+            })
+        });
+        sub.triangles.push(tri);
+    }
+    let count = |sub: &TriangleSoup, at: &[u32]| {
+        let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
+        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
+        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
+    };
+    let (k, g) = (ids[&keep], ids[&gone]);
+    let before = count(&sub, &[g, k]);
+    let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
+    let mut changed = vec![true; sub.triangles.len()];
+    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), &mut Repair::default());
+    (before, count(&sub, &[k]))
+}
+
+/// Applies `map` (point → the point it collapses onto) to every triangle, removes the
+/// triangles left without three distinct corners and pairs of opposite coinciding
+/// triangles, and marks every triangle at a kept point changed.
+fn collapse(
+    soup: &mut TriangleSoup,
+    origin: &mut Vec<u32>,
+    changed: &mut Vec<bool>,
+    map: &HashMap<u32, u32>,
+    repair: &mut Repair,
+) {
+    let kept: std::collections::HashSet<u32> = map.values().copied().collect();
+    let before = soup.triangles.len();
+    let mut next = Vec::with_capacity(before);
+    for (k, t) in soup.triangles.iter().enumerate() {
+        let t = t.map(|v| map.get(&v).copied().unwrap_or(v));
+        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+            continue;
+        }
+        next.push((t, origin[k], changed[k] || t.iter().any(|v| kept.contains(v))));
+    }
+    // Coinciding triangles with opposite orientations cancel (their edges balance).
+    let mut by_corners: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (k, (t, _, c)) in next.iter().enumerate() {
+        if *c {
+            let mut key = *t;
+            key.sort_unstable();
+            by_corners.entry(key).or_default().push(k);
+        }
+    }
+    let mut gone = vec![false; next.len()];
+    let parity = |t: [u32; 3]| {
+        // Even rotations of the sorted corners give one orientation, odd ones the other.
+        let m = t.iter().position(|v| *v == *t.iter().min().unwrap_or(&0)).unwrap_or(0);
+        t[(m + 1) % 3] < t[(m + 2) % 3]
+    };
+    for group in by_corners.values().filter(|g| g.len() > 1) {
+        let (up, down): (Vec<usize>, Vec<usize>) = group.iter().partition(|&&k| parity(next[k].0));
+        for (&u, &d) in up.iter().zip(&down) {
+            gone[u] = true;
+            gone[d] = true;
+        }
+    }
+    soup.triangles.clear();
+    origin.clear();
+    changed.clear();
+    for ((t, o, c), g) in next.into_iter().zip(gone) {
+        if !g {
+            soup.triangles.push(t);
+            origin.push(o);
+            changed.push(c);
+        }
+    }
+    soup.face_of = (0..soup.triangles.len() as u32).collect();
+    repair.removed_triangles += before - soup.triangles.len();
+}
+
+/// Drops every shell that encloses no volume by the operand rule, then applies the rule
+/// to what is left.
+fn drop_flat_shells(
+    soup: &mut TriangleSoup,
+    origin: &mut Vec<u32>,
+    repair: &mut Repair,
+) -> Result<(), InvalidResult> {
+    let mut sets = UnionFind::new(soup.positions.len());
+    for t in &soup.triangles {
+        sets.union(t[0], t[1]);
+        sets.union(t[0], t[2]);
+    }
+    let (lo, hi) =
+        soup.triangles.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(soup.positions[v as usize]), hi.max(soup.positions[v as usize]))
+        });
+    let apex = (lo + hi) * 0.5;
+    // Per shell root: volume and box.
+    let mut shells: HashMap<u32, (f64, DVec3, DVec3)> = HashMap::new();
+    let roots: Vec<u32> = soup.triangles.iter().map(|t| sets.find(t[0])).collect();
+    for (t, &r) in soup.triangles.iter().zip(&roots) {
+        let [a, b, c] = t.map(|v| soup.positions[v as usize]);
+        let e = shells.entry(r).or_insert((0.0, DVec3::INFINITY, DVec3::NEG_INFINITY));
+        e.0 += signed_tetra_volume(apex, a, b, c);
+        e.1 = e.1.min(a.min(b).min(c));
+        e.2 = e.2.max(a.max(b).max(c));
+    }
+    let flat: std::collections::HashSet<u32> =
+        shells.iter().filter(|(_, s)| is_flat(s.0, s.1, s.2)).map(|(&r, _)| r).collect();
+    if !flat.is_empty() {
+        repair.dropped_shells = flat.len();
+        let mut k = 0;
+        soup.triangles.retain(|_| {
+            k += 1;
+            !flat.contains(&roots[k - 1])
+        });
+        let mut k = 0;
+        origin.retain(|_| {
+            k += 1;
+            !flat.contains(&roots[k - 1])
+        });
+    }
+    let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.0).sum();
+    let (lo, hi) = shells
+        .iter()
+        .filter(|(r, _)| !flat.contains(r))
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (_, s)| (lo.min(s.1), hi.max(s.2)));
+    if !soup.triangles.is_empty() && is_flat(volume, lo, hi) {
+        return Err(InvalidResult::NoVolume { volume });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::procedural;
+
+    fn triangles(m: &crate::mesh::Mesh) -> Vec<[u32; 3]> {
+        TriangleSoup::new(m).triangles
+    }
+
+    #[test]
+    fn a_clean_result_is_left_alone() {
+        let cube = procedural::cube();
+        let tris = triangles(&cube);
+        let changed = vec![true; tris.len()];
+        let done = finish(cube.positions(), 0, &tris, &changed, 1.0).unwrap();
+        assert_eq!(done.triangles, tris);
+        assert_eq!(done.origin, (0..tris.len() as u32).collect::<Vec<_>>());
+        assert!(done.repair.is_clean() && done.repair.collapsed_edges == 0, "{}", done.repair);
+    }
+
+    #[test]
+    fn crossing_shells_without_a_short_edge_are_an_error() {
+        // Two overlapping cubes as one closed, oriented surface: their faces cross, and
+        // every edge is long.
+        let cube = procedural::cube();
+        let n = cube.num_vertices() as u32;
+        let mut points = cube.positions().to_vec();
+        points.extend(cube.positions().iter().map(|&p| p + DVec3::splat(0.5)));
+        let mut tris = triangles(&cube);
+        tris.extend(triangles(&cube).iter().map(|t| t.map(|v| v + n)));
+        let changed = vec![true; tris.len()];
+        let e = finish(&points, 0, &tris, &changed, 4.0).unwrap_err();
+        assert!(matches!(e, InvalidResult::Crossing { .. }), "{e}");
+        // Marked unchanged, the same triangles are not tested (they are trusted).
+        let unchanged = vec![false; tris.len()];
+        assert!(finish(&points, 0, &tris, &unchanged, 4.0).is_ok());
+    }
+}
