@@ -17,7 +17,7 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::exact::{orient2d, orient2d_approx, orient3d, orient3d_approx};
+use crate::exact::{line_crossing, orient2d, orient3d, plane_crossing};
 use crate::mesh::intersect::triangle_projection;
 use crate::mesh::triangulate::Projection;
 
@@ -99,9 +99,7 @@ impl Key {
 
 /// Where segment pq crosses the plane of t (p, q strictly on opposite sides).
 fn edge_plane(p: DVec3, q: DVec3, t: [DVec3; 3]) -> DVec3 {
-    let dp = orient3d_approx(t[0], t[1], t[2], p);
-    let dq = orient3d_approx(t[0], t[1], t[2], q);
-    let l = (dp / (dp - dq)).clamp(0.0, 1.0);
+    let l = plane_crossing(t[0], t[1], t[2], p, q).clamp(0.0, 1.0);
     if l.is_finite() { p + (q - p) * l } else { p }
 }
 
@@ -110,9 +108,7 @@ fn edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> DVec3 {
     let n = (q - p).cross(s - r);
     let Some(proj) = Projection::along(n) else { return (p + q) * 0.5 };
     let [p2, q2, r2, s2] = [p, q, r, s].map(|x| proj.apply(x));
-    let dp = orient2d_approx(r2, s2, p2);
-    let dq = orient2d_approx(r2, s2, q2);
-    let l = (dp / (dp - dq)).clamp(0.0, 1.0);
+    let l = line_crossing(r2, s2, p2, q2).clamp(0.0, 1.0);
     if l.is_finite() { p + (q - p) * l } else { p }
 }
 
@@ -328,7 +324,7 @@ fn clip(
         let or = orient2d(a, b, r);
         if oa * ob < 0 && op * or < 0 {
             // Proper crossing of the two edges' interiors.
-            let l = orient2d_approx(a, b, p) / (orient2d_approx(a, b, p) - orient2d_approx(a, b, r));
+            let l = line_crossing(a, b, p, r);
             push(l, key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
         }
         // A corner of the triangle on the segment's interior.

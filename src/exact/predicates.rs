@@ -10,8 +10,9 @@
 //! determinant exactly with expansions ([`super::expansion`]), on the stack.
 //!
 //! [`orient2d_approx`] and [`orient3d_approx`] give the determinant itself, with the same
-//! exact sign: for constructions that interpolate with it, never for decisions. The
-//! perturbed predicates decide at p + (ε, ε³, ε²) for an infinitesimal ε > 0 (the
+//! exact sign, and [`plane_crossing`] and [`line_crossing`] where a segment crosses a
+//! plane or a line, accurate however close to parallel they are: for constructions,
+//! never for decisions. The perturbed predicates decide at p + (ε, ε³, ε²) for an infinitesimal ε > 0 (the
 //! voxelizers' tie rule, [`crate::voxel::exact`]): they are never zero for a proper
 //! triangle.
 
@@ -46,6 +47,15 @@ fn orient2d_filter(a: DVec2, b: DVec2, c: DVec2) -> Option<f64> {
     (det.abs() >= O2D_BOUND * (l + r).abs() + UNDERFLOW).then_some(det)
 }
 
+/// The 2D determinant in f64 and a bound on its error (the differences, the products and
+/// the subtraction each round once).
+#[inline(always)]
+fn orient2d_float(a: DVec2, b: DVec2, c: DVec2) -> (f64, f64) {
+    let l = (a.x - c.x) * (b.y - c.y);
+    let r = (a.y - c.y) * (b.x - c.x);
+    (l - r, 8.0 * EPS * (l.abs() + r.abs()) + UNDERFLOW)
+}
+
 fn orient2d_exact(a: DVec2, b: DVec2, c: DVec2) -> Stack<16> {
     let d = Stack::<2>::diff;
     let (acx, acy, bcx, bcy) = (d(a.x, c.x), d(a.y, c.y), d(b.x, c.x), d(b.y, c.y));
@@ -74,6 +84,14 @@ pub fn orient2d_approx(a: impl Into<DVec2>, b: impl Into<DVec2>, c: impl Into<DV
 /// The 3D determinant in f64 when its sign is certain, in [`orient3d`]'s convention.
 #[inline(always)]
 fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
+    let (det, bound) = orient3d_float(a, b, c, d);
+    (det.abs() > bound).then_some(det)
+}
+
+/// The 3D determinant in f64, in [`orient3d`]'s convention, and Shewchuk's bound on its
+/// error.
+#[inline(always)]
+fn orient3d_float(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
     let (ad, bd, cd) = (a - d, b - d, c - d);
     let (bc1, bc2) = (bd.x * cd.y, cd.x * bd.y);
     let (ca1, ca2) = (cd.x * ad.y, ad.x * cd.y);
@@ -83,7 +101,7 @@ fn orient3d_filter(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
         + (ca1.abs() + ca2.abs()) * bd.z.abs()
         + (ab1.abs() + ab2.abs()) * cd.z.abs();
     // det((a−d, b−d, c−d)) is positive when d lies below abc: texgeo's sign is the opposite.
-    (det.abs() > O3D_BOUND * permanent + UNDERFLOW).then_some(-det)
+    (-det, O3D_BOUND * permanent + UNDERFLOW)
 }
 
 /// det((a−d, b−d, c−d)) exactly (the opposite of [`orient3d`]'s sign).
@@ -114,11 +132,42 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
 }
 
 /// The value of [`orient3d`]'s determinant (six times the signed volume of abcd): its
-/// f64 evaluation when the filter vouches for its sign, else the exact value rounded. For
-/// constructions only.
+/// f64 evaluation when the filter vouches for its sign, else the exact value rounded.
 #[inline]
 pub fn orient3d_approx(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     orient3d_filter(a, b, c, d).unwrap_or_else(|| -orient3d_exact(a, b, c, d).estimate())
+}
+
+/// Relative accuracy of [`plane_crossing`] and [`line_crossing`]: a point they place lies
+/// within this fraction of its segment's length of the exact crossing, far below any
+/// tolerance of the constructions that use them.
+pub const CROSSING_ACCURACY: f64 = 1.0 / (1u64 << 44) as f64;
+
+/// Where segment pq crosses the plane of abc (p and q strictly on opposite sides), as the
+/// fraction of the way from p to q: d(p) / (d(p) − d(q)) of the [`orient3d`]
+/// determinants, within [`CROSSING_ACCURACY`]. From the f64 determinants when their error
+/// bounds allow, else from the exact ones: an approximate determinant may be off by its
+/// whole size where the segment runs almost along the plane (near-coplanar triangles),
+/// and the point with it, by a good part of the segment.
+pub fn plane_crossing(a: DVec3, b: DVec3, c: DVec3, p: DVec3, q: DVec3) -> f64 {
+    let ((dp, ep), (dq, eq)) = (orient3d_float(a, b, c, p), orient3d_float(a, b, c, q));
+    if ep + eq <= CROSSING_ACCURACY * (dp - dq).abs() {
+        return dp / (dp - dq);
+    }
+    // Both exact determinants have the opposite sign: the ratio is the same.
+    let (xp, xq) = (orient3d_exact(a, b, c, p), orient3d_exact(a, b, c, q));
+    xp.estimate() / Stack::<384>::sum(&xp, &xq.negated()).estimate()
+}
+
+/// Where segment pq crosses the line ab in the plane (p and q strictly on opposite
+/// sides), as the fraction of the way from p to q: [`plane_crossing`] in 2D.
+pub fn line_crossing(a: DVec2, b: DVec2, p: DVec2, q: DVec2) -> f64 {
+    let ((dp, ep), (dq, eq)) = (orient2d_float(a, b, p), orient2d_float(a, b, q));
+    if ep + eq <= CROSSING_ACCURACY * (dp - dq).abs() {
+        return dp / (dp - dq);
+    }
+    let (xp, xq) = (orient2d_exact(a, b, p), orient2d_exact(a, b, q));
+    xp.estimate() / Stack::<32>::sum(&xp, &xq.negated()).estimate()
 }
 
 /// The exact signs of the components of the normal (b − a) × (c − a): the orientations
@@ -219,6 +268,40 @@ mod tests {
             let xy = |q: [i64; 3]| [q[0] as f64, q[1] as f64];
             assert_eq!(orient2d(xy(a), xy(b), xy(c)), o2.signum() as Sign);
         }
+    }
+
+    #[test]
+    fn crossings_of_segments_almost_in_the_plane_are_accurate() {
+        // p and q are exactly coplanar with abc, then moved kp ulps up and kq ulps down
+        // along x: their determinants are kp·u·n_x and −kq·u·n_x, so the segment crosses
+        // the plane at kp / (kp + kq) of the way. The f64 determinants are a few times
+        // their error bound here, so their ratio may be far off.
+        let mut rng = Rng::new(7);
+        let mut worst = 0.0f64;
+        for trial in 0..2000 {
+            let a = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 0.25 + 1.0;
+            let b = a + DVec3::new(0.25, 0.5, -0.125);
+            let c = a + DVec3::new(-0.5, 0.125, 0.75);
+            let (kp, kq) = (1 + trial % 97, 1 + (trial * 7) % 89);
+            let step = |x: f64, k: usize, up: bool| {
+                (0..k).fold(x, |x, _| if up { x.next_up() } else { x.next_down() })
+            };
+            let p = a + DVec3::new(0.0, 0.28125, 0.125);
+            let q = a + DVec3::new(0.0, 0.140625, 0.0625);
+            let (p, q) =
+                (DVec3::new(step(p.x, kp, true), p.y, p.z), DVec3::new(step(q.x, kq, false), q.y, q.z));
+            let want = kp as f64 / (kp + kq) as f64;
+            let got = plane_crossing(a, b, c, p, q);
+            worst = worst.max((got - want).abs());
+            // The same in 2D: the xy projections against the line ab.
+            let (a2, b2) = (DVec2::new(1.0, 1.0), DVec2::new(1.5, 2.0));
+            let on = |s: f64| a2 + (b2 - a2) * s;
+            let (p2, q2) = (on(0.25), on(0.75));
+            let (p2, q2) = (DVec2::new(step(p2.x, kp, false), p2.y), DVec2::new(step(q2.x, kq, true), q2.y));
+            let got2 = line_crossing(a2, b2, p2, q2);
+            worst = worst.max((got2 - want).abs());
+        }
+        assert!(worst <= 4.0 * CROSSING_ACCURACY, "{worst:e}");
     }
 
     #[test]
