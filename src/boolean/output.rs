@@ -30,14 +30,16 @@
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::input::is_flat;
+use crate::exact::orient2d;
 use crate::mesh::covering::signed_tetra_volume;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate, soup_self_intersections_near, weld_by_position};
+use crate::mesh::triangulate::{self, Projection};
 
 /// Longest edge a repair collapses, relative to the operands' bounding-box diagonal: far
 /// below any feature of a real model (the volume moved is of the order of its square
@@ -60,6 +62,11 @@ pub struct Repair {
     pub collapsed_edges: usize,
     /// Triangles removed by the collapses (those on a collapsed edge, cancelling pairs).
     pub removed_triangles: usize,
+    /// Flat regions rebuilt without their sliver (between two nearly coincident faces, too
+    /// thin for f64 and too wide to collapse an edge of).
+    pub pockets: usize,
+    /// Triangles those regions had.
+    pub pocket_triangles: usize,
     /// Shells dropped because they enclose no volume.
     pub dropped_shells: usize,
     /// Farthest any point moved.
@@ -69,7 +76,7 @@ pub struct Repair {
 impl Repair {
     /// True when the result was written as selected.
     pub fn is_clean(&self) -> bool {
-        self.crossings == 0 && self.flat_triangles == 0 && self.dropped_shells == 0
+        self.crossings == 0 && self.flat_triangles == 0 && self.pockets == 0 && self.dropped_shells == 0
     }
 }
 
@@ -78,13 +85,15 @@ impl std::fmt::Display for Repair {
         write!(
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} edges collapsed \
-             ({} triangles removed, points moved at most {:e}), {} flat shells dropped",
+             ({} triangles removed, points moved at most {:e}), {} flat slivers removed ({} triangles rebuilt), {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
             self.collapsed_edges,
             self.removed_triangles,
             self.moved,
+            self.pockets,
+            self.pocket_triangles,
             self.dropped_shells
         )
     }
@@ -111,9 +120,13 @@ impl InvalidResult {
     /// The same, with its place and volume given in the operands' units.
     pub fn out_of(self, frame: Frame) -> InvalidResult {
         match self {
-            InvalidResult::Crossing { a, b, near } => InvalidResult::Crossing { a, b, near: frame.point_out(near) },
+            InvalidResult::Crossing { a, b, near } => {
+                InvalidResult::Crossing { a, b, near: frame.point_out(near) }
+            }
             InvalidResult::Flat { face, near } => InvalidResult::Flat { face, near: frame.point_out(near) },
-            InvalidResult::NoVolume { volume } => InvalidResult::NoVolume { volume: frame.volume_out(volume) },
+            InvalidResult::NoVolume { volume } => {
+                InvalidResult::NoVolume { volume: frame.volume_out(volume) }
+            }
         }
     }
 }
@@ -153,6 +166,8 @@ pub fn finish(
     let mut changed = changed.to_vec();
     repair.tested = changed.iter().filter(|&&c| c).count();
     let limit = COLLAPSE * diagonal;
+    let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let thickness = super::snap::tolerance(max_abs, diagonal);
     let is_new = |v: u32| v >= first_new;
     for round in 0..=ROUNDS {
         let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
@@ -200,16 +215,49 @@ pub fn finish(
         };
         let mut edges = Vec::new();
         let mut stuck = None;
+        let mut wide = Vec::new();
         for c in &crossings {
             match shortest(&[c.0, c.1]) {
                 Some(e) => edges.push(e),
-                None => stuck = stuck.or_else(|| Some(crossing(c))),
+                None => {
+                    stuck = stuck.or_else(|| Some(crossing(c)));
+                    wide.push(*c);
+                }
             }
         }
-        for f in &flat {
-            match shortest(&[*f]) {
-                Some(e) => edges.push(e),
-                None => stuck = stuck.or_else(|| Some(flat_face(f))),
+        // Crossings without a short edge: the flat region around them is rebuilt without
+        // its sliver, and everything is checked again.
+        if !wide.is_empty() && round < ROUNDS {
+            let by_edge = edge_faces(&soup);
+            let mut gone = vec![false; soup.triangles.len()];
+            let mut added = Vec::new();
+            for &(a, b) in &wide {
+                if gone[a] || gone[b] {
+                    continue;
+                }
+                let Some(f) = flatten(&soup, &by_edge, &origin, a, thickness) else { continue };
+                if f.removed.iter().any(|&t| gone[t]) || !(f.removed.contains(&a) && f.removed.contains(&b)) {
+                    continue;
+                }
+                for &t in &f.removed {
+                    gone[t] = true;
+                }
+                repair.pockets += 1;
+                repair.pocket_triangles += f.removed.len();
+                added.extend(f.added);
+            }
+            if gone.iter().any(|&g| g) {
+                let keep: Vec<bool> = gone.iter().map(|g| !g).collect();
+                retain_marked(&mut soup.triangles, &keep);
+                retain_marked(&mut origin, &keep);
+                retain_marked(&mut changed, &keep);
+                for (t, o) in added {
+                    soup.triangles.push(t);
+                    origin.push(o);
+                    changed.push(true);
+                }
+                soup.face_of = (0..soup.triangles.len() as u32).collect();
+                continue;
             }
         }
         if round == ROUNDS || edges.is_empty() {
@@ -253,8 +301,142 @@ pub fn finish(
         }
         collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
     }
+    if repair.pockets > 0 {
+        // Rebuilt triangles go back among those of their origin: A's faces first.
+        let mut order: Vec<usize> = (0..origin.len()).collect();
+        order.sort_by_key(|&k| origin[k]);
+        soup.triangles = order.iter().map(|&k| soup.triangles[k]).collect();
+        origin = order.iter().map(|&k| origin[k]).collect();
+    }
     drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
     Ok(Finished { triangles: soup.triangles, origin, repair })
+}
+
+/// The triangles on each edge (ends in increasing order).
+type EdgeFaces = HashMap<(u32, u32), Vec<usize>>;
+
+fn edge_faces(soup: &TriangleSoup) -> EdgeFaces {
+    let mut by_edge = EdgeFaces::new();
+    for (t, tri) in soup.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (p, q) = (tri[k], tri[(k + 1) % 3]);
+            by_edge.entry((p.min(q), p.max(q))).or_default().push(t);
+        }
+    }
+    by_edge
+}
+
+/// A flat region rebuilt without its sliver: the triangles it removes and those it adds.
+struct Flattened {
+    removed: Vec<usize>,
+    /// New triangles, each with the origin of a removed triangle it lies on.
+    added: Vec<([u32; 3], u32)>,
+}
+
+/// Rebuilds the flat region around triangle `seed`, if it holds a sliver: the triangles
+/// connected to it by edges with every corner within `thickness` of its plane are replaced
+/// by a triangulation, in the plane's projection, of where they cover the plane a net once
+/// (bounded by their boundary edges left after opposite edges cancel). Nearly coincident
+/// faces kept from both operands (one's face outside the other, the other's inside the
+/// one, a hair apart) cover the plane once from each side: the sliver between them goes,
+/// and the region's boundary, where it joins the rest of the surface, stays edge for edge
+/// (closed and oriented). `None` when the new triangles would not have that boundary, or
+/// the change of volume is not negligible.
+fn flatten(
+    soup: &TriangleSoup,
+    by_edge: &EdgeFaces,
+    origin: &[u32],
+    seed: usize,
+    thickness: f64,
+) -> Option<Flattened> {
+    /// Beyond this many triangles in one plane the search gives up (quadratic coverage).
+    const MOST: usize = 4096;
+    let [a, b, c] = soup.triangle(seed);
+    let normal = (b - a).cross(c - a);
+    let unit = normal.try_normalize()?;
+    let proj = Projection::along(normal)?;
+    let within = |t: usize| soup.triangle(t).iter().all(|&p| (p - a).dot(unit).abs() <= thickness);
+    // The faces in the plane, connected to the seed.
+    let mut region = vec![seed];
+    let mut seen = std::collections::HashSet::from([seed]);
+    let mut next = 0;
+    while next < region.len() {
+        let tri = soup.triangles[region[next]];
+        next += 1;
+        for k in 0..3 {
+            let (p, q) = (tri[k], tri[(k + 1) % 3]);
+            for &t in by_edge.get(&(p.min(q), p.max(q)))? {
+                if !seen.contains(&t) && within(t) {
+                    seen.insert(t);
+                    region.push(t);
+                    if region.len() > MOST {
+                        return None;
+                    }
+                }
+            }
+        }
+    }
+    let flat: Vec<[DVec2; 3]> = region.iter().map(|&t| soup.triangle(t).map(|p| proj.apply(p))).collect();
+    let side: Vec<i32> = flat.iter().map(|f| i32::from(orient2d(f[0], f[1], f[2]))).collect();
+    // Net cover at x: +1 per face of the seed's side holding it, −1 per face of the other,
+    // and the first face holding it.
+    let cover = |x: DVec2| -> (i32, Option<usize>) {
+        let holding = |k: &usize| {
+            side[*k] != 0
+                && (0..3).all(|e| i32::from(orient2d(flat[*k][e], flat[*k][(e + 1) % 3], x)) == side[*k])
+        };
+        let mut holders = (0..region.len()).filter(holding);
+        let first = holders.next();
+        (first.into_iter().chain(holders).map(|k| side[k]).sum(), first)
+    };
+    // The region's boundary: directed edges whose opposites do not cancel them.
+    let net = |tris: &mut dyn Iterator<Item = [u32; 3]>| -> HashMap<(u32, u32), i32> {
+        let mut balance: HashMap<(u32, u32), i32> = HashMap::new();
+        for tri in tris {
+            for k in 0..3 {
+                let (p, q) = (tri[k], tri[(k + 1) % 3]);
+                *balance.entry((p.min(q), p.max(q))).or_default() += if p < q { 1 } else { -1 };
+            }
+        }
+        balance.retain(|_, b| *b != 0);
+        balance
+    };
+    let boundary = net(&mut region.iter().map(|&t| soup.triangles[t]));
+    if boundary.values().any(|b| b.abs() != 1) {
+        return None;
+    }
+    let mut ids: Vec<u32> = boundary.keys().flat_map(|&(p, q)| [p, q]).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let local = |v: u32| ids.binary_search(&v).map(|i| i as u32).unwrap_or(u32::MAX);
+    let points: Vec<DVec2> = ids.iter().map(|&v| proj.apply(soup.positions[v as usize])).collect();
+    let constraints: Vec<[u32; 2]> = boundary.keys().map(|&(p, q)| [local(p), local(q)]).collect();
+    let cdt = triangulate::cdt(&points, &[], &constraints).ok()?;
+    let mut added = Vec::new();
+    for t in cdt.triangles {
+        let f = t.map(|v| points[v as usize]);
+        match cover((f[0] + f[1] + f[2]) / 3.0) {
+            (0, _) => {}
+            (1, Some(k)) => added.push((t.map(|v| ids[v as usize]), origin[region[k]])),
+            (-1, Some(k)) => added.push(([t[0], t[2], t[1]].map(|v| ids[v as usize]), origin[region[k]])),
+            _ => return None,
+        }
+    }
+    if net(&mut added.iter().map(|a| a.0)) != boundary {
+        return None;
+    }
+    let (lo, hi) = region
+        .iter()
+        .flat_map(|&t| soup.triangle(t))
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let apex = (lo + hi) * 0.5;
+    let volume = |tri: [u32; 3]| {
+        let [a, b, c] = tri.map(|v| soup.positions[v as usize]);
+        signed_tetra_volume(apex, a, b, c)
+    };
+    let change: f64 = region.iter().map(|&t| volume(soup.triangles[t])).sum::<f64>()
+        - added.iter().map(|a| volume(a.0)).sum::<f64>();
+    is_flat(change, lo, hi).then_some(Flattened { removed: region, added })
 }
 
 /// Crossings and triangles without area at `gone` and `keep` before and after `gone`
@@ -355,6 +537,15 @@ fn collapse(
     repair.removed_triangles += before - soup.triangles.len();
 }
 
+/// Keeps the items of `v` whose flag in `keep` is set.
+fn retain_marked<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut k = 0;
+    v.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+}
+
 /// Drops every shell that encloses no volume by the operand rule, then applies the rule
 /// to what is left.
 fn drop_flat_shells(
@@ -386,16 +577,9 @@ fn drop_flat_shells(
         shells.iter().filter(|(_, s)| is_flat(s.0, s.1, s.2)).map(|(&r, _)| r).collect();
     if !flat.is_empty() {
         repair.dropped_shells = flat.len();
-        let mut k = 0;
-        soup.triangles.retain(|_| {
-            k += 1;
-            !flat.contains(&roots[k - 1])
-        });
-        let mut k = 0;
-        origin.retain(|_| {
-            k += 1;
-            !flat.contains(&roots[k - 1])
-        });
+        let keep: Vec<bool> = roots.iter().map(|r| !flat.contains(r)).collect();
+        retain_marked(&mut soup.triangles, &keep);
+        retain_marked(origin, &keep);
     }
     let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.0).sum();
     let (lo, hi) = shells

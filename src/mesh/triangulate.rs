@@ -241,7 +241,8 @@ pub struct Cdt {
 /// `outline` (indices into `points`, counter-clockwise), with the extra segments
 /// `constraints` (index pairs) as edges. Returns the triangles inside the outline as
 /// index triples into `points`, counter-clockwise, and the constraint edges inside it.
-/// Points not on the outline are inserted too (they must lie inside it).
+/// Points not on the outline are inserted too (they must lie inside it). An empty outline
+/// keeps every triangle of the points' convex hull.
 ///
 /// Fails when segments cross or two points coincide: both mean the input was not a
 /// planar straight-line graph (a self-overlapping polygon, or intersection segments
@@ -281,7 +282,7 @@ pub fn cdt(points: &[DVec2], outline: &[u32], constraints: &[[u32; 2]]) -> Resul
     // Flood the outside from the convex hull inwards, never crossing the outline.
     let mut outside = vec![false; cdt.num_all_faces()];
     let mut stack = Vec::new();
-    for hull in cdt.convex_hull() {
+    for hull in cdt.convex_hull().filter(|_| n > 0) {
         for edge in [hull, hull.rev()] {
             let [a, b] = edge.vertices().map(|v| v.data().id);
             if let Some(f) = edge.face().as_inner() {
