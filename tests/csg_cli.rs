@@ -24,9 +24,10 @@ fn ok(args: &[&str]) -> String {
     stdout(&o)
 }
 
+/// Faces and volume of a mesh file (0 for the empty solid).
 fn read(path: &str) -> (usize, f64) {
     let m = formats::read(std::path::Path::new(path)).unwrap();
-    (m.num_faces(), Covering::new(&m).volume())
+    (m.num_faces(), if m.num_faces() == 0 { 0.0 } else { Covering::new(&m).volume() })
 }
 
 #[test]
@@ -83,6 +84,43 @@ fn an_expression_equals_its_operations_one_by_one() {
     ]);
     assert_eq!(std::fs::read(&folded).unwrap(), std::fs::read(&three).unwrap());
     assert!(read(&folded).1 < read(&step0).1);
+}
+
+#[test]
+fn empty_operands_and_results() {
+    // a − a is the empty solid, written as a file without faces; in an expression and read
+    // back from its file it leaves a union as it was and empties an intersection.
+    let dir = TempDir::new("csg-empty");
+    let empty = dir.arg("empty.off");
+    let text = ok(&["csg", "a - a", "a=builtin:cube", "-o", &empty]);
+    assert!(text.starts_with("a - a: 0 triangles, volume 0 -> "), "{text}");
+    assert_eq!(read(&empty), (0, 0.0));
+    let sphere = dir.arg("sphere.off");
+    ok(&["csg", "b", "b=builtin:sphere", "-o", &sphere]);
+    let (_, want) = read(&sphere);
+    let e = format!("e={empty}");
+    for (expr, operands, volume) in [
+        ("(a - a) | b", vec!["a=builtin:cube", "b=builtin:sphere"], want),
+        ("e | b", vec![e.as_str(), "b=builtin:sphere"], want),
+        ("b - e", vec![e.as_str(), "b=builtin:sphere"], want),
+        ("b & e", vec![e.as_str(), "b=builtin:sphere"], 0.0),
+        ("e - b", vec![e.as_str(), "b=builtin:sphere"], 0.0),
+        ("(b & (a - a)) | e", vec!["a=builtin:cube", "b=builtin:sphere", e.as_str()], 0.0),
+        ("e", vec![e.as_str()], 0.0),
+    ] {
+        let out = dir.arg("out.off");
+        let mut args = vec!["csg", expr];
+        args.extend(operands);
+        args.extend(["-o", &out]);
+        ok(&args);
+        let (faces, got) = read(&out);
+        assert_eq!(faces == 0, volume == 0.0, "{expr}: {faces} faces");
+        assert!((got - volume).abs() <= 1e-12 * want, "{expr}: {got} vs {volume}");
+    }
+    // `boolean` with more operands folds through the empty solid the same way.
+    let out = dir.arg("folded.off");
+    ok(&["boolean", &empty, "builtin:sphere", &empty, "--op", "union", "-o", &out]);
+    assert!((read(&out).1 - want).abs() <= 1e-12 * want);
 }
 
 #[test]
