@@ -128,3 +128,40 @@ pub fn total_memory() -> Option<u64> {
 fn read_trimmed(path: &str) -> Option<String> {
     std::fs::read_to_string(path).ok().map(|s| s.trim().to_string()).filter(|s| !s.is_empty())
 }
+
+/// The load average over 1, 5 and 15 minutes (`/proc/loadavg`).
+pub fn load_average() -> Option<[f64; 3]> {
+    let s = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let mut it = s.split_whitespace().map(|v| v.parse::<f64>().ok());
+    Some([it.next()??, it.next()??, it.next()??])
+}
+
+/// CPU time counters, in clock ticks: the whole machine's (all cores, `/proc/stat`) and
+/// this process' with its waited-for children (`/proc/self/stat`).
+#[derive(Clone, Copy, Debug)]
+pub struct CpuTicks {
+    /// Every core's ticks, idle included.
+    pub total: u64,
+    /// Every core's ticks spent running something.
+    pub busy: u64,
+    /// This process' user + system ticks, its finished children's included.
+    pub own: u64,
+}
+
+impl CpuTicks {
+    pub fn now() -> Option<CpuTicks> {
+        let stat = std::fs::read_to_string("/proc/stat").ok()?;
+        let cpu: Vec<u64> =
+            stat.lines().next()?.split_whitespace().skip(1).filter_map(|v| v.parse().ok()).collect();
+        // user nice system idle iowait irq softirq steal (guest time is inside user).
+        let total: u64 = cpu.iter().take(8).sum();
+        let idle = cpu.get(3)? + cpu.get(4).copied().unwrap_or(0);
+        let own_stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+        // Fields after the command name (which may hold spaces) start at the state (3).
+        let rest = own_stat.rsplit_once(')')?.1;
+        let f: Vec<u64> = rest.split_whitespace().map(|v| v.parse().unwrap_or(0)).collect();
+        // utime, stime, cutime, cstime are fields 14–17: 11–14 after the state.
+        let own = f.get(11)? + f.get(12)? + f.get(13)? + f.get(14)?;
+        Some(CpuTicks { total, busy: total - idle.min(total), own })
+    }
+}

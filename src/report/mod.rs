@@ -8,7 +8,7 @@ mod table;
 mod timing;
 
 pub use table::{Report, Table};
-pub use timing::{Samples, time_runs, timed};
+pub use timing::{Samples, Side, interleave, time_runs, timed};
 
 /// Where a long measurement says what it is doing: `texgeo bench` prints a line per
 /// step, `texgeo reproduce` advances a progress bar.
@@ -26,6 +26,33 @@ pub struct Log(pub &'static str);
 impl Progress for Log {
     fn step(&mut self, what: &str) {
         crate::note!("{}: {what}", self.0);
+    }
+}
+
+/// One line on standard error when each part of a long run starts and one when it ends,
+/// with the time it took and the time since the run began: progress for a log file or
+/// CI, where bars do not show.
+pub struct Lines {
+    prefix: &'static str,
+    start: std::time::Instant,
+}
+
+impl Lines {
+    pub fn new(prefix: &'static str) -> Lines {
+        Lines { prefix, start: std::time::Instant::now() }
+    }
+
+    pub fn started(&self, what: &str) {
+        crate::note!("{}: {what}: started at {:.1} s", self.prefix, self.start.elapsed().as_secs_f64());
+    }
+
+    pub fn ended(&self, what: &str, took: std::time::Duration) {
+        crate::note!(
+            "{}: {what}: done in {:.1} s (at {:.1} s)",
+            self.prefix,
+            took.as_secs_f64(),
+            self.start.elapsed().as_secs_f64()
+        );
     }
 }
 

@@ -52,6 +52,26 @@ pub fn time_runs<E>(runs: usize, mut f: impl FnMut() -> Result<Duration, E>) -> 
     Ok(s)
 }
 
+/// One side of an interleaved comparison: runs once and says how long its timed part took.
+pub type Side<'a, E> = dyn FnMut() -> Result<Duration, E> + 'a;
+
+/// Runs every side once untimed (warm-up), then `runs` rounds of A, B, … in turn, and
+/// returns each side's durations. Load that comes and goes hits every side of a
+/// comparison alike, and sample k of every side comes from round k, so the ratio of two
+/// sides can be taken round by round.
+pub fn interleave<E>(runs: usize, sides: &mut [&mut Side<'_, E>]) -> Result<Vec<Samples>, E> {
+    for side in sides.iter_mut() {
+        side()?;
+    }
+    let mut out = vec![Samples::default(); sides.len()];
+    for _ in 0..runs.max(1) {
+        for (side, samples) in sides.iter_mut().zip(&mut out) {
+            samples.push(side()?);
+        }
+    }
+    Ok(out)
+}
+
 /// Times a closure.
 pub fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
     let t = Instant::now();

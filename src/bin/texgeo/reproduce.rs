@@ -1,6 +1,7 @@
 //! `texgeo reproduce -o DIR`: every experiment of both theses, one report (Markdown,
 //! HTML, CSV, plots, pictures, claims); `--compare OLD NEW` says what moved.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -13,6 +14,10 @@ pub struct Args {
     /// Built-in models and small sizes: about two minutes on two cores.
     #[arg(long)]
     quick: bool,
+    /// Add N repetitions to every timed comparison: narrower intervals, fewer
+    /// "inconclusive" verdicts, a longer run.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    repeat: usize,
     /// Where `tools/fetch-models` put the models that stand in for the thesis' ones.
     #[arg(long, default_value = "models")]
     models: PathBuf,
@@ -28,8 +33,8 @@ pub struct Args {
     compare: Option<Vec<PathBuf>>,
 }
 
-/// Progress bars on standard error: one per experiment and one overall; hidden when
-/// standard error is not a terminal.
+/// Progress bars on standard error: one per experiment and one overall (at a terminal;
+/// elsewhere one line per experiment's start and end).
 struct Bars {
     multi: MultiProgress,
     overall: ProgressBar,
@@ -89,12 +94,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let out = args.out.clone().ok_or_else(|| anyhow::anyhow!("-o DIR is required"))?;
-    let config = Config { quick: args.quick, models_dir: args.models, only: args.only, out };
+    let config =
+        Config { quick: args.quick, repeat: args.repeat, models_dir: args.models, only: args.only, out };
     // Before the device opens and minutes of measuring start.
     config.check()?;
     let ctx = crate::open_context(device)?;
     let selected =
         EXPERIMENTS.iter().filter(|e| config.only.is_empty() || config.only.iter().any(|o| o == e.key));
+    if !std::io::stderr().is_terminal() {
+        let outcome = reproduce::run(&ctx, &config, &mut texgeo::report::Lines::new("texgeo reproduce"))?;
+        return summarize(&outcome);
+    }
     let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
     let overall = multi.add(ProgressBar::new(selected.count() as u64));
     overall.set_style(
@@ -106,14 +116,20 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mut bars = Bars { multi, overall };
     let outcome = reproduce::run(&ctx, &config, &mut bars)?;
     bars.overall.finish_and_clear();
+    summarize(&outcome)
+}
+
+/// The closing lines of a run; an error when a part failed.
+fn summarize(outcome: &reproduce::Outcome) -> anyhow::Result<()> {
     say!(
-        "wrote {} and {} in {:.1} s: claims {} hold, {} do not hold, {} not measurable",
+        "wrote {} and {} in {:.1} s: claims {} hold, {} do not hold, {} inconclusive (within noise), {} not measurable",
         outcome.report.display(),
         outcome.html.display(),
         outcome.elapsed.as_secs_f64(),
         outcome.verdicts[0],
         outcome.verdicts[1],
-        outcome.verdicts[2]
+        outcome.verdicts[2],
+        outcome.verdicts[3]
     );
     for d in &outcome.disagreements {
         note!("texgeo: warning: answers differ from the reference: {d}");

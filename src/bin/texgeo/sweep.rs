@@ -219,7 +219,14 @@ fn sweep(device: Option<&str>, a: RunArgs) -> anyhow::Result<()> {
         results.append(&r)?;
         n += 1;
         let why = if r.reason.is_empty() { String::new() } else { format!(" ({})", r.reason) };
-        say!("[{n}/{total}] {}: {}{why} {:.1} ms", r.mesh, r.outcome, r.total_ms().unwrap_or(0.0));
+        // One line per mesh with the time since the start: a log of a long sweep is never silent.
+        say!(
+            "[{n}/{total} at {:.1} s] {}: {}{why} {:.1} ms",
+            start.elapsed().as_secs_f64(),
+            r.mesh,
+            r.outcome,
+            r.total_ms().unwrap_or(0.0)
+        );
         Ok(())
     })?;
     say!(

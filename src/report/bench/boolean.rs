@@ -80,21 +80,35 @@ fn ms(d: Duration) -> String {
     format!("{:.1}", d.as_secs_f64() * 1e3)
 }
 
-/// One timed evaluation: (phase 1, phase 2 without assembly, assembly per op of
-/// [`OPERATIONS`], the last evaluation). `runs` timed runs after a warm-up; `ctx` for the
-/// GPU point tests. `texgeo reproduce` measures Table 6-1 with it too.
-pub fn measure(
+/// The timed runs of one evaluation: (phase 1, phase 2 without assembly, assembly per
+/// op of [`OPERATIONS`], the last evaluation).
+pub type Timed = (Samples, Samples, Vec<Samples>, Evaluation);
+
+/// One timed evaluation: `runs` timed runs after a warm-up; `ctx` for the GPU point
+/// tests. `texgeo reproduce` measures Table 6-1 with it too.
+pub fn measure(pair: &Pair, options: &Options, ctx: Option<&Context>, runs: usize) -> boolean::Result<Timed> {
+    let mut all = measure_interleaved(pair, &[(options, ctx)], runs)?;
+    Ok(all.pop().unwrap_or_else(|| unreachable!("one variant")))
+}
+
+/// Several ways to evaluate `pair` (options and, for GPU point tests, the device), each
+/// warmed up once, then `runs` rounds of every way in turn: load that comes and goes hits
+/// every way alike, and the ratio of two ways can be taken round by round.
+pub fn measure_interleaved(
     pair: &Pair,
-    options: &Options,
-    ctx: Option<&Context>,
+    variants: &[(&Options, Option<&Context>)],
     runs: usize,
-) -> boolean::Result<(Samples, Samples, Vec<Samples>, Evaluation)> {
-    let (mut p1, mut p2) = (Samples::default(), Samples::default());
-    let mut assembly: Vec<Samples> = OPERATIONS.iter().map(|_| Samples::default()).collect();
-    let mut last = None;
-    for run in 0..=runs.max(1) {
-        let ev = boolean::evaluate(&pair.a, &pair.b, Names { a: &pair.name, b: "copy" }, options, ctx)?;
-        if run > 0 {
+) -> boolean::Result<Vec<Timed>> {
+    let names = Names { a: &pair.name, b: "copy" };
+    let mut out: Vec<Timed> = Vec::new();
+    for (options, ctx) in variants {
+        let ev = boolean::evaluate(&pair.a, &pair.b, names, options, *ctx)?;
+        let assembly = OPERATIONS.iter().map(|_| Samples::default()).collect();
+        out.push((Samples::default(), Samples::default(), assembly, ev));
+    }
+    for _ in 0..runs.max(1) {
+        for ((options, ctx), (p1, p2, assembly, last)) in variants.iter().zip(&mut out) {
+            let ev = boolean::evaluate(&pair.a, &pair.b, names, options, *ctx)?;
             p1.push(ev.timings.refine);
             p2.push(ev.timings.classification());
             for (k, &op) in OPERATIONS.iter().enumerate() {
@@ -102,11 +116,10 @@ pub fn measure(
                 ev.result(op, true)?;
                 assembly[k].push(start.elapsed());
             }
+            *last = ev;
         }
-        last = Some(ev);
     }
-    let ev = last.unwrap_or_else(|| unreachable!("at least one run"));
-    Ok((p1, p2, assembly, ev))
+    Ok(out)
 }
 
 /// The options of a timed evaluation: phases one after the other (no overlap of the
@@ -142,8 +155,11 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
     let mut refused = Vec::new();
     for pair in pairs {
         let triangles = pair.a.num_faces() + pair.b.num_faces();
-        let grouped = measure(pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs);
-        let (p1, p2, asm, ev) = match grouped {
+        // The CPU and GPU point tests in turn, run after run.
+        let (cpu, gpu) =
+            (sequential(cfg.cpu_method, Grouping::Grouped), sequential(Method::Gpu, Grouping::Grouped));
+        let grouped = measure_interleaved(pair, &[(&cpu, None), (&gpu, Some(ctx))], cfg.runs);
+        let mut both = match grouped {
             Err(e @ boolean::BooleanError::Input { .. }) => {
                 crate::note!("texgeo: skipping {}: {e}", pair.name);
                 refused.push(format!("{} ({e})", pair.name));
@@ -151,8 +167,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
             }
             r => r?,
         };
-        let (_, p2_gpu, _, ev_gpu) =
-            measure(pair, &sequential(Method::Gpu, Grouping::Grouped), Some(ctx), cfg.runs)?;
+        let (_, p2_gpu, _, ev_gpu) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
+        let (p1, p2, asm, ev) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
         // The GPU and CPU classifications agree (they are both exact).
         let same =
             ev_gpu.classification.a == ev.classification.a && ev_gpu.classification.b == ev.classification.b;

@@ -96,26 +96,19 @@ fn point_sets(mesh: &Mesh, cfg: &Config) -> Vec<Vec<DVec3>> {
     (0..cfg.sets).map(|k| Rng::new(4000 + k as u64).points_in_box(cfg.points, lo, hi)).collect()
 }
 
-/// Something that classifies a set of points (a CPU classifier or a GPU solver).
-type Classify<'a> = dyn FnMut(&[DVec3]) -> Result<Vec<Class>, InclusionError> + 'a;
+/// A timed classifier of the experiment: a TetraGrid or a method's solver.
+enum Contender {
+    Grid(Box<GridClassifier>),
+    Solver(Box<Solver>),
+}
 
-/// The time of every set and whether every answer equals `want`.
-fn set_times(
-    solver: &mut Classify,
-    sets: &[Vec<DVec3>],
-    want: &[Vec<Class>],
-) -> Result<(Samples, bool), InclusionError> {
-    // One untimed warm-up (lavapipe compiles shaders at the first draw).
-    solver(&sets[0])?;
-    let mut times = Samples::default();
-    let mut agree = true;
-    for (set, w) in sets.iter().zip(want) {
-        let t = Instant::now();
-        let got = solver(set)?;
-        times.push(t.elapsed());
-        agree &= got == *w;
+impl Contender {
+    fn classify(&mut self, points: &[DVec3]) -> Result<Vec<Class>, InclusionError> {
+        match self {
+            Contender::Grid(g) => Ok(g.classify_all(points)),
+            Contender::Solver(s) => s.classify_all(points),
+        }
     }
-    Ok((times, agree))
 }
 
 /// Everything measured on one model.
@@ -172,10 +165,10 @@ impl Measured {
     }
 }
 
-/// Steps [`measure`] reports per model: the reference, each TetraGrid resolution, each
-/// method, the indexes, the thesis' GPU layout.
+/// Steps [`measure`] reports per model: the reference, building each TetraGrid
+/// resolution, each method and the thesis' GPU layout, then each set.
 pub fn steps(models: usize, cfg: &Config) -> u64 {
-    (models * (cfg.resolutions.len() + METHODS.len() + 3)) as u64
+    (models * (cfg.resolutions.len() + METHODS.len() + 2 + cfg.sets)) as u64
 }
 
 /// The methods of Tables 4-6 to 4-9, at their default settings (TetraGrid 32³, octree 6).
@@ -222,43 +215,64 @@ fn measure_model(
     let want: Vec<Vec<Class>> = sets.iter().map(|s| cpu.classify_all(s)).collect();
 
     // Tables 4-4 and 4-5: GridClassifier at every resolution.
+    let mut sides: Vec<(String, Contender)> = Vec::new();
     for &n in &cfg.resolutions {
         if !RESOLUTIONS.contains(&n) {
             return Err(InclusionError::Resolution(n));
         }
-        progress.step(&format!("{}: TetraGrid {n}³", model.name));
+        progress.step(&format!("{}: building TetraGrid {n}³", model.name));
         let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
         let grid = GridClassifier::new(ft, n)?;
         let s = grid.index_stats();
         m.grid_builds.push((s.build_time, s.bytes));
-        let (t, ok) = set_times(&mut |p| Ok(grid.classify_all(p)), &sets, &want)?;
-        if !ok {
-            m.disagreements.push(format!("tetragrid-{n}"));
-        }
-        m.grid_times.push(t);
         m.grid_tested.push(tested_share(&grid, &sets, m.triangles));
+        sides.push((format!("tetragrid-{n}"), Contender::Grid(Box::new(grid))));
     }
 
-    // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6).
-    for method in METHODS {
-        progress.step(&format!("{}: {method}", model.name));
-        let mut solver = match Solver::new(method, mesh, &Options::default(), Some(ctx), None) {
-            Ok(s) => s,
+    // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6),
+    // and the thesis' layout: one point-vertex per tetrahedron.
+    let methods = METHODS.iter().map(|&k| (k, k.name().to_string(), None));
+    for (method, name, batch) in
+        methods.chain(std::iter::once((Method::Gpu, "gpu-batch-1".to_string(), Some(1))))
+    {
+        progress.step(&format!("{}: building {name}", model.name));
+        match Solver::new(method, mesh, &Options::default(), Some(ctx), batch) {
+            Ok(s) => sides.push((name, Contender::Solver(Box::new(s)))),
             Err(e) if method.is_cpu() => return Err(e),
-            Err(e) => {
-                // A GPU method this device cannot run marks its cells, not the whole run.
-                m.failed.push((method.name().to_string(), e.to_string()));
-                continue;
-            }
-        };
-        let (time, ok) = set_times(&mut |p| solver.classify_all(p), &sets, &want)?;
-        if !ok {
-            m.disagreements.push(method.name().to_string());
+            // A GPU method this device cannot run marks its cells, not the whole run.
+            Err(e) => m.failed.push((name, e.to_string())),
         }
-        if let Some(g) = solver.gpu_stats() {
+    }
+
+    // Every method on every set in turn (set 1: A, B, …; set 2: A, B, …), after one
+    // untimed warm-up each (lavapipe compiles shaders at the first draw): load that comes
+    // and goes hits every method alike, and the ratio of two methods can be taken set by
+    // set.
+    for (_, side) in &mut sides {
+        side.classify(&sets[0])?;
+    }
+    let mut times = vec![Samples::default(); sides.len()];
+    let mut agree = vec![true; sides.len()];
+    for (k, (set, w)) in sets.iter().zip(&want).enumerate() {
+        progress.step(&format!("{}: set {} of {}, every method in turn", model.name, k + 1, sets.len()));
+        for (i, (_, side)) in sides.iter_mut().enumerate() {
+            let t = Instant::now();
+            let got = side.classify(set)?;
+            times[i].push(t.elapsed());
+            agree[i] &= got == *w;
+        }
+    }
+    for ((name, side), (time, ok)) in sides.into_iter().zip(times.into_iter().zip(agree)) {
+        if !ok {
+            m.disagreements.push(if name == "gpu-batch-1" { "gpu (batch 1)".into() } else { name.clone() });
+        }
+        if let Contender::Solver(solver) = &side
+            && let Some(g) = solver.gpu_stats()
+            && name != "gpu-batch-1"
+        {
             m.gpu_split.push(format!(
                 "{}: last set {} points drawn in {} draw(s), GPU submissions {:.3} ms, host {:.3} ms, {} flagged → exact CPU {:.3} ms",
-                method,
+                name,
                 g.gpu_points,
                 g.draws,
                 g.gpu.as_secs_f64() * 1e3,
@@ -267,7 +281,11 @@ fn measure_model(
                 g.fallback.as_secs_f64() * 1e3
             ));
         }
-        m.times.push((method.name().to_string(), time));
+        if name.starts_with("tetragrid-") {
+            m.grid_times.push(time);
+        } else {
+            m.times.push((name, time));
+        }
     }
     // Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
     // covering and per-tetra planes every Feito-Torres variant shares.
@@ -278,18 +296,6 @@ fn measure_model(
         ("bvh", Bvh::new(ft()?).index_stats()),
         ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
     ];
-    // The thesis' layout: one point-vertex per tetrahedron.
-    progress.step(&format!("{}: gpu, one tetrahedron per point-vertex", model.name));
-    match Solver::new(Method::Gpu, mesh, &Options::default(), Some(ctx), Some(1)) {
-        Ok(mut thesis_gpu) => {
-            let (time, ok) = set_times(&mut |p| thesis_gpu.classify_all(p), &sets, &want)?;
-            if !ok {
-                m.disagreements.push("gpu (batch 1)".into());
-            }
-            m.times.push(("gpu-batch-1".into(), time));
-        }
-        Err(e) => m.failed.push(("gpu-batch-1".into(), e.to_string())),
-    }
     Ok(m)
 }
 

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use crate::gpu::Context;
 use crate::mesh::{Mesh, formats, procedural};
-use crate::report::{Environment, Log, Progress, Report, Samples, Table, time_runs};
+use crate::report::{Environment, Log, Progress, Report, Samples, Table, interleave};
 use crate::subdiv::compare::Comparison;
 use crate::subdiv::gpu::{Options, Run, Subdivider, Times};
 use crate::subdiv::{Result, cpu, osd};
@@ -103,8 +103,10 @@ pub struct Measured {
     pub cold: Duration,
     /// texgeo's f64 CPU reference (TCPU²).
     pub cpu: Samples,
-    /// OpenSubdiv: the helper's minimum and median of refine + interpolate, seconds.
+    /// OpenSubdiv: the minimum and median of refine + interpolate, seconds.
     pub osd: (f64, f64),
+    /// OpenSubdiv's every run, interleaved with `gpu_totals` and `cpu`.
+    pub osd_runs: Samples,
     /// "match, …", "MISMATCH" or "not checked".
     pub verdict: String,
 }
@@ -132,26 +134,37 @@ pub fn measure(
         let mut subdivider = Subdivider::new(ctx)?;
         let first = subdivider.refine(ctx, mesh, level, &Options::default())?;
         let cold = start.elapsed();
+        // The GPU path, the CPU reference and OpenSubdiv in turn, run after run: load
+        // that comes and goes hits all three alike, and their ratios can be taken run by
+        // run.
+        progress.step(&format!("{}: GPU path, CPU reference and OpenSubdiv in turn", model.name));
         let mut times = Vec::new();
         let mut last: Option<Run> = None;
-        let gpu_totals = time_runs(settings.runs, || {
-            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
-            let total = run.times.total;
-            times.push(run.times.clone());
-            last = Some(run);
-            Ok::<_, crate::subdiv::SubdivError>(total)
-        })?;
+        let samples = interleave(
+            settings.runs,
+            &mut [
+                &mut || -> Result<Duration> {
+                    let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
+                    let total = run.times.total;
+                    times.push(run.times.clone());
+                    last = Some(run);
+                    Ok(total)
+                },
+                &mut || -> Result<Duration> {
+                    let start = Instant::now();
+                    cpu::refine(mesh, level)?;
+                    Ok(start.elapsed())
+                },
+                &mut || -> Result<Duration> { osd_once(mesh, level) },
+            ],
+        )?;
+        let [gpu_totals, cpu, osd_runs]: [Samples; 3] =
+            samples.try_into().unwrap_or_else(|_| unreachable!("three sides"));
         times.remove(0); // the warm-up run
         let gpu = median_times(&times);
         let run = last.unwrap_or(first);
-        progress.step(&format!("{}: CPU reference", model.name));
-        let cpu = time_runs(settings.runs, || {
-            let start = Instant::now();
-            cpu::refine(mesh, level)?;
-            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
-        })?;
-        progress.step(&format!("{}: OpenSubdiv", model.name));
-        let osd_times = osd_times(mesh, level, settings.runs)?;
+        progress.step(&format!("{}: compared with OpenSubdiv", model.name));
+        let osd_times = (osd_runs.min().as_secs_f64(), osd_runs.median().as_secs_f64());
         let verdict = if settings.validate {
             let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
             if c.is_match() {
@@ -176,23 +189,22 @@ pub fn measure(
             cold,
             cpu,
             osd: osd_times,
+            osd_runs,
             verdict,
         });
     }
     Ok(out)
 }
 
-/// OpenSubdiv's minimum and median seconds over `runs` timed runs (no output written).
-fn osd_times(mesh: &Mesh, level: u32, runs: usize) -> Result<(f64, f64)> {
-    let options = osd::Options { repeat: Some(runs.max(1) as u32), no_output: true, ..Default::default() };
+/// One timed OpenSubdiv refine + interpolate, as the helper measured it (no output
+/// written; the helper's start is not counted).
+fn osd_once(mesh: &Mesh, level: u32) -> Result<Duration> {
+    let options = osd::Options { repeat: Some(1), no_output: true, ..Default::default() };
     let timed = osd::run(&crate::subdiv::Surface::smooth(mesh.clone()), level, &options)?;
-    match (timed.min_seconds, timed.median_seconds) {
-        (Some(min), Some(median)) => Ok((min, median)),
-        _ => Err(crate::subdiv::SubdivError::Helper {
-            path: "osd-refine".into(),
-            message: "no timing was printed".into(),
-        }),
-    }
+    timed.min_seconds.map(Duration::from_secs_f64).ok_or_else(|| crate::subdiv::SubdivError::Helper {
+        path: "osd-refine".into(),
+        message: "no timing was printed".into(),
+    })
 }
 
 /// One level of [`per_level`].
@@ -205,6 +217,8 @@ pub struct LevelTimes {
     pub cpu: Samples,
     /// OpenSubdiv's minimum and median, seconds.
     pub osd: (f64, f64),
+    /// OpenSubdiv's every run, interleaved with `gpu` and `cpu`.
+    pub osd_runs: Samples,
 }
 
 /// The GPU path, the CPU reference and OpenSubdiv at each level of `levels`: where the
@@ -222,19 +236,27 @@ pub fn per_level(
         progress.step(&format!("level {level}"));
         let mut faces = 0;
         let mut gpu_levels = 0;
-        let gpu = time_runs(runs, || {
-            let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
-            faces = run.mesh.num_faces();
-            gpu_levels = run.gpu_levels;
-            Ok::<_, crate::subdiv::SubdivError>(run.times.total)
-        })?;
-        let cpu = time_runs(runs, || {
-            let start = Instant::now();
-            cpu::refine(mesh, level)?;
-            Ok::<_, crate::subdiv::SubdivError>(start.elapsed())
-        })?;
-        let osd = osd_times(mesh, level, runs)?;
-        out.push(LevelTimes { level, gpu_levels, faces, gpu, cpu, osd });
+        let samples = interleave(
+            runs,
+            &mut [
+                &mut || -> Result<Duration> {
+                    let run = subdivider.refine(ctx, mesh, level, &Options::default())?;
+                    faces = run.mesh.num_faces();
+                    gpu_levels = run.gpu_levels;
+                    Ok(run.times.total)
+                },
+                &mut || -> Result<Duration> {
+                    let start = Instant::now();
+                    cpu::refine(mesh, level)?;
+                    Ok(start.elapsed())
+                },
+                &mut || -> Result<Duration> { osd_once(mesh, level) },
+            ],
+        )?;
+        let [gpu, cpu, osd_runs]: [Samples; 3] =
+            samples.try_into().unwrap_or_else(|_| unreachable!("three sides"));
+        let osd = (osd_runs.min().as_secs_f64(), osd_runs.median().as_secs_f64());
+        out.push(LevelTimes { level, gpu_levels, faces, gpu, cpu, osd, osd_runs });
     }
     Ok(out)
 }

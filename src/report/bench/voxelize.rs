@@ -75,6 +75,9 @@ impl Medians {
     }
 }
 
+/// A method's runs so far and its last result, or why this device cannot run it.
+type Timed = std::result::Result<(Medians, crate::voxel::Voxelization), String>;
+
 /// One method at one resolution on one model.
 #[derive(Clone, Debug)]
 pub struct Measured {
@@ -137,37 +140,35 @@ pub fn measure(
             progress.step(&format!("{} {n}³: exact reference", model.name));
             let grid = Grid::for_mesh(&model.mesh, n)?;
             let reference = voxelizer.run(&solid, &grid, Method::Scanline)?.volume;
+            // Every method once untimed (a warm-up, and whether this device can run it),
+            // then `runs` rounds of every method in turn: load that comes and goes hits
+            // every method alike, and two methods' ratio can be taken round by round.
+            let mut results: Vec<(Method, Timed)> = Vec::new();
             for &method in &cfg.methods {
                 progress.step(&format!("{} {n}³: {method}", model.name));
-                let mut times = Medians::default();
-                let mut last = None;
-                let mut failed = None;
-                for run in 0..=cfg.runs.max(1) {
-                    match voxelizer.run(&solid, &grid, method) {
-                        Ok(r) => {
-                            if run > 0 {
-                                times.push(&r.timings);
-                            }
-                            last = Some(r);
-                        }
-                        Err(e) if unsupported(&e) => {
-                            failed = Some(e.to_string());
-                            break;
-                        }
-                        Err(e) => return Err(e),
+                match voxelizer.run(&solid, &grid, method) {
+                    Ok(r) => results.push((method, Ok((Medians::default(), r)))),
+                    Err(e) if unsupported(&e) => results.push((method, Err(e.to_string()))),
+                    Err(e) => return Err(e),
+                }
+            }
+            for _ in 0..cfg.runs.max(1) {
+                for (method, result) in &mut results {
+                    if let Ok((times, last)) = result {
+                        let r = voxelizer.run(&solid, &grid, *method)?;
+                        times.push(&r.timings);
+                        *last = r;
                     }
                 }
-                let result = match (failed, last) {
-                    (Some(why), _) => Err(why),
-                    (None, Some(r)) => Ok(MethodResult {
-                        times,
-                        fallback_centres: r.band.candidates as u64,
-                        corrected: r.band.changed as u64,
-                        occupied: r.volume.count(),
-                        identical: r.volume == reference,
-                    }),
-                    (None, None) => return Err(VoxelError::Usage("no run".into())),
-                };
+            }
+            for (method, result) in results {
+                let result = result.map(|(times, r)| MethodResult {
+                    times,
+                    fallback_centres: r.band.candidates as u64,
+                    corrected: r.band.changed as u64,
+                    occupied: r.volume.count(),
+                    identical: r.volume == reference,
+                });
                 out.push(Measured {
                     model: model.name.clone(),
                     thesis: model.thesis,

@@ -66,6 +66,10 @@ pub struct Fact {
     pub key: String,
     pub unit: &'static str,
     pub value: Result<Stat, String>,
+    /// Every repetition's value in the order they ran (empty: a single number). The
+    /// sides of a comparison are measured in turn, so repetition k of two facts of one
+    /// model ran back to back.
+    pub runs: Vec<f64>,
 }
 
 /// Where the numbers come from.
@@ -101,6 +105,14 @@ impl Facts {
         self.push(experiment, model, key, unit, Ok(stat));
     }
 
+    /// A timed value (seconds) with every repetition behind it.
+    pub fn add_runs(&mut self, experiment: &'static str, model: &str, key: &str, stat: Stat, runs: &Samples) {
+        self.push(experiment, model, key, "s", Ok(stat));
+        if let Some(f) = self.facts.last_mut() {
+            f.runs = runs.0.iter().map(|d| d.as_secs_f64()).collect();
+        }
+    }
+
     pub fn missing(
         &mut self,
         experiment: &'static str,
@@ -120,7 +132,14 @@ impl Facts {
         unit: &'static str,
         value: Result<Stat, String>,
     ) {
-        self.facts.push(Fact { experiment, model: model.to_string(), key: key.to_string(), unit, value });
+        self.facts.push(Fact {
+            experiment,
+            model: model.to_string(),
+            key: key.to_string(),
+            unit,
+            value,
+            runs: Vec::new(),
+        });
     }
 
     pub fn skipped(&mut self, experiment: &'static str, why: &str) {
@@ -188,6 +207,24 @@ impl Facts {
         Ok(out)
     }
 
+    /// `a / b` with its interval on every model that has both, smallest model first:
+    /// (model, size, ratio).
+    pub fn ratios(&self, experiment: &str, a: &str, b: &str) -> Result<Vec<(String, f64, Ratio)>, String> {
+        let pairs = self.pairs(experiment, a, b)?;
+        Ok(pairs
+            .into_iter()
+            .filter_map(|(m, size, _, _)| {
+                let r = Ratio::of(self.find(experiment, &m, a)?, self.find(experiment, &m, b)?)?;
+                Some((m, size, r))
+            })
+            .collect())
+    }
+
+    /// Every repetition of `key` on `model` (empty: a single number or none).
+    pub fn runs(&self, experiment: &str, model: &str, key: &str) -> &[f64] {
+        self.find(experiment, model, key).map_or(&[], |f| f.runs.as_slice())
+    }
+
     /// `a` and `b` on every model that has both: (model, size, a, b).
     pub fn pairs(
         &self,
@@ -208,6 +245,44 @@ impl Facts {
             return Err(why.unwrap_or_else(|| format!("no model has both {a} and {b}")));
         }
         Ok(out)
+    }
+}
+
+/// A ratio of two measured values with its interval: the range of the per-repetition
+/// ratios when both sides were measured in turn the same number of times, else the
+/// widest ratio their ranges allow (a point for single numbers).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ratio {
+    pub value: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Per-repetition ratios (empty when the sides were not paired).
+    pub runs: Vec<f64>,
+}
+
+impl Ratio {
+    pub fn of(a: &Fact, b: &Fact) -> Option<Ratio> {
+        let (x, y) = (a.value.as_ref().ok()?, b.value.as_ref().ok()?);
+        if a.runs.len() >= 2 && a.runs.len() == b.runs.len() && b.runs.iter().all(|v| *v > 0.0) {
+            let runs: Vec<f64> = a.runs.iter().zip(&b.runs).map(|(p, q)| p / q).collect();
+            let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            return Some(Ratio { value: median(&runs), lo, hi, runs });
+        }
+        let value = x.value / y.value;
+        let (lo, hi) = if x.runs > 1 || y.runs > 1 { (x.min / y.max, x.max / y.min) } else { (value, value) };
+        Some(Ratio { value, lo: lo.min(value), hi: hi.max(value), runs: Vec::new() })
+    }
+}
+
+/// Median of a non-empty list (0 for an empty one).
+pub fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    match s.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => s[n / 2],
+        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
     }
 }
 

@@ -28,7 +28,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use claims::{Claim, Verdict};
+pub use claims::{Claim, Decision, Verdict};
 pub use compare::compare;
 pub use experiments::{EXPERIMENTS, Experiment, Figure};
 pub use facts::{Facts, Stat};
@@ -95,6 +95,9 @@ impl ReproduceError {
 pub struct Config {
     /// Built-in models and small sizes (about two minutes on two cores).
     pub quick: bool,
+    /// Repetitions added to every timed comparison (narrower intervals, fewer
+    /// inconclusive verdicts, a longer run).
+    pub repeat: usize,
     /// Where `tools/fetch-models` put the thesis stand-ins.
     pub models_dir: PathBuf,
     /// Experiment names to run (empty: all).
@@ -145,6 +148,16 @@ impl Monitor for Quiet {
     fn end(&mut self, _name: &str, _elapsed: Duration) {}
 }
 
+impl Monitor for crate::report::Lines {
+    fn begin(&mut self, name: &str) -> Box<dyn Progress> {
+        self.started(name);
+        Box::new(NoProgress)
+    }
+    fn end(&mut self, name: &str, elapsed: Duration) {
+        self.ended(name, elapsed);
+    }
+}
+
 /// What a run produced.
 #[derive(Debug)]
 pub struct Outcome {
@@ -154,8 +167,8 @@ pub struct Outcome {
     pub failures: Vec<(String, String)>,
     /// Methods whose answers differed from the reference, per experiment.
     pub disagreements: Vec<String>,
-    /// Claims per verdict: holds, does not hold, not measurable.
-    pub verdicts: [usize; 3],
+    /// Claims per verdict: holds, does not hold, inconclusive (within noise), not measurable.
+    pub verdicts: [usize; 4],
     pub elapsed: Duration,
 }
 
@@ -164,6 +177,8 @@ pub struct Outcome {
 pub struct Run<'a> {
     pub ctx: &'a Context,
     pub quick: bool,
+    /// Repetitions to add to every timed comparison.
+    pub repeat: usize,
     pub models_dir: &'a Path,
     pub progress: &'a mut dyn Progress,
     pub facts: &'a mut Facts,
@@ -231,8 +246,9 @@ impl Run<'_> {
 pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<Outcome> {
     config.check()?;
     let start = Instant::now();
+    let watch = header::Watch::start();
     let layout = Layout::create(&config.out)?;
-    let header = header::Header::new(ctx, config);
+    let mut header = header::Header::new(ctx, config);
     let thesis = thesis::facts();
     let mut today = facts::Facts::new(facts::Source::Today);
     let mut names = HashSet::new();
@@ -259,6 +275,7 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
                 let mut r = Run {
                     ctx,
                     quick: config.quick,
+                    repeat: config.repeat,
                     models_dir: &config.models_dir,
                     progress: progress.as_mut(),
                     facts: &mut today,
@@ -332,7 +349,7 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
             "verdict",
         ],
     );
-    let mut verdicts = [0usize; 3];
+    let mut verdicts = [0usize; 4];
     for e in EXPERIMENTS {
         for c in e.claims {
             let then = (c.measure)(&thesis);
@@ -341,10 +358,11 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
             verdicts[match verdict {
                 Verdict::Holds => 0,
                 Verdict::DoesNotHold => 1,
-                Verdict::NotMeasurable(_) => 2,
+                Verdict::Inconclusive => 2,
+                Verdict::NotMeasurable(_) => 3,
             }] += 1;
             let thesis_cell = match &then {
-                Ok((shown, holds)) => format!("{shown} ({})", if *holds { "holds" } else { "does not hold" }),
+                Ok((shown, _)) => format!("{shown} ({})", Verdict::of(&then).word()),
                 Err(why) => format!("– ({why})"),
             };
             let measured = match &now {
@@ -368,17 +386,29 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
          — a ratio above 1; much, considerably, greatly — at least 2×; drastically, enormously, the vast majority — \
          at least 10× (90 %); linear — a log–log slope within 0.8–1.2; close — within a factor of 2; equal or better \
          — not slower beyond the range of the repeated runs (within 5 % for single numbers, such as the thesis'). \
+         Each compared pair was measured in turn, repetition by repetition (A, B, A, B, …), so that load from other \
+         work hits both sides alike. A value in parentheses after a measured one is its interval: for a ratio, the \
+         range of the per-repetition ratios; for a slope or a rank correlation, the range of the values fitted to \
+         each repetition on its own (the number of models says how few points a fit has); for a geometric mean, \
+         the geometric means of the cells' interval ends. A claim holds or does not hold only when the whole \
+         interval lies on one side of the rule's threshold; otherwise it is \"inconclusive (within noise)\" (more \
+         repetitions with `--repeat N` narrow the intervals). Counts, bytes and single builds carry no interval. \
          \"not measurable\" says why in \"measured here\".",
     );
 
     let elapsed = start.elapsed();
+    let state = watch.finish();
+    let warning = state.warning();
+    header.state = Some(state);
     let longest = sections.iter().max_by_key(|s| s.3).map(|s| (EXPERIMENTS[s.0].title, s.3));
     let write_table = |t: Table, stem: &str| -> Result<Block> {
         let csv = format!("{}/{stem}.csv", Layout::CSV);
         layout.write(&csv, t.to_csv().as_bytes())?;
         Ok(Block::Table { table: t, csv })
     };
-    let mut blocks = vec![write_table(header.table(elapsed, longest), "run")?, header::Header::note()];
+    let mut blocks: Vec<Block> = warning.into_iter().collect();
+    blocks.push(write_table(header.table(elapsed, longest), "run")?);
+    blocks.push(header::Header::note());
     let mut summary =
         Table::new("Experiments", &["experiment", "thesis tables", "command", "status", "time (s)"]);
     for (i, _, status, t) in &sections {
@@ -394,10 +424,12 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
     blocks.push(Block::Heading(2, "Summary".into()));
     blocks.push(write_table(summary, "experiments")?);
     blocks.push(Block::Para(format!(
-        "Claims: **{}** hold, **{}** do not hold, **{}** are not measurable here (details in [Claims](#claims)). {}",
+        "Claims: **{}** hold, **{}** do not hold, **{}** are inconclusive (within noise), **{}** are not measurable \
+         here (details in [Claims](#claims)). {}",
         verdicts[0],
         verdicts[1],
         verdicts[2],
+        verdicts[3],
         if disagreements.is_empty() {
             "Every method gave the reference's answer on every point, voxel and vertex checked.".to_string()
         } else {

@@ -12,7 +12,7 @@ use crate::inclusion::Method;
 use crate::mesh::{Mesh, procedural};
 use crate::report::Samples;
 use crate::report::Table;
-use crate::report::bench::boolean::{OPERATIONS, Pair, STAND_INS, measure, sequential};
+use crate::report::bench::boolean::{OPERATIONS, Pair, STAND_INS, measure_interleaved, sequential};
 use crate::report::plot::Chart;
 use crate::report::reproduce::doc::Block;
 use crate::report::reproduce::facts::Stat;
@@ -55,7 +55,7 @@ fn ms(d: Duration) -> String {
 pub fn run(r: &mut Run) -> Result<Vec<Block>> {
     let (models, notes) =
         if r.quick { (quick_models(), Vec::new()) } else { stand_ins(r.models_dir, STAND_INS)? };
-    let runs = 3;
+    let runs = 3 + r.repeat;
     let cgal_ready = cgal::helper_path().is_ok();
     r.progress.total(models.len() as u64);
 
@@ -76,8 +76,14 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         r.progress.step(&format!("{}: phases, grouped and plain, CPU and GPU", model.name));
         let pair = Pair::with_turned_copy(model.thesis, model.name.clone(), model.mesh)?;
         let triangles = pair.a.num_faces() + pair.b.num_faces();
-        let grouped = measure(&pair, &sequential(CPU_METHOD, Grouping::Grouped), None, runs);
-        let (p1, p2, asm, ev) = match grouped {
+        // Grouped with CPU and with GPU point tests, and plain, in turn, run after run.
+        let (cpu, gpu, plain) = (
+            sequential(CPU_METHOD, Grouping::Grouped),
+            sequential(Method::Gpu, Grouping::Grouped),
+            sequential(CPU_METHOD, Grouping::Plain),
+        );
+        let measured = measure_interleaved(&pair, &[(&cpu, None), (&gpu, Some(r.ctx)), (&plain, None)], runs);
+        let mut measured = match measured {
             Err(e @ crate::boolean::BooleanError::Input { .. }) => {
                 refused.push(format!("{} ({e})", pair.name));
                 continue;
@@ -89,10 +95,10 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             }
             other => other?,
         };
-        let (_, p2_gpu, asm_gpu, ev_gpu) =
-            measure(&pair, &sequential(Method::Gpu, Grouping::Grouped), Some(r.ctx), runs)?;
-        let (_, p2_plain, asm_plain, ev_plain) =
-            measure(&pair, &sequential(CPU_METHOD, Grouping::Plain), None, 1)?;
+        let three = "three variants";
+        let (_, p2_plain, asm_plain, ev_plain) = measured.pop().unwrap_or_else(|| unreachable!("{three}"));
+        let (_, p2_gpu, asm_gpu, ev_gpu) = measured.pop().unwrap_or_else(|| unreachable!("{three}"));
+        let (p1, p2, asm, ev) = measured.pop().unwrap_or_else(|| unreachable!("{three}"));
         let same = |a: &crate::boolean::Evaluation| {
             a.classification.a == ev.classification.a && a.classification.b == ev.classification.b
         };
@@ -138,12 +144,15 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         let phase2_cpu = sum(&[&p2, &asm[2]]);
         let phase2_gpu = sum(&[&p2_gpu, &asm_gpu[2]]);
         let phase2_plain = sum(&[&p2_plain, &asm_plain[2]]);
-        r.facts.add(EXP, &name, "time:phase1", "s", Stat::median_of(&p1));
-        r.facts.add(EXP, &name, "time:phase2-grouped", "s", Stat::median_of(&phase2_cpu));
-        r.facts.add(EXP, &name, "time:phase2-cpu", "s", Stat::median_of(&phase2_cpu));
-        r.facts.add(EXP, &name, "time:phase2-gpu", "s", Stat::median_of(&phase2_gpu));
-        r.facts.add(EXP, &name, "time:phase2-plain", "s", Stat::median_of(&phase2_plain));
-        r.facts.add(EXP, &name, "time:total", "s", Stat::median_of(&sum(&[&p1, &p2, &asm[2]])));
+        let timed = |f: &mut crate::report::reproduce::Facts, key: &str, s: &Samples| {
+            f.add_runs(EXP, &name, key, Stat::median_of(s), s);
+        };
+        timed(r.facts, "time:phase1", &p1);
+        timed(r.facts, "time:phase2-grouped", &phase2_cpu);
+        timed(r.facts, "time:phase2-cpu", &phase2_cpu);
+        timed(r.facts, "time:phase2-gpu", &phase2_gpu);
+        timed(r.facts, "time:phase2-plain", &phase2_plain);
+        timed(r.facts, "time:total", &sum(&[&p1, &p2, &asm[2]]));
         r.facts.add(EXP, &name, "reduction", "", Stat::exact(s.saved_share()));
         r.facts.add(EXP, &name, "point-tests", "", Stat::exact(s.point_tests as f64));
         r.facts.add(
@@ -157,12 +166,11 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         // dearest single one.
         let all = sum(&[&p1, &p2, &asm[0], &asm[1], &asm[2]]);
         let dearest = (0..OPERATIONS.len()).max_by_key(|&k| asm[k].median()).unwrap_or(0);
-        r.facts.add(EXP, &name, "time:all-ops", "s", Stat::median_of(&all));
-        r.facts.add(EXP, &name, "time:one-op", "s", Stat::median_of(&sum(&[&p1, &p2, &asm[dearest]])));
+        timed(r.facts, "time:all-ops", &all);
+        timed(r.facts, "time:one-op", &sum(&[&p1, &p2, &asm[dearest]]));
         for (k, &op) in OPERATIONS.iter().enumerate() {
             let grouped_gpu = sum(&[&p1, &p2_gpu, &asm_gpu[k]]);
             let grouped_cpu = sum(&[&p1, &p2, &asm[k]]);
-            // The plain run's phase 1 is a single run: its median is itself.
             let plain = sum(&[&p1, &p2_plain, &asm_plain[k]]);
             for (kind, times) in [("grouped", &grouped_gpu), ("grouped-cpu", &grouped_cpu), ("plain", &plain)]
             {
@@ -223,7 +231,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         r.disagreement(format!("boolean: no answer on {f}"));
     }
     table.note(format!(
-        "Medians of {runs} runs after a warm-up (plain classification: one run). Each pair is a solid and its copy \
+        "Medians of {runs} runs after a warm-up, each run measuring grouped CPU, grouped GPU and plain in turn. \
+         Each pair is a solid and its copy \
          rotated 10° about y and moved by 1 % of its diagonal along x (`texgeo bench boolean`'s pairs); triangles = \
          both operands. phase 1 = index + pair tests + intersection points + re-triangulation; phase 2 = both \
          inclusion classifiers + on-tests + groups (grouped) + point tests + the operation's assembly. CPU point tests \
@@ -237,7 +246,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
 
     let mut blocks = vec![Block::Para(format!(
         "Every pair is measured with grouped classification (one point test per group, §6.5.1) on the CPU and on \
-         the GPU, and with plain classification (one point test per triangle), {runs} timed runs after a warm-up. \
+         the GPU, and with plain classification (one point test per triangle), {runs} timed runs after a warm-up, the three \
+         back to back in every run so that load from other work hits them alike. \
          Union, intersection and difference are all assembled from the one refinement and classification."
     ))];
     blocks.push(r.table(models_table(EXP, r, &list), "boolean-models")?);
