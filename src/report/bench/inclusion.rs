@@ -121,6 +121,8 @@ pub struct Measured {
     pub triangles: usize,
     /// TetraGrid build (time, bytes) at each of `Config::resolutions`.
     pub grid_builds: Vec<(Duration, usize)>,
+    /// Every TetraGrid build at each resolution (median in `grid_builds`).
+    pub grid_build_times: Vec<Samples>,
     /// Method name → the time of every set (`gpu-batch-1`: the thesis' one tetrahedron
     /// per point-vertex).
     pub times: Vec<(String, Samples)>,
@@ -135,6 +137,8 @@ pub struct Measured {
     pub disagreements: Vec<String>,
     /// Index-only build stats of the methods with preprocessing (Tables 4-7, 4-8).
     pub index: Vec<(&'static str, crate::inclusion::BuildStats)>,
+    /// Every build of each index of `index` (median in its stats).
+    pub index_builds: Vec<Samples>,
 }
 
 impl Measured {
@@ -171,6 +175,10 @@ pub fn steps(models: usize, cfg: &Config) -> u64 {
     (models * (cfg.resolutions.len() + METHODS.len() + 2 + cfg.sets)) as u64
 }
 
+/// Builds of every index and TetraGrid resolution, for the medians and ranges of
+/// Tables 4-4, 4-7 and 4-8.
+const BUILDS: usize = 3;
+
 /// The methods of Tables 4-6 to 4-9, at their default settings (TetraGrid 32³, octree 6).
 const METHODS: [Method; 9] = [
     Method::Cpu,
@@ -201,6 +209,7 @@ fn measure_model(
         faces: mesh.num_faces(),
         triangles: covering.triangles.len(),
         grid_builds: Vec::new(),
+        grid_build_times: Vec::new(),
         times: Vec::new(),
         failed: Vec::new(),
         grid_times: Vec::new(),
@@ -208,6 +217,7 @@ fn measure_model(
         gpu_split: Vec::new(),
         disagreements: Vec::new(),
         index: Vec::new(),
+        index_builds: Vec::new(),
     };
 
     // The reference answers: the exact test with basic preprocessing.
@@ -223,10 +233,21 @@ fn measure_model(
         progress.step(&format!("{}: building TetraGrid {n}³", model.name));
         let ft = FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?;
         let grid = GridClassifier::new(ft, n)?;
-        let s = grid.index_stats();
-        m.grid_builds.push((s.build_time, s.bytes));
+        m.grid_build_times.push(Samples(vec![grid.index_stats().build_time]));
+        m.grid_builds.push((Duration::ZERO, grid.index_stats().bytes));
         m.grid_tested.push(tested_share(&grid, &sets, m.triangles));
         sides.push((format!("tetragrid-{n}"), Contender::Grid(Box::new(grid))));
+    }
+    // More builds of every resolution in turn: a build time is as exposed to load as a
+    // query time, and the build's growth in n is a claim.
+    for _ in 1..BUILDS {
+        for (i, &n) in cfg.resolutions.iter().enumerate() {
+            let grid = GridClassifier::new(FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?, n)?;
+            m.grid_build_times[i].push(grid.index_stats().build_time);
+        }
+    }
+    for (b, t) in m.grid_builds.iter_mut().zip(&m.grid_build_times) {
+        b.0 = t.median();
     }
 
     // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6),
@@ -289,13 +310,26 @@ fn measure_model(
     }
     // Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
     // covering and per-tetra planes every Feito-Torres variant shares.
+    // Each built BUILDS times, the indexes in turn.
     let ft = || FeitoTorres::with_options(mesh, None, EdgeRule::Rerun);
-    m.index = vec![
-        ("octants", Octants::new(ft()?).index_stats()),
-        ("tetragrid", GridClassifier::new(ft()?, 32)?.index_stats()),
-        ("bvh", Bvh::new(ft()?).index_stats()),
-        ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
-    ];
+    for _ in 0..BUILDS {
+        let built = [
+            ("octants", Octants::new(ft()?).index_stats()),
+            ("tetragrid", GridClassifier::new(ft()?, 32)?.index_stats()),
+            ("bvh", Bvh::new(ft()?).index_stats()),
+            ("jordan-octree", JordanOctree::new(mesh, 6)?.index_stats()),
+        ];
+        if m.index.is_empty() {
+            m.index_builds = vec![Samples::default(); built.len()];
+            m.index = built.to_vec();
+        }
+        for (s, (_, stats)) in m.index_builds.iter_mut().zip(&built) {
+            s.push(stats.build_time);
+        }
+    }
+    for ((_, stats), s) in m.index.iter_mut().zip(&m.index_builds) {
+        stats.build_time = s.median();
+    }
     Ok(m)
 }
 

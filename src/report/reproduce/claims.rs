@@ -9,7 +9,7 @@
 //! "close" — within a factor of 2; "equal or better" — not slower beyond the range of the
 //! repeated runs (within 5 % for single numbers, such as the thesis').
 
-use super::facts::{Facts, Ratio, Stat, geomean, loglog_slope, spearman};
+use super::facts::{Facts, Missing, Ratio, Stat, geomean, loglog_slope, spearman};
 
 /// A claim of a thesis.
 pub struct Claim {
@@ -178,7 +178,7 @@ fn pct(v: f64) -> String {
 
 /// `a / b` with its interval for every model that has both: (model, size, ratio).
 fn ratios(f: &Facts, exp: &str, a: &str, b: &str) -> Result<Vec<(String, f64, Ratio)>, String> {
-    f.ratios(exp, a, b)
+    Ok(f.ratios(exp, a, b)?)
 }
 
 /// The ratio on every model, which must reach `t` (`strict`: exceed it).
@@ -290,7 +290,11 @@ fn tetragrid_beyond_64(f: &Facts) -> Measure {
 
 fn tetragrid_discards(f: &Facts) -> Measure {
     let s = f.series("inclusion", "tested:tetragrid-32").map_err(|e| {
-        if e.starts_with("no model") { "the thesis gives no count of tests".to_string() } else { e }
+        if matches!(e, Missing::NoModel(_)) {
+            "the thesis gives no count of tests".to_string()
+        } else {
+            e.into()
+        }
     })?;
     let worst = s.iter().map(|p| p.2.value).fold(0f64, f64::max);
     Ok((
@@ -320,24 +324,29 @@ fn tetragrid_memory_grows(f: &Facts) -> Measure {
 }
 
 fn tetragrid_build_order(f: &Facts) -> Measure {
-    let mut worst: Option<(f64, String)> = None;
+    let mut worst: Option<((f64, f64, f64, usize), String)> = None;
+    let mut decisions = Vec::new();
     for (m, _) in f.models_of("inclusion") {
-        let pts: Vec<(f64, f64)> = [16.0, 32.0, 64.0]
+        let keys: Vec<(f64, String)> =
+            [16, 32, 64].iter().map(|n| (*n as f64, format!("build:tetragrid-{n}"))).collect();
+        let pts: Vec<(f64, f64, &[f64])> = keys
             .iter()
-            .filter_map(|&n| {
-                f.get("inclusion", &m, &format!("build:tetragrid-{n}")).ok().map(|s| (n, s.value.max(1e-9)))
+            .filter_map(|(n, k)| {
+                f.get("inclusion", &m, k).ok().map(|s| (*n, s.value.max(1e-9), f.runs("inclusion", &m, k)))
             })
             .collect();
-        if let Some(k) = loglog_slope(&pts)
-            && worst.as_ref().is_none_or(|w| k > w.0)
-        {
-            worst = Some((k, m));
+        if let Some(k) = slope_interval(&pts) {
+            decisions.push(at_most(k.1, k.2, 3.0));
+            if worst.as_ref().is_none_or(|w| k.0 > w.0.0) {
+                worst = Some((k, m));
+            }
         }
     }
-    let (k, m) = worst.ok_or_else(|| {
+    let ((k, lo, hi, reps), m) = worst.ok_or_else(|| {
         f.why_not_run("inclusion").unwrap_or("no TetraGrid build times at 16³–64³").to_string()
     })?;
-    Ok((format!("steepest slope {k:.2} in n ({m}; one build each)"), (k <= 3.0).into()))
+    let how = if reps > 0 { format!("; interval: each of {reps} builds fitted") } else { String::new() };
+    Ok((format!("steepest slope {} in n ({m}{how})", fr(k, lo, hi, false)), Decision::all(decisions)))
 }
 
 fn gpu_faster(f: &Facts) -> Measure {
@@ -373,10 +382,22 @@ fn gpu_linear(f: &Facts) -> Measure {
     slope(f, "inclusion", "time:gpu", (0.8, 1.2))
 }
 
+/// Whether `mine` is below `rival` beyond the range of their runs.
+fn below(mine: &Stat, rival: &Stat) -> Decision {
+    if mine.max < rival.min {
+        Decision::Holds
+    } else if mine.min >= rival.max {
+        Decision::DoesNotHold
+    } else {
+        Decision::Inconclusive
+    }
+}
+
 /// Whether `index` has the smallest `what` (build or memory) of all indexes on every model.
 fn cheapest(f: &Facts, index: &str, others: &[&str]) -> Measure {
     let mut checked = 0;
     let mut fails = Vec::new();
+    let mut decisions = Vec::new();
     for what in ["build", "memory"] {
         let mine = f.series("inclusion", &format!("{what}:{index}"))?;
         for (m, _, v) in mine {
@@ -386,9 +407,14 @@ fn cheapest(f: &Facts, index: &str, others: &[&str]) -> Measure {
                 continue;
             }
             checked += 1;
-            if rivals.iter().any(|r| r.value <= v.value) {
-                fails.push(format!("{what} on {m}"));
+            let d = Decision::all(rivals.iter().map(|r| below(&v, r)));
+            if d != Decision::Holds {
+                fails.push(format!(
+                    "{what} on {m}{}",
+                    if d == Decision::Inconclusive { " (within noise)" } else { "" }
+                ));
             }
+            decisions.push(d);
         }
     }
     if checked == 0 {
@@ -399,7 +425,10 @@ fn cheapest(f: &Facts, index: &str, others: &[&str]) -> Measure {
     } else {
         format!("not the cheapest: {}", fails.join(", "))
     };
-    Ok((format!("{shown} (one build each)"), fails.is_empty().into()))
+    Ok((
+        format!("{shown} (build times: medians of their runs, compared beyond their range)"),
+        Decision::all(decisions),
+    ))
 }
 
 fn octants_cheapest(f: &Facts) -> Measure {
@@ -408,7 +437,11 @@ fn octants_cheapest(f: &Facts) -> Measure {
 
 fn bsp_costliest(f: &Facts) -> Measure {
     let s = f.series("inclusion", "build:bsp").map_err(|e| {
-        if e.starts_with("no model") { "texgeo has no BSP method (a BVH stands in)".to_string() } else { e }
+        if matches!(e, Missing::NoModel(_)) {
+            "texgeo has no BSP method (a BVH stands in)".to_string()
+        } else {
+            e.into()
+        }
     })?;
     let mut fails = Vec::new();
     for (m, _, v) in &s {
@@ -646,7 +679,10 @@ fn voxel_grows_with_n(f: &Facts) -> Measure {
         return Err("needs two or more resolutions".into());
     }
     Ok((
-        format!("time grows with N beyond the runs' range in {grows_n} of {total} (model, method) series"),
+        format!(
+            "time grows with N beyond the runs' range in {grows_n} of {total} (model, method) series; the rest \
+             within it or shrinking"
+        ),
         Decision::all(decisions),
     ))
 }
@@ -674,7 +710,8 @@ fn voxel_grows_with_size(f: &Facts) -> Measure {
     }
     Ok((
         format!(
-            "time grows with triangles beyond the runs' range in {grows_n} of {total} (N, method) series"
+            "time grows with triangles beyond the runs' range in {grows_n} of {total} (N, method) series; the \
+             rest within it or shrinking"
         ),
         Decision::all(decisions),
     ))
@@ -1083,8 +1120,8 @@ fn gpu_beats_cpu_l5(f: &Facts) -> Measure {
 
 fn gpu_beats_osd_l5(f: &Facts) -> Measure {
     match f.series("subdivide", "time:osd") {
-        Err(e) if e.starts_with("no model") => Err("the thesis compared with CGAL only".into()),
-        Err(e) => Err(e),
+        Err(Missing::NoModel(_)) => Err("the thesis compared with CGAL only".into()),
+        Err(e) => Err(e.into()),
         Ok(_) => min_ratio(f, "subdivide", "time:osd", "time:gpu-path", 1.0, true),
     }
 }
@@ -1147,7 +1184,11 @@ fn crossover_osd(f: &Facts) -> Measure {
 
 fn one_pass_per_level(f: &Facts) -> Measure {
     let p = f.pairs("subdivide", "passes", "gpu-levels").map_err(|e| {
-        if e.starts_with("no model") { "the thesis gives no pass counts".to_string() } else { e }
+        if matches!(e, Missing::NoModel(_)) {
+            "the thesis gives no pass counts".to_string()
+        } else {
+            e.into()
+        }
     })?;
     let ok = p.iter().filter(|q| q.2.value == q.3.value).count();
     Ok((format!("one pass per GPU level on {ok} of {} models", p.len()), (ok == p.len()).into()))
@@ -1215,3 +1256,108 @@ pub const SUBDIVIDE: &[Claim] = &[
         measure: real_time_cube,
     },
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::Samples;
+    use crate::report::reproduce::facts::Source;
+    use std::time::Duration;
+
+    fn samples(ms: &[f64]) -> Samples {
+        Samples(ms.iter().map(|v| Duration::from_secs_f64(v / 1e3)).collect())
+    }
+
+    /// A model of a test: name, size, (key, per-repetition ms).
+    type TestModel<'a> = (&'a str, f64, &'a [(&'a str, &'a [f64])]);
+
+    /// Today's facts of `exp`.
+    fn today(exp: &'static str, models: &[TestModel]) -> Facts {
+        let mut f = Facts::new(Source::Today);
+        for (name, size, keys) in models {
+            f.model(exp, name, *size, "–");
+            for (key, ms) in *keys {
+                let s = samples(ms);
+                f.add_runs(exp, name, key, Stat::median_of(&s), &s);
+            }
+        }
+        f
+    }
+
+    fn decision(m: Measure) -> Decision {
+        m.expect("measurable").1
+    }
+
+    #[test]
+    fn a_verdict_needs_the_whole_interval_on_one_side() {
+        assert_eq!(at_least(2.1, 3.0, 2.0), Decision::Holds);
+        assert_eq!(at_least(1.5, 1.9, 2.0), Decision::DoesNotHold);
+        assert_eq!(at_least(1.9, 2.1, 2.0), Decision::Inconclusive);
+        assert_eq!(within(0.9, 1.1, 0.8, 1.2), Decision::Holds);
+        assert_eq!(within(0.7, 0.9, 0.8, 1.2), Decision::Inconclusive);
+        assert_eq!(within(1.3, 1.5, 0.8, 1.2), Decision::DoesNotHold);
+        // Per-repetition ratios 1.2, 0.9, 1.1: OpenSubdiv / GPU path straddles 1.
+        let f = today(
+            "subdivide",
+            &[("cube", 100.0, &[("time:osd", &[12.0, 9.0, 11.0]), ("time:gpu-path", &[10.0, 10.0, 10.0])])],
+        );
+        let (shown, d) = gpu_beats_osd_l5(&f).unwrap();
+        assert_eq!(d, Decision::Inconclusive, "{shown}");
+        assert!(shown.contains("(0.90–1.20×)"), "the interval is shown: {shown}");
+        // Every repetition ahead: decided.
+        let f = today(
+            "subdivide",
+            &[("cube", 100.0, &[("time:osd", &[12.0, 13.0, 11.0]), ("time:gpu-path", &[10.0, 10.0, 10.0])])],
+        );
+        assert_eq!(decision(gpu_beats_osd_l5(&f)), Decision::Holds);
+    }
+
+    #[test]
+    fn ratios_are_taken_per_repetition() {
+        // Load doubled both sides of repetition 2: per repetition the ratio stays 4×,
+        // while the sides' own ranges would allow 2×–8×.
+        let f = today(
+            "subdivide",
+            &[(
+                "cube",
+                100.0,
+                &[("time:tcpu2", &[40.0, 80.0, 40.0]), ("time:gpu-path", &[10.0, 20.0, 10.0])],
+            )],
+        );
+        let (shown, d) = gpu_beats_cpu_l5(&f).unwrap();
+        assert_eq!(d, Decision::Holds, "{shown}");
+        assert!(shown.starts_with("4.00× (cube)"), "{shown}");
+    }
+
+    #[test]
+    fn a_narrowing_gap_while_the_gpu_is_slower_is_no_growing_advantage() {
+        // cpu / gpu rises with size (0.04 → 0.14) but the GPU is 7–25× slower throughout.
+        let sa: [(&str, &[f64]); 2] = [("time:phase2-cpu", &[1.0; 3]), ("time:phase2-gpu", &[25.0; 3])];
+        let sb: [(&str, &[f64]); 2] = [("time:phase2-cpu", &[2.0; 3]), ("time:phase2-gpu", &[20.0; 3])];
+        let sc: [(&str, &[f64]); 2] = [("time:phase2-cpu", &[1.0; 3]), ("time:phase2-gpu", &[7.0; 3])];
+        let f = today("boolean", &[("small", 1e3, &sa), ("mid", 1e4, &sb), ("large", 1e5, &sc)]);
+        let (shown, d) = boolean_gpu_grows(&f).unwrap();
+        assert_eq!(d, Decision::DoesNotHold, "{shown}");
+    }
+
+    #[test]
+    fn equal_speed_beats_nothing() {
+        // The GPU path and OpenSubdiv take the same time at every level: S4 must not hold.
+        let mut keys: Vec<(String, Vec<f64>)> = Vec::new();
+        for level in 1..=5 {
+            keys.push((format!("level:{level}:gpu-path"), vec![10.0; 3]));
+            keys.push((format!("level:{level}:osd"), vec![10.0; 3]));
+        }
+        let mut f = Facts::new(Source::Today);
+        f.model("subdivide", "builtin:knot", 1e4, "–");
+        for (k, ms) in &keys {
+            let s = samples(ms);
+            f.add_runs("subdivide", "builtin:knot", k, Stat::median_of(&s), &s);
+        }
+        for level in 1..=5 {
+            f.add("subdivide", "builtin:knot", &format!("level:{level}:gpu-levels"), "", Stat::exact(1.0));
+        }
+        let (shown, d) = crossover_osd(&f).unwrap();
+        assert_eq!(d, Decision::DoesNotHold, "{shown}");
+    }
+}

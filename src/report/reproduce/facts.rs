@@ -72,6 +72,82 @@ pub struct Fact {
     pub runs: Vec<f64>,
 }
 
+/// Why a number is missing, said in words a reader of the report understands (never
+/// the store's keys).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Missing {
+    /// The experiment did not run, or this device could not measure it: the reason.
+    Why(String),
+    /// No model of the source has the quantity (key).
+    NoModel(String),
+    /// One model lacks the quantity.
+    NotFor { key: String, model: String },
+    /// No model has both quantities.
+    NoPair(String, String),
+}
+
+impl std::fmt::Display for Missing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Missing::Why(why) => f.write_str(why),
+            Missing::NoModel(key) => write!(f, "no model has {}", describe(key)),
+            Missing::NotFor { key, model } => write!(f, "{} was not measured on {model}", describe(key)),
+            Missing::NoPair(a, b) => write!(f, "no model has both {} and {}", describe(a), describe(b)),
+        }
+    }
+}
+
+impl From<Missing> for String {
+    fn from(m: Missing) -> String {
+        m.to_string()
+    }
+}
+
+/// A method or part of a key in words.
+fn method_words(m: &str) -> String {
+    let words = match m {
+        "cpu" => "the CPU test",
+        "gpu" => "the GPU test",
+        "jordan" => "Jordan's test",
+        "jordan-octree" => "Jordan's test with an octree",
+        "gpu-path" => "the GPU path",
+        "tcpu1" => "the CPU base level (TCPU¹)",
+        "tgpu" => "the fragment passes (TGPU)",
+        "tcpu2" => "the CPU reference (TCPU²)",
+        "osd" => "OpenSubdiv",
+        "phase1" => "phase 1",
+        "phase2-cpu" | "phase2-grouped" => "phase 2 with CPU point tests",
+        "phase2-gpu" => "phase 2 with GPU point tests",
+        "phase2-plain" => "phase 2 with plain classification",
+        "total" => "the whole grouped operation",
+        "all-ops" => "all three operations",
+        "one-op" => "a single operation",
+        other => return other.replace("tetragrid-", "TetraGrid ").replace('-', " "),
+    };
+    words.to_string()
+}
+
+/// A quantity of the store in words: "time:phase2-cpu" → "the time of phase 2 with CPU
+/// point tests".
+pub fn describe(key: &str) -> String {
+    let parts: Vec<&str> = key.split(':').collect();
+    match parts.as_slice() {
+        ["time", m] => match m.split_once('@') {
+            Some((m, n)) => format!("the time of {} at {n}³", method_words(m)),
+            None => format!("the time of {}", method_words(m)),
+        },
+        ["build", m] => format!("the build time of {}", method_words(m)),
+        ["memory", m] => format!("the memory of {}", method_words(m)),
+        ["tested", m] => format!("the share of tetrahedra tested by {}", method_words(m)),
+        ["level", l, "gpu-levels"] => format!("the GPU levels at level {l}"),
+        ["level", l, m] => format!("the time of {} at level {l}", method_words(m)),
+        ["reduction"] => "the share of point tests saved".into(),
+        ["passes"] => "a count of fragment passes".into(),
+        ["gpu-levels"] => "a count of GPU levels".into(),
+        _ => key.replace([':', '-'], " "),
+    }
+}
+
 /// Where the numbers come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Source {
@@ -176,21 +252,21 @@ impl Facts {
     }
 
     /// The value, or why there is none.
-    pub fn get(&self, experiment: &str, model: &str, key: &str) -> Result<Stat, String> {
+    pub fn get(&self, experiment: &str, model: &str, key: &str) -> Result<Stat, Missing> {
         if let Some(why) = self.why_not_run(experiment) {
-            return Err(why.to_string());
+            return Err(Missing::Why(why.to_string()));
         }
         match self.find(experiment, model, key) {
-            Some(f) => f.value.clone(),
-            None => Err(format!("no {key} for {model}")),
+            Some(f) => f.value.clone().map_err(Missing::Why),
+            None => Err(Missing::NotFor { key: key.to_string(), model: model.to_string() }),
         }
     }
 
     /// `key` on every model that has it, smallest model first: (model, size, value).
     /// Err: the reason, when no model has it.
-    pub fn series(&self, experiment: &str, key: &str) -> Result<Vec<(String, f64, Stat)>, String> {
+    pub fn series(&self, experiment: &str, key: &str) -> Result<Vec<(String, f64, Stat)>, Missing> {
         if let Some(why) = self.why_not_run(experiment) {
-            return Err(why.to_string());
+            return Err(Missing::Why(why.to_string()));
         }
         let mut out = Vec::new();
         let mut why = None;
@@ -202,14 +278,14 @@ impl Facts {
             }
         }
         if out.is_empty() {
-            return Err(why.unwrap_or_else(|| format!("no model has {key}")));
+            return Err(why.map_or_else(|| Missing::NoModel(key.to_string()), Missing::Why));
         }
         Ok(out)
     }
 
     /// `a / b` with its interval on every model that has both, smallest model first:
     /// (model, size, ratio).
-    pub fn ratios(&self, experiment: &str, a: &str, b: &str) -> Result<Vec<(String, f64, Ratio)>, String> {
+    pub fn ratios(&self, experiment: &str, a: &str, b: &str) -> Result<Vec<(String, f64, Ratio)>, Missing> {
         let pairs = self.pairs(experiment, a, b)?;
         Ok(pairs
             .into_iter()
@@ -231,7 +307,7 @@ impl Facts {
         experiment: &str,
         a: &str,
         b: &str,
-    ) -> Result<Vec<(String, f64, Stat, Stat)>, String> {
+    ) -> Result<Vec<(String, f64, Stat, Stat)>, Missing> {
         let first = self.series(experiment, a)?;
         let mut out = Vec::new();
         let mut why = None;
@@ -242,7 +318,7 @@ impl Facts {
             }
         }
         if out.is_empty() {
-            return Err(why.unwrap_or_else(|| format!("no model has both {a} and {b}")));
+            return Err(why.unwrap_or_else(|| Missing::NoPair(a.to_string(), b.to_string())));
         }
         Ok(out)
     }
@@ -364,10 +440,19 @@ mod tests {
         f.model("voxelize", "knot", 1200.0, "Torusknot");
         f.missing("voxelize", "knot", "time:zoned@64", "s", "device lacks logic_op");
         f.add("voxelize", "knot", "time:cpu@64", "s", Stat::exact(0.1));
-        assert_eq!(f.get("voxelize", "knot", "time:zoned@64"), Err("device lacks logic_op".into()));
-        assert_eq!(f.series("voxelize", "time:zoned@64").unwrap_err(), "device lacks logic_op");
+        let why = |s: &str| Missing::Why(s.to_string());
+        assert_eq!(f.get("voxelize", "knot", "time:zoned@64"), Err(why("device lacks logic_op")));
+        assert_eq!(f.series("voxelize", "time:zoned@64").unwrap_err(), why("device lacks logic_op"));
         assert_eq!(f.series("voxelize", "time:cpu@64").unwrap().len(), 1);
+        // A quantity no model has is said in words, not by its key.
+        let none = f.series("voxelize", "time:fang@64").unwrap_err();
+        assert_eq!(none, Missing::NoModel("time:fang@64".into()));
+        assert_eq!(none.to_string(), "no model has the time of fang at 64³");
         f.skipped("boolean", "not run");
-        assert_eq!(f.series("boolean", "reduction").unwrap_err(), "not run");
+        assert_eq!(f.series("boolean", "reduction").unwrap_err(), why("not run"));
+        f.model("boolean2", "torus", 10.0, "–");
+        let e = f.pairs("boolean2", "time:phase2-cpu", "time:phase2-gpu").unwrap_err().to_string();
+        assert_eq!(e, "no model has the time of phase 2 with CPU point tests");
+        assert!(!e.contains(':'), "{e}");
     }
 }

@@ -171,7 +171,10 @@ mod tests {
         assert_eq!(f.get("inclusion", "Armadillo", "time:cpu").unwrap().value, 20.785783);
         assert_eq!(f.get("inclusion", "Torusknot", "time:tetragrid-64").unwrap().value, 0.001527);
         assert_eq!(f.get("inclusion", "Torusknot", "memory:tetragrid-32").unwrap().value, 953.0);
-        assert_eq!(f.get("inclusion", "Chinese Dragon", "memory:bsp").unwrap_err(), "stack overflow");
+        assert_eq!(
+            f.get("inclusion", "Chinese Dragon", "memory:bsp").unwrap_err().to_string(),
+            "stack overflow"
+        );
         assert_eq!(f.get("voxelize", "Armadillo", "time:zoned@256").unwrap().value, 0.008743);
         assert_eq!(f.get("subdivide", "row 1: cube", "time:gpu-path").unwrap().value, 0.015 + 0.031);
         assert_eq!(f.models_of("inclusion").len(), 9);

@@ -44,8 +44,9 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         for (i, &n) in cfg.resolutions.iter().enumerate() {
             let t = &m.grid_times[i];
             f.add_runs(EXP, &m.name, &format!("time:tetragrid-{n}"), Stat::mean_of(t), t);
-            let (build, bytes) = m.grid_builds[i];
-            f.add(EXP, &m.name, &format!("build:tetragrid-{n}"), "s", Stat::exact(build.as_secs_f64()));
+            let (_, bytes) = m.grid_builds[i];
+            let builds = &m.grid_build_times[i];
+            f.add_runs(EXP, &m.name, &format!("build:tetragrid-{n}"), Stat::median_of(builds), builds);
             f.add(
                 EXP,
                 &m.name,
@@ -55,8 +56,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             );
             f.add(EXP, &m.name, &format!("tested:tetragrid-{n}"), "", Stat::exact(m.grid_tested[i]));
         }
-        for (index, stats) in &m.index {
-            f.add(EXP, &m.name, &format!("build:{index}"), "s", Stat::exact(stats.build_time.as_secs_f64()));
+        for ((index, stats), builds) in m.index.iter().zip(&m.index_builds) {
+            f.add_runs(EXP, &m.name, &format!("build:{index}"), Stat::median_of(builds), builds);
             f.add(
                 EXP,
                 &m.name,
