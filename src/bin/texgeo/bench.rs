@@ -282,18 +282,27 @@ pub fn run(device: Option<&str>, cmd: Command) -> anyhow::Result<()> {
         Command::Subdivide { .. } => "subdivide",
         Command::Boolean { .. } => "boolean",
     };
-    // A start and an end line with the time taken, so a log of a long run is never silent.
-    let lines = texgeo::report::Lines::new("texgeo bench");
-    lines.started(name);
-    let start = std::time::Instant::now();
-    let result = measure(&ctx, cmd);
-    if result.is_ok() {
-        lines.ended(name, start.elapsed());
-    }
-    result
+    measure(&ctx, cmd, &Around { lines: texgeo::report::Lines::new("texgeo bench"), name })
 }
 
-fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
+/// A start and an end line with the time taken around the measuring, once the options
+/// are checked (a refused option stays one line): a log of a long run is never silent.
+struct Around {
+    lines: texgeo::report::Lines,
+    name: &'static str,
+}
+
+impl Around {
+    fn run<T>(&self, f: impl FnOnce() -> T) -> T {
+        self.lines.started(self.name);
+        let start = std::time::Instant::now();
+        let v = f();
+        self.lines.ended(self.name, start.elapsed());
+        v
+    }
+}
+
+fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow::Result<()> {
     match cmd {
         Command::Inclusion { models, sets, points, resolutions, out } => {
             let models = models
@@ -302,7 +311,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
                 .map(|(thesis, name, mesh)| bench::inclusion::Model { thesis, name, mesh })
                 .collect::<Vec<_>>();
             let cfg = bench::inclusion::Config { sets, points, resolutions };
-            finish(bench::inclusion::run(ctx, &models, &cfg)?, &Common { runs: 0, out })
+            finish(around.run(|| bench::inclusion::run(ctx, &models, &cfg))?, &Common { runs: 0, out })
         }
         Command::Voxelize { models, sizes, methods, zone, runs, out } => {
             let methods = if methods.is_empty() { texgeo::voxel::Method::ALL.to_vec() } else { methods };
@@ -316,7 +325,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
                 .collect::<Vec<_>>();
             anyhow::ensure!(!models.is_empty(), "no models to measure");
             let cfg = bench::voxelize::Config { resolutions: sizes, methods, runs, zone };
-            finish(bench::voxelize::run(ctx, &models, &cfg)?, &Common { runs, out })
+            finish(around.run(|| bench::voxelize::run(ctx, &models, &cfg))?, &Common { runs, out })
         }
         Command::Scale {
             mesh,
@@ -357,7 +366,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
             let mut thread_counts = if thread_counts.is_empty() { vec![1, cores] } else { thread_counts };
             thread_counts.dedup();
             let cfg = Config { points, methods, sizes, voxel_methods, threads: thread_counts, runs, budget };
-            finish(bench::scale::run(ctx, &inclusion, &voxel, &cfg)?, &Common { runs, out })
+            finish(around.run(|| bench::scale::run(ctx, &inclusion, &voxel, &cfg))?, &Common { runs, out })
         }
         Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {
             use bench::boolean::{Config, Pair, STAND_INS};
@@ -378,19 +387,19 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
                 cgal: !no_cgal,
                 scaling: scaling.into_iter().filter(|&n| n > 0).collect(),
             };
-            finish(bench::boolean::run(ctx, &pairs, &cfg)?, &common)
+            finish(around.run(|| bench::boolean::run(ctx, &pairs, &cfg))?, &common)
         }
         Command::Xor { sizes, triangles, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
-            finish(bench::xor::run(ctx, &sizes, triangles, common.runs)?, &common)
+            finish(around.run(|| bench::xor::run(ctx, &sizes, triangles, common.runs))?, &common)
         }
         Command::Reduce { sizes, common } => {
             if let Some(bad) = sizes.iter().find(|&&s| s == 0 || s > ctx.info().max_image_2d) {
                 anyhow::bail!("size {bad} is outside 1..={}", ctx.info().max_image_2d);
             }
-            finish(bench::reduce::run(ctx, &sizes, common.runs)?, &common)
+            finish(around.run(|| bench::reduce::run(ctx, &sizes, common.runs))?, &common)
         }
         Command::Subdivide { level, meshes, models, only, validate, creases, crease_angle, common } => {
             use bench::subdiv::{CreaseSettings, Model, Settings, crease_models, default_models};
@@ -407,7 +416,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
                     angle_degrees: crease_angle,
                     sharpness: &[10.0, 2.5],
                 };
-                return finish(bench::subdiv::run_creases(ctx, &list, settings)?, &common);
+                return finish(around.run(|| bench::subdiv::run_creases(ctx, &list, settings))?, &common);
             }
             let mut list = if only { Vec::new() } else { default_models(&models)? };
             for m in &meshes {
@@ -415,7 +424,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command) -> anyhow::Result<()> {
             }
             anyhow::ensure!(!list.is_empty(), "no models to measure");
             let settings = Settings { level, runs: common.runs, validate };
-            finish(bench::subdiv::run(ctx, &list, settings)?, &common)
+            finish(around.run(|| bench::subdiv::run(ctx, &list, settings))?, &common)
         }
     }
 }
