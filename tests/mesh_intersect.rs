@@ -227,3 +227,56 @@ fn a_folding_fan_is_not_used() {
         Some(DVec3::new(2.0, 2.0, 4.5))
     );
 }
+
+/// `procedural::bicone(sides, 1, 1)` with its first top triangle (ring corners 0, 1 and
+/// the apex) replaced by the other three faces of a tetrahedron to a point below its
+/// centroid at height `z`: a dent into the solid for z above the bottom cap, a spike
+/// pushed through the bottom cap for z below it.
+fn dented_bicone(sides: u32, z: f64) -> Mesh {
+    let b = procedural::bicone(sides, 1.0, 1.0);
+    let mut positions = b.positions().to_vec();
+    let apex = sides;
+    let c = (positions[0] + positions[1] + positions[apex as usize]) / 3.0;
+    positions.push(DVec3::new(c.x, c.y, z));
+    let p = apex + 2;
+    let mut faces: Vec<Vec<u32>> = b.faces().map(<[u32]>::to_vec).collect();
+    assert_eq!(faces[0], vec![0, 1, apex]);
+    faces[0] = vec![0, 1, p];
+    faces.push(vec![1, apex, p]);
+    faces.push(vec![apex, 0, p]);
+    Mesh::new(positions, faces).unwrap()
+}
+
+#[test]
+fn fans_slivers_and_high_valence_vertices_are_clean() {
+    for (name, m) in [
+        ("bicone", procedural::bicone(300, 1.0, 1.0)),
+        ("needle over a fanned base", procedural::bicone(300, 100.0, 0.0)),
+        ("flat lens", procedural::bicone(300, 0.01, 0.01)),
+        ("cone", procedural::cone(300)),
+        ("dented bicone", dented_bicone(300, 0.2)),
+    ] {
+        assert_eq!(self_intersections(&m, 10), vec![], "{name}");
+        let check = texgeo::mesh::solidity::check(&m);
+        assert!(check.is_solid(), "{name}: {:?}", check.defects);
+    }
+}
+
+#[test]
+fn a_cap_triangle_pushed_through_the_other_cap_crosses_it() {
+    let sides = 300;
+    let m = dented_bicone(sides, -0.5);
+    let pairs = self_intersections(&m, 1000);
+    // Only the spike's faces (0 and the last two) cross, and only bottom faces.
+    let spike = [0, 2 * sides as usize, 2 * sides as usize + 1];
+    let bottom = sides as usize..2 * sides as usize;
+    assert!(!pairs.is_empty(), "the spike through the bottom cap is not found");
+    assert!(pairs.iter().all(|&(f, g)| spike.contains(&f) != spike.contains(&g)), "{pairs:?}");
+    assert!(pairs.iter().all(|&(f, g)| bottom.contains(&f) || bottom.contains(&g)), "{pairs:?}");
+    let check = texgeo::mesh::solidity::check(&m);
+    assert!(
+        check.defects.iter().any(|d| matches!(d, texgeo::mesh::solidity::Defect::SelfIntersecting { .. })),
+        "{:?}",
+        check.defects
+    );
+}

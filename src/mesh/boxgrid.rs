@@ -1,5 +1,5 @@
-//! Overlapping box pairs by a uniform grid: the spatial index behind self-intersection
-//! detection and the Boolean refinement's candidate pairs.
+//! Overlapping box pairs by a uniform grid: the spatial index behind the Boolean
+//! refinement's candidate pairs and the crossing test restricted to marked triangles.
 //!
 //! Every box is entered in the grid cells it touches (a counting sort by cell), and the
 //! boxes sharing a cell are tested against each other. A pair is reported only by the

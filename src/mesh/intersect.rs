@@ -21,14 +21,17 @@
 //! that whole segment as an edge and those on the other side have its pieces. Those
 //! faces only touch; to tell that from crossing, the triangles with the whole segment
 //! are split at the middle corner before the pair tests ([`split_at_t_junctions`]).
-//! Candidate pairs come from a uniform grid over the triangles' boxes
-//! ([`super::boxgrid`]).
+//! Candidate pairs come from an octree over the triangles and their edges that leaves
+//! out pairs which cannot count, so fans and long slivers stay cheap
+//! ([`super::crosstree`]); restricted to marked triangles, they are the marked
+//! triangles' boxes against all others in a uniform grid ([`super::boxgrid`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Mesh;
 use super::boxgrid::box_pairs;
+use super::crosstree::candidate_pairs;
 use super::triangulate::{self, Projection, TriangulateError};
 use crate::exact::{Sign, orient2d, orient2d_approx, orient3d};
 
@@ -413,12 +416,12 @@ fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(u
     let soup = split.as_ref().unwrap_or(soup);
     let n = soup.triangles.len();
     let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();
-    let boxes = soup.boxes();
     let candidates = match near {
-        None => box_pairs(&boxes, None),
+        None => candidate_pairs(&soup.positions, &soup.triangles, &soup.face_of, &degenerate),
         Some(near) => {
             // Marked boxes against all: a pair of two marked triangles comes twice (keep
             // one), a triangle meets its own box (drop it).
+            let boxes = soup.boxes();
             let marked: Vec<u32> = (0..n as u32).filter(|&t| near[t as usize]).collect();
             let marked_boxes: Vec<_> = marked.iter().map(|&t| boxes[t as usize]).collect();
             box_pairs(&marked_boxes, Some(&boxes))
@@ -520,6 +523,86 @@ mod tests {
         assert!(meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, 3.0, 0.0)));
         assert!(!meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, -3.0, 0.0)));
         assert!(!meet_beyond_edge(p, q, v(0.5, 1.0, 0.0), v(0.2, 3.0, 1e-300)));
+    }
+
+    /// [`self_intersections`] with every triangle pair tested, no candidate search.
+    fn all_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
+        let soup = TriangleSoup::new(mesh);
+        let mut found: Vec<(usize, usize)> = soup
+            .failed
+            .iter()
+            .filter(|(_, e)| *e == TriangulateError::Crossing || *e == TriangulateError::Duplicate)
+            .map(|&(f, _)| (f as usize, f as usize))
+            .collect();
+        let soup = split_at_t_junctions(&soup).unwrap_or(soup);
+        let n = soup.triangles.len();
+        let flat: Vec<bool> = (0..n).map(|t| is_degenerate(soup.triangle(t))).collect();
+        for i in 0..n {
+            for j in i + 1..n {
+                if !flat[i] && !flat[j] && soup.face_of[i] != soup.face_of[j] && soup_pair_meets(&soup, i, j)
+                {
+                    let (f, g) = (soup.face_of[i] as usize, soup.face_of[j] as usize);
+                    if !found.contains(&(f.min(g), f.max(g))) {
+                        found.push((f.min(g), f.max(g)));
+                    }
+                }
+            }
+        }
+        found
+    }
+
+    /// Triangles between points of the grid {0, 1, 2}³ (many coplanar, collinear and
+    /// shared corners, so every sharing and touching case comes up), some of them moved
+    /// off the grid.
+    fn grid_soup(seed: u64, triangles: usize) -> Mesh {
+        let mut rng = crate::random::Rng::new(seed);
+        let mut positions: Vec<DVec3> =
+            (0..27).map(|i| DVec3::new(f64::from(i % 3), f64::from(i / 3 % 3), f64::from(i / 9))).collect();
+        positions.extend((0..10).map(|_| rng.point_in_box(DVec3::ZERO, DVec3::splat(2.0))));
+        let faces = (0..triangles)
+            .map(|_| {
+                loop {
+                    let f: Vec<u32> = (0..3).map(|_| rng.below(positions.len() as u64) as u32).collect();
+                    if f[0] != f[1] && f[1] != f[2] && f[0] != f[2] {
+                        break f;
+                    }
+                }
+            })
+            .collect();
+        Mesh::new(positions, faces).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn candidate_search_finds_what_testing_every_pair_finds() {
+        use super::super::procedural::{bicone, cone, cube_with_cavity, sphere};
+        // The bicone with its first top triangle replaced by a spike through the bottom cap.
+        let spiked = {
+            let b = bicone(40, 1.0, 1.0);
+            let mut positions = b.positions().to_vec();
+            positions.push(DVec3::new(0.6, 0.05, -0.5));
+            let mut faces: Vec<Vec<u32>> = b.faces().map(<[u32]>::to_vec).collect();
+            faces[0] = vec![0, 1, 42];
+            faces.extend([vec![1, 40, 42], vec![40, 0, 42]]);
+            Mesh::new(positions, faces).unwrap_or_else(|e| panic!("{e}"))
+        };
+        let mut meshes =
+            vec![spiked, bicone(40, 1.0, 1.0), bicone(40, 5.0, 0.0), cone(40), cube_with_cavity()];
+        // A sphere crossed by a shifted copy of itself, in one mesh.
+        let s = sphere(6, 10);
+        let mut positions = s.positions().to_vec();
+        positions.extend(s.positions().iter().map(|p| *p + DVec3::new(0.5, 0.25, 0.125)));
+        let k = s.num_vertices() as u32;
+        let faces =
+            s.faces().map(<[u32]>::to_vec).chain(s.faces().map(|f| f.iter().map(|v| v + k).collect()));
+        meshes.push(Mesh::new(positions, faces.collect()).unwrap_or_else(|e| panic!("{e}")));
+        meshes.extend((0..6).map(|seed| grid_soup(seed, 60)));
+        for (i, m) in meshes.iter().enumerate() {
+            let expected = all_pairs(m);
+            assert_eq!(self_intersections(m, usize::MAX), expected, "mesh {i}");
+            if i == 0 || i >= 5 {
+                assert!(!expected.is_empty(), "mesh {i} has no crossing to find");
+            }
+        }
     }
 
     #[test]

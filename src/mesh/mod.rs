@@ -6,6 +6,7 @@ use glam::DVec3;
 pub mod boxgrid;
 pub mod constrained;
 pub mod covering;
+pub mod crosstree;
 pub mod disjoint_sets;
 pub mod error;
 pub mod formats;

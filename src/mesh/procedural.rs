@@ -151,6 +151,29 @@ pub fn cone(sides: u32) -> Mesh {
     mesh(positions, faces)
 }
 
+/// Two fans around the z axis over one ring: `sides` ring vertices on the unit circle in
+/// z = 0 (≥ 3), every top triangle sharing the apex (0, 0, `top`) and every bottom one the
+/// apex (0, 0, −`bottom`); `2 · sides` triangles. With `bottom` = 0 the bottom is a flat
+/// fan around the ring's centre (a cone with a fanned base). The apexes have valence
+/// `sides` and, with many sides, every triangle is a long sliver whose box overlaps those
+/// of the other fan: the worst case for a box-based self-intersection test.
+/// `top` must be positive and `bottom` non-negative.
+pub fn bicone(sides: u32, top: f64, bottom: f64) -> Mesh {
+    let sides = sides.max(3);
+    let mut positions: Vec<DVec3> = (0..sides)
+        .map(|i| {
+            let a = TAU * f64::from(i) / f64::from(sides);
+            DVec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    positions.push(DVec3::new(0.0, 0.0, top));
+    positions.push(DVec3::new(0.0, 0.0, 0.0 - bottom));
+    let (apex, nadir) = (sides, sides + 1);
+    let mut faces: Vec<Vec<u32>> = (0..sides).map(|i| vec![i, (i + 1) % sides, apex]).collect();
+    faces.extend((0..sides).map(|i| vec![(i + 1) % sides, i, nadir]));
+    mesh(positions, faces)
+}
+
 /// A square pyramid: base [−1, 1]² at z = −1, apex (0, 0, 1); one quad and 4 triangles.
 pub fn pyramid() -> Mesh {
     let positions = vec![

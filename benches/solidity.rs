@@ -1,0 +1,59 @@
+//! The solidity check (`mesh::solidity::check`, whose exact self-intersection test is the
+//! costly part) on shapes that defeat box-based candidate search, as CSV on stdout:
+//!
+//!     cargo bench --bench solidity -- [--faces 10000,100000] [--repeat N] [--shape NAME]
+//!
+//! Shapes (each about `faces` triangles): `bicone`, two fans of long slivers meeting at
+//! a ring; `needle`, a cone 100 times taller than wide over a base fanned from its centre
+//! (long slivers over a flat fan); `cone`, one apex of valence `faces / 2` over a base
+//! kept as one polygon. Seconds are the median and minimum of N runs (default 3).
+
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use texgeo::mesh::{Mesh, procedural, solidity};
+
+fn shape(name: &str, faces: u32) -> Option<Mesh> {
+    let sides = (faces / 2).max(3);
+    Some(match name {
+        "bicone" => procedural::bicone(sides, 1.0, 1.0),
+        "needle" => procedural::bicone(sides, 100.0, 0.0),
+        "cone" => procedural::cone(sides),
+        _ => return None,
+    })
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let value = |flag: &str| args.iter().position(|a| a == flag).and_then(|i| args.get(i + 1));
+    let repeat: usize = value("--repeat").map_or(Ok(3), |v| v.parse()).context("--repeat")?;
+    let faces: Vec<u32> = value("--faces")
+        .map_or("10000,100000", String::as_str)
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .context("--faces")?;
+    let shapes: Vec<&str> = match value("--shape") {
+        Some(s) => vec![s.as_str()],
+        None => vec!["bicone", "needle", "cone"],
+    };
+    println!("shape,faces,triangles,median_s,min_s,solid");
+    for name in shapes {
+        for &n in &faces {
+            let Some(mesh) = shape(name, n) else { bail!("unknown shape {name}") };
+            let triangles: usize = mesh.faces().map(|f| f.len() - 2).sum();
+            let mut seconds = Vec::new();
+            let mut solid = false;
+            for _ in 0..repeat.max(1) {
+                let start = Instant::now();
+                let report = solidity::check(&mesh);
+                seconds.push(start.elapsed().as_secs_f64());
+                solid = report.is_solid();
+            }
+            seconds.sort_by(f64::total_cmp);
+            let median = seconds[seconds.len() / 2];
+            println!("{name},{},{triangles},{median:.3},{:.3},{solid}", mesh.num_faces(), seconds[0]);
+        }
+    }
+    Ok(())
+}

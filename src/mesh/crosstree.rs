@@ -1,0 +1,336 @@
+//! Candidate triangle pairs for the exact self-intersection test: every pair that could
+//! meet beyond what it shares, found without looking at the pairs that cannot.
+//!
+//! Two triangles that meet beyond their common vertices meet at a point of an edge of one
+//! of them that has no vertex of the other: with no common vertex, some edge of one meets
+//! the other; with one common vertex a, the edge opposite a of one meets the other (a
+//! common part that leaves a along an edge ends on the other's opposite edge or at that
+//! edge's far corner). Pairs with two or three common vertices share an edge and come
+//! from the edges' triangle lists. So fans cost nothing: the triangles around a vertex
+//! are paired only where the edges opposite it reach.
+//!
+//! The (edge, triangle) pairs come from an adaptive octree over the mesh's box: a triangle
+//! or edge enters a cell only when it may cross it (its box overlaps the cell, and the
+//! cell is not strictly on one side of its plane or, for an edge, of the planes through
+//! it along the axes; tested with a margin for rounding, so nothing that crosses is left
+//! out). A cell stops splitting when it holds few entries, when all its entries share a
+//! vertex or all belong to one face (no pair there counts), or when it holds no edge or
+//! no triangle. Long slivers and high-valence fans therefore sit in few cells, unlike
+//! boxes in a uniform grid, whose overlaps grow with the square of the fan's size.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// A cell with at most this many entries pairs them instead of splitting.
+const LEAF: usize = 32;
+/// Deeper cells are not split (a point where many triangles truly cross).
+const MAX_DEPTH: u32 = 24;
+/// Cells with more entries are split with their children in parallel.
+const PARALLEL: usize = 4096;
+/// Face of an edge whose triangles belong to different faces.
+const MIXED: u32 = u32::MAX;
+
+type Box3 = (DVec3, DVec3);
+
+struct Tree<'a> {
+    positions: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+    face_of: &'a [u32],
+    /// Entries: triangles `0..n`, then edges `n..`.
+    n: u32,
+    edges: Vec<[u32; 2]>,
+    /// Triangles of edge e: `adjacent[start[e]..start[e + 1]]`.
+    start: Vec<u32>,
+    adjacent: Vec<u32>,
+    edge_face: Vec<u32>,
+    boxes: Vec<Box3>,
+}
+
+/// Triangle pairs `(i, j)`, i < j, sorted and distinct, that include every pair of
+/// triangles (neither in `skip`) that share an edge, and every pair where an edge of one
+/// with no vertex of the other may meet the other. Triangles of one face (`face_of`) are
+/// not paired through the octree (they never count); they may still come as edge pairs.
+pub fn candidate_pairs(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    face_of: &[u32],
+    skip: &[bool],
+) -> Vec<(u32, u32)> {
+    let n = triangles.len() as u32;
+    // Every edge once, with its triangles.
+    let mut ends: Vec<(u64, u32)> = (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter(|&t| !skip[t as usize])
+        .flat_map_iter(|t| {
+            let v = triangles[t as usize];
+            (0..3).map(move |k| {
+                let (a, b) = (v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3]));
+                ((a as u64) << 32 | b as u64, t)
+            })
+        })
+        .collect();
+    ends.par_sort_unstable();
+    let mut tree = Tree {
+        positions,
+        triangles,
+        face_of,
+        n,
+        edges: Vec::new(),
+        start: vec![0],
+        adjacent: Vec::with_capacity(ends.len()),
+        edge_face: Vec::new(),
+        boxes: Vec::new(),
+    };
+    let mut out: Vec<u64> = Vec::new();
+    for run in ends.chunk_by(|x, y| x.0 == y.0) {
+        let key = run[0].0;
+        tree.edges.push([(key >> 32) as u32, key as u32]);
+        let first = tree.adjacent.len();
+        tree.adjacent.extend(run.iter().map(|&(_, t)| t));
+        tree.start.push(tree.adjacent.len() as u32);
+        let faces = &tree.adjacent[first..];
+        let f = face_of[faces[0] as usize];
+        tree.edge_face.push(if faces.iter().all(|&t| face_of[t as usize] == f) { f } else { MIXED });
+        for (k, &t) in faces.iter().enumerate() {
+            for &u in &faces[k + 1..] {
+                out.push((t.min(u) as u64) << 32 | t.max(u) as u64);
+            }
+        }
+    }
+    drop(ends);
+    let hull = |v: &[u32]| {
+        v.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
+            (lo.min(positions[i as usize]), hi.max(positions[i as usize]))
+        })
+    };
+    tree.boxes =
+        triangles.par_iter().map(|t| hull(t)).chain(tree.edges.par_iter().map(|e| hull(e))).collect();
+    let entries: Vec<u32> =
+        (0..n).filter(|&t| !skip[t as usize]).chain((0..tree.edges.len() as u32).map(|e| n + e)).collect();
+    let root = entries
+        .iter()
+        .map(|&x| tree.boxes[x as usize])
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+    if !entries.is_empty() {
+        tree.walk(root, entries, 0, &mut out);
+    }
+    out.par_sort_unstable();
+    out.dedup();
+    out.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect()
+}
+
+impl Tree<'_> {
+    fn vertices(&self, x: u32) -> &[u32] {
+        if x < self.n { &self.triangles[x as usize] } else { &self.edges[(x - self.n) as usize] }
+    }
+
+    fn face(&self, x: u32) -> u32 {
+        if x < self.n { self.face_of[x as usize] } else { self.edge_face[(x - self.n) as usize] }
+    }
+
+    /// No pair of `entries` can count: none is an edge or none a triangle, all share a
+    /// vertex, or all belong to one face.
+    fn nothing_to_pair(&self, entries: &[u32]) -> bool {
+        let edges = entries.iter().filter(|&&x| x >= self.n).count();
+        if edges == 0 || edges == entries.len() {
+            return true;
+        }
+        let first = entries[0];
+        if self.vertices(first).iter().any(|v| entries.iter().all(|&x| self.vertices(x).contains(v))) {
+            return true;
+        }
+        let f = self.face(first);
+        f != MIXED && entries.iter().all(|&x| self.face(x) == f)
+    }
+
+    /// Entry `x` may cross the closed box `cell` (its box overlaps `cell`): no axis of
+    /// the separating-axis theorem shows them apart (the triangle's normal and its edges
+    /// crossed with the coordinate axes; for an edge, the edge crossed with them).
+    fn may_cross(&self, x: u32, cell: Box3) -> bool {
+        let p = |i: u32| self.positions[i as usize];
+        if x < self.n {
+            let t = self.triangles[x as usize].map(p);
+            let (e, f) = (t[1] - t[0], t[2] - t[0]);
+            let size = DVec3::new(
+                (e.y * f.z).abs() + (e.z * f.y).abs(),
+                (e.z * f.x).abs() + (e.x * f.z).abs(),
+                (e.x * f.y).abs() + (e.y * f.x).abs(),
+            );
+            if apart(e.cross(f), size, t[0], 0.0, DVec3::ZERO, cell) {
+                return false;
+            }
+            (0..3).all(|k| {
+                let (a, r) = (t[k], t[(k + 2) % 3]);
+                let (d, span) = (t[(k + 1) % 3] - a, r - a);
+                edge_axes(d)
+                    .into_iter()
+                    .all(|axis| !apart(axis, axis.abs(), a, axis.dot(span), span.abs(), cell))
+            })
+        } else {
+            let [a, b] = self.edges[(x - self.n) as usize].map(p);
+            edge_axes(b - a).into_iter().all(|axis| !apart(axis, axis.abs(), a, 0.0, DVec3::ZERO, cell))
+        }
+    }
+
+    fn walk(&self, cell: Box3, entries: Vec<u32>, depth: u32, out: &mut Vec<u64>) {
+        if self.nothing_to_pair(&entries) {
+            return;
+        }
+        let (lo, hi) = cell;
+        let mid = (lo + hi) * 0.5;
+        // Axes the cell can still be halved along.
+        let split: [bool; 3] = std::array::from_fn(|k| lo[k] < mid[k] && mid[k] < hi[k]);
+        if entries.len() <= LEAF || depth >= MAX_DEPTH || !split.contains(&true) {
+            self.pair(&entries, out);
+            return;
+        }
+        let child_box = |c: usize| -> Box3 {
+            let mut b = cell;
+            for k in 0..3 {
+                if split[k] {
+                    if c >> k & 1 == 0 {
+                        b.1[k] = mid[k];
+                    } else {
+                        b.0[k] = mid[k];
+                    }
+                }
+            }
+            b
+        };
+        let mut children: Vec<Vec<u32>> = vec![Vec::new(); 8];
+        for &x in &entries {
+            let (blo, bhi) = self.boxes[x as usize];
+            // The halves of each axis the entry's box reaches.
+            let sides = |k: usize| -> (usize, usize) {
+                if !split[k] { (0, 0) } else { (usize::from(blo[k] > mid[k]), usize::from(bhi[k] >= mid[k])) }
+            };
+            let [(x0, x1), (y0, y1), (z0, z1)] = [sides(0), sides(1), sides(2)];
+            let one = x0 == x1 && y0 == y1 && z0 == z1;
+            for cz in z0..=z1 {
+                for cy in y0..=y1 {
+                    for cx in x0..=x1 {
+                        let c = cx | cy << 1 | cz << 2;
+                        if one || self.may_cross(x, child_box(c)) {
+                            children[c].push(x);
+                        }
+                    }
+                }
+            }
+        }
+        drop(entries);
+        let total: usize = children.iter().map(Vec::len).sum();
+        if total > PARALLEL {
+            let found: Vec<Vec<u64>> = children
+                .into_par_iter()
+                .enumerate()
+                .map(|(c, xs)| {
+                    let mut o = Vec::new();
+                    if !xs.is_empty() {
+                        self.walk(child_box(c), xs, depth + 1, &mut o);
+                    }
+                    o
+                })
+                .collect();
+            found.into_iter().for_each(|o| out.extend(o));
+        } else {
+            for (c, xs) in children.into_iter().enumerate() {
+                if !xs.is_empty() {
+                    self.walk(child_box(c), xs, depth + 1, out);
+                }
+            }
+        }
+    }
+
+    /// Every (edge, triangle) of a leaf with no common vertex and overlapping boxes gives
+    /// the pairs of the edge's triangles with that triangle.
+    fn pair(&self, entries: &[u32], out: &mut Vec<u64>) {
+        let overlaps = |a: Box3, b: Box3| a.0.cmple(b.1).all() && b.0.cmple(a.1).all();
+        for &e in entries.iter().filter(|&&x| x >= self.n) {
+            let ends = self.vertices(e);
+            let k = (e - self.n) as usize;
+            for &u in entries.iter().filter(|&&x| x < self.n) {
+                if self.triangles[u as usize].iter().any(|v| ends.contains(v))
+                    || !overlaps(self.boxes[e as usize], self.boxes[u as usize])
+                {
+                    continue;
+                }
+                let fu = self.face_of[u as usize];
+                for &t in &self.adjacent[self.start[k] as usize..self.start[k + 1] as usize] {
+                    if self.face_of[t as usize] != fu {
+                        out.push((t.min(u) as u64) << 32 | t.max(u) as u64);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The direction `d` crossed with each coordinate axis (exactly, from `d`).
+fn edge_axes(d: DVec3) -> [DVec3; 3] {
+    [DVec3::new(0.0, d.z, -d.y), DVec3::new(-d.z, 0.0, d.x), DVec3::new(d.y, -d.x, 0.0)]
+}
+
+/// Along `axis`, the closed box `cell` and an object that projects (relative to its point
+/// `a`) onto the interval between 0 and `reach` (`reach` = axis · (r − a) for the
+/// object's point r with |r − a| = `span`) are apart by more than the rounding can
+/// explain, given that each component of `axis` is within a few ulps of its exact value
+/// relative to `size` (a bound on its terms). Differences of f64 are correctly rounded,
+/// so every error is relative to a term (or an underflowed product, absolutely tiny);
+/// overflow never gives "apart".
+fn apart(axis: DVec3, size: DVec3, a: DVec3, reach: f64, span: DVec3, (lo, hi): Box3) -> bool {
+    let (u, v) = (lo - a, hi - a);
+    let (p, q) = (axis * u, axis * v);
+    let (min, max) = (p.min(q).element_sum(), p.max(q).element_sum());
+    let w = u.abs().max(v.abs()).max(span);
+    let tol = 1e-12 * (size * w).element_sum() + 1e-300 * (w.element_sum() + 1.0);
+    min > reach.max(0.0) + tol || max < reach.min(0.0) - tol
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn apart_only_when_strictly_aside() {
+        let cell = (DVec3::ZERO, DVec3::ONE);
+        let (n, none) = (DVec3::ONE, DVec3::ZERO);
+        // The plane x + y + z = 3 touches the corner (1, 1, 1): not apart.
+        assert!(!apart(n, n, DVec3::new(3.0, 0.0, 0.0), 0.0, none, cell));
+        assert!(apart(n, n, DVec3::new(3.001, 0.0, 0.0), 0.0, none, cell));
+        assert!(apart(n, n, DVec3::new(-0.001, 0.0, 0.0), 0.0, none, cell));
+        assert!(!apart(n, n, DVec3::new(1.5, 0.0, 0.0), 0.0, none, cell));
+        // An interval reaching back to the box.
+        let r = DVec3::new(-1.0, 0.0, 0.0);
+        assert!(!apart(n, n, DVec3::new(4.0, 0.0, 0.0), n.dot(r), r.abs(), cell));
+        assert!(apart(n, n, DVec3::new(4.001, 0.0, 0.0), n.dot(r), r.abs(), cell));
+        // Far beyond f64's range the products overflow: no decision.
+        assert!(!apart(DVec3::splat(1e300), DVec3::splat(1e300), DVec3::splat(1e300), 0.0, none, cell));
+    }
+
+    #[test]
+    fn triangles_enter_only_cells_they_cross() {
+        // One long sliver from the origin to (1, 1, 0) and (1, 0.99, 0).
+        let positions = [DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0), DVec3::new(1.0, 0.99, 0.0)];
+        let pairs = candidate_pairs(&positions, &[[0, 1, 2]], &[0], &[false]);
+        assert!(pairs.is_empty());
+        let tree = Tree {
+            positions: &positions,
+            triangles: &[[0, 1, 2]],
+            face_of: &[0],
+            n: 1,
+            edges: vec![[0, 1]],
+            start: vec![0, 1],
+            adjacent: vec![0],
+            edge_face: vec![0],
+            boxes: Vec::new(),
+        };
+        let cell = |x: f64, y: f64| (DVec3::new(x, y, -0.1), DVec3::new(x + 0.1, y + 0.1, 0.1));
+        // Inside its box but off the sliver, beside its edge: out for both.
+        assert!(!tree.may_cross(0, cell(0.6, 0.3)) && !tree.may_cross(1, cell(0.6, 0.3)));
+        // On it: in.
+        assert!(tree.may_cross(0, cell(0.45, 0.45)) && tree.may_cross(1, cell(0.45, 0.45)));
+        // Touching its corner (1, 1, 0) only: in.
+        assert!(tree.may_cross(0, cell(1.0, 1.0)) && tree.may_cross(1, cell(1.0, 1.0)));
+    }
+}
