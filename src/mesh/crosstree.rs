@@ -22,7 +22,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 /// A cell with at most this many entries pairs them instead of splitting.
-const LEAF: usize = 32;
+const LEAF: usize = 48;
 /// Deeper cells are not split (a point where many triangles truly cross).
 const MAX_DEPTH: u32 = 24;
 /// Cells with more entries are split with their children in parallel.
@@ -144,12 +144,16 @@ impl Tree<'_> {
         f != MIXED && entries.iter().all(|&x| self.face(x) == f)
     }
 
-    /// Entry `x` may cross the closed box `cell` (its box overlaps `cell`): no axis of
-    /// the separating-axis theorem shows them apart (the triangle's normal and its edges
-    /// crossed with the coordinate axes; for an edge, the edge crossed with them).
-    fn may_cross(&self, x: u32, cell: Box3) -> bool {
+    /// The children of `cell` (halved at `mid` along the axes of `split`; child c takes
+    /// the upper half of axis k iff bit k of c is set) among `mask` that entry `x` may
+    /// cross: no separating axis shows them apart (the triangle's normal and its edges
+    /// crossed with a coordinate axis; for an edge, the edge crossed with each coordinate
+    /// axis; the coordinate axes themselves gave `mask`). Fewer axes than the theorem's
+    /// only keep more children.
+    fn children_crossed(&self, x: u32, cell: Box3, mid: DVec3, split: [bool; 3], mut mask: u8) -> u8 {
         let p = |i: u32| self.positions[i as usize];
-        if x < self.n {
+        let mut axes = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, 0.0, DVec3::ZERO); 4];
+        let count = if x < self.n {
             let t = self.triangles[x as usize].map(p);
             let (e, f) = (t[1] - t[0], t[2] - t[0]);
             let size = DVec3::new(
@@ -157,20 +161,33 @@ impl Tree<'_> {
                 (e.z * f.x).abs() + (e.x * f.z).abs(),
                 (e.x * f.y).abs() + (e.y * f.x).abs(),
             );
-            if apart(e.cross(f), size, t[0], 0.0, DVec3::ZERO, cell) {
-                return false;
-            }
-            (0..3).all(|k| {
+            let normal = e.cross(f);
+            axes[0] = (normal, size, t[0], 0.0, DVec3::ZERO);
+            // The edges crossed with the axis the triangle faces most: the separating axes
+            // of its projection along that axis, which is where a sliver is thin (the
+            // other six axes of the theorem rarely separate more).
+            let facing = normal.abs().max_position();
+            for k in 0..3 {
                 let (a, r) = (t[k], t[(k + 2) % 3]);
                 let (d, span) = (t[(k + 1) % 3] - a, r - a);
-                edge_axes(d)
-                    .into_iter()
-                    .all(|axis| !apart(axis, axis.abs(), a, axis.dot(span), span.abs(), cell))
-            })
+                let axis = edge_axes(d)[facing];
+                axes[1 + k] = (axis, axis.abs(), a, axis.dot(span), span.abs());
+            }
+            4
         } else {
             let [a, b] = self.edges[(x - self.n) as usize].map(p);
-            edge_axes(b - a).into_iter().all(|axis| !apart(axis, axis.abs(), a, 0.0, DVec3::ZERO, cell))
+            for (j, axis) in edge_axes(b - a).into_iter().enumerate() {
+                axes[j] = (axis, axis.abs(), a, 0.0, DVec3::ZERO);
+            }
+            3
+        };
+        for &(axis, size, a, reach, span) in &axes[..count] {
+            mask &= !apart_children(axis, size, a, reach, span, cell, mid, split);
+            if mask == 0 {
+                break;
+            }
         }
+        mask
     }
 
     fn walk(&self, cell: Box3, entries: Vec<u32>, depth: u32, out: &mut Vec<u64>) {
@@ -206,15 +223,20 @@ impl Tree<'_> {
                 if !split[k] { (0, 0) } else { (usize::from(blo[k] > mid[k]), usize::from(bhi[k] >= mid[k])) }
             };
             let [(x0, x1), (y0, y1), (z0, z1)] = [sides(0), sides(1), sides(2)];
-            let one = x0 == x1 && y0 == y1 && z0 == z1;
+            let mut mask = 0u8;
             for cz in z0..=z1 {
                 for cy in y0..=y1 {
                     for cx in x0..=x1 {
-                        let c = cx | cy << 1 | cz << 2;
-                        if one || self.may_cross(x, child_box(c)) {
-                            children[c].push(x);
-                        }
+                        mask |= 1 << (cx | cy << 1 | cz << 2);
                     }
+                }
+            }
+            if mask.count_ones() > 1 {
+                mask = self.children_crossed(x, cell, mid, split, mask);
+            }
+            for (c, child) in children.iter_mut().enumerate() {
+                if mask >> c & 1 == 1 {
+                    child.push(x);
                 }
             }
         }
@@ -271,20 +293,43 @@ fn edge_axes(d: DVec3) -> [DVec3; 3] {
     [DVec3::new(0.0, d.z, -d.y), DVec3::new(-d.z, 0.0, d.x), DVec3::new(d.y, -d.x, 0.0)]
 }
 
-/// Along `axis`, the closed box `cell` and an object that projects (relative to its point
-/// `a`) onto the interval between 0 and `reach` (`reach` = axis · (r − a) for the
-/// object's point r with |r − a| = `span`) are apart by more than the rounding can
-/// explain, given that each component of `axis` is within a few ulps of its exact value
-/// relative to `size` (a bound on its terms). Differences of f64 are correctly rounded,
-/// so every error is relative to a term (or an underflowed product, absolutely tiny);
-/// overflow never gives "apart".
-fn apart(axis: DVec3, size: DVec3, a: DVec3, reach: f64, span: DVec3, (lo, hi): Box3) -> bool {
-    let (u, v) = (lo - a, hi - a);
-    let (p, q) = (axis * u, axis * v);
-    let (min, max) = (p.min(q).element_sum(), p.max(q).element_sum());
+/// Along `axis`, which children of `cell` (halved at `mid` along the axes of `split`, as
+/// in [`Tree::children_crossed`]; bit c for child c) and an object that projects
+/// (relative to its point `a`) onto the interval between 0 and `reach` (`reach` =
+/// axis · (r − a) for the object's point r with |r − a| = `span`) are apart by more than
+/// the rounding can explain, given that each component of `axis` is within a few ulps of
+/// its exact value relative to `size` (a bound on its terms). Differences of f64 are
+/// correctly rounded, so every error is relative to a term (or an underflowed product,
+/// absolutely tiny); overflow never gives "apart".
+#[allow(clippy::too_many_arguments)]
+fn apart_children(
+    axis: DVec3,
+    size: DVec3,
+    a: DVec3,
+    reach: f64,
+    span: DVec3,
+    (lo, hi): Box3,
+    mid: DVec3,
+    split: [bool; 3],
+) -> u8 {
+    let (u, m, v) = (lo - a, mid - a, hi - a);
+    let (pu, pm, pv) = (axis * u, axis * m, axis * v);
+    // Each component's term over the lower (or whole) and the upper half: (min, max).
+    let half: [[(f64, f64); 2]; 3] = std::array::from_fn(|k| {
+        let low = if split[k] { pm[k] } else { pv[k] };
+        [(pu[k].min(low), pu[k].max(low)), (pm[k].min(pv[k]), pm[k].max(pv[k]))]
+    });
     let w = u.abs().max(v.abs()).max(span);
     let tol = 1e-12 * (size * w).element_sum() + 1e-300 * (w.element_sum() + 1.0);
-    min > reach.max(0.0) + tol || max < reach.min(0.0) - tol
+    let (below, above) = (reach.min(0.0) - tol, reach.max(0.0) + tol);
+    let mut apart = 0u8;
+    for c in 0..8 {
+        let [x, y, z] = std::array::from_fn(|k| half[k][c >> k & 1]);
+        if x.0 + y.0 + z.0 > above || x.1 + y.1 + z.1 < below {
+            apart |= 1 << c;
+        }
+    }
+    apart
 }
 
 #[cfg(test)]
@@ -294,18 +339,35 @@ mod tests {
     #[test]
     fn apart_only_when_strictly_aside() {
         let cell = (DVec3::ZERO, DVec3::ONE);
-        let (n, none) = (DVec3::ONE, DVec3::ZERO);
+        let whole = [false; 3];
+        let apart = |a: DVec3, reach: f64, span: DVec3| {
+            apart_children(DVec3::ONE, DVec3::ONE, a, reach, span, cell, DVec3::splat(0.5), whole) & 1 == 1
+        };
+        let none = DVec3::ZERO;
         // The plane x + y + z = 3 touches the corner (1, 1, 1): not apart.
-        assert!(!apart(n, n, DVec3::new(3.0, 0.0, 0.0), 0.0, none, cell));
-        assert!(apart(n, n, DVec3::new(3.001, 0.0, 0.0), 0.0, none, cell));
-        assert!(apart(n, n, DVec3::new(-0.001, 0.0, 0.0), 0.0, none, cell));
-        assert!(!apart(n, n, DVec3::new(1.5, 0.0, 0.0), 0.0, none, cell));
+        assert!(!apart(DVec3::new(3.0, 0.0, 0.0), 0.0, none));
+        assert!(apart(DVec3::new(3.001, 0.0, 0.0), 0.0, none));
+        assert!(apart(DVec3::new(-0.001, 0.0, 0.0), 0.0, none));
+        assert!(!apart(DVec3::new(1.5, 0.0, 0.0), 0.0, none));
         // An interval reaching back to the box.
         let r = DVec3::new(-1.0, 0.0, 0.0);
-        assert!(!apart(n, n, DVec3::new(4.0, 0.0, 0.0), n.dot(r), r.abs(), cell));
-        assert!(apart(n, n, DVec3::new(4.001, 0.0, 0.0), n.dot(r), r.abs(), cell));
+        assert!(!apart(DVec3::new(4.0, 0.0, 0.0), DVec3::ONE.dot(r), r.abs()));
+        assert!(apart(DVec3::new(4.001, 0.0, 0.0), DVec3::ONE.dot(r), r.abs()));
+        // Halved: the plane x + y + z = 1.4 misses the upper octant [0.5, 1]³ only.
+        let halves = apart_children(
+            DVec3::ONE,
+            DVec3::ONE,
+            DVec3::new(1.4, 0.0, 0.0),
+            0.0,
+            none,
+            cell,
+            DVec3::splat(0.5),
+            [true; 3],
+        );
+        assert_eq!(halves, 1 << 7);
         // Far beyond f64's range the products overflow: no decision.
-        assert!(!apart(DVec3::splat(1e300), DVec3::splat(1e300), DVec3::splat(1e300), 0.0, none, cell));
+        let big = DVec3::splat(1e300);
+        assert_eq!(apart_children(big, big, big, 0.0, none, cell, DVec3::splat(0.5), [true; 3]), 0);
     }
 
     #[test]
@@ -325,12 +387,17 @@ mod tests {
             edge_face: vec![0],
             boxes: Vec::new(),
         };
-        let cell = |x: f64, y: f64| (DVec3::new(x, y, -0.1), DVec3::new(x + 0.1, y + 0.1, 0.1));
-        // Inside its box but off the sliver, beside its edge: out for both.
-        assert!(!tree.may_cross(0, cell(0.6, 0.3)) && !tree.may_cross(1, cell(0.6, 0.3)));
-        // On it: in.
-        assert!(tree.may_cross(0, cell(0.45, 0.45)) && tree.may_cross(1, cell(0.45, 0.45)));
-        // Touching its corner (1, 1, 0) only: in.
-        assert!(tree.may_cross(0, cell(1.0, 1.0)) && tree.may_cross(1, cell(1.0, 1.0)));
+        // The cell [0.4, 0.8] × [0.35, 0.75] × [−0.2, 0.2] (inside the sliver's box),
+        // halved: the sliver and its long edge cross every child but the two with x in
+        // the upper half and y in the lower (bit 0 set, bit 1 clear).
+        let cell = (DVec3::new(0.4, 0.35, -0.2), DVec3::new(0.8, 0.75, 0.2));
+        let mid = DVec3::new(0.6, 0.55, 0.0);
+        let crossed = 0xff & !(1 << 1 | 1 << 5);
+        assert_eq!(tree.children_crossed(0, cell, mid, [true; 3], 0xff), crossed);
+        assert_eq!(tree.children_crossed(1, cell, mid, [true; 3], 0xff), crossed);
+        // Children that only touch its corner (1, 1, 0) stay.
+        let corner = (DVec3::new(1.0, 1.0, -0.2), DVec3::new(1.4, 1.4, 0.2));
+        let at = 1 | 1 << 4;
+        assert_eq!(tree.children_crossed(0, corner, DVec3::new(1.2, 1.2, 0.0), [true; 3], at), at);
     }
 }
