@@ -392,7 +392,7 @@ mod tests {
         // the upper half and y in the lower (bit 0 set, bit 1 clear).
         let cell = (DVec3::new(0.4, 0.35, -0.2), DVec3::new(0.8, 0.75, 0.2));
         let mid = DVec3::new(0.6, 0.55, 0.0);
-        let crossed = 0xff & !(1 << 1 | 1 << 5);
+        let crossed: u8 = !(1 << 1 | 1 << 5);
         assert_eq!(tree.children_crossed(0, cell, mid, [true; 3], 0xff), crossed);
         assert_eq!(tree.children_crossed(1, cell, mid, [true; 3], 0xff), crossed);
         // Children that only touch its corner (1, 1, 0) stay.
