@@ -496,6 +496,22 @@ fn volumes_far_from_the_origin_are_exact() {
     let o = texgeo(&["mesh", "stats", out.to_str().unwrap()]);
     let w = number_after(&stdout(&o), "volume");
     assert!((w - want).abs() <= 1e-12 * want, "{w} vs {want}");
+    // Two small solids far apart are not flat: the result is an operand again.
+    let again = dir.join("again.off");
+    let o = texgeo(&[
+        "boolean",
+        out.to_str().unwrap(),
+        far_path,
+        "--op",
+        "union",
+        "--method",
+        "cpu",
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = number_after(&stdout(&o), "volume");
+    assert!((v - want).abs() <= 1e-12 * want, "{v} vs {want}");
 }
 
 #[test]

@@ -11,6 +11,7 @@ use glam::DVec3;
 
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
+use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate};
 use crate::mesh::solidity::{self, NotSolid, Policy};
@@ -70,8 +71,7 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
     }
     // In the frame: the volume in the input's units may underflow.
     let volume = Covering::new(mesh).volume();
-    let (lo, hi) = mesh.bounds();
-    if is_flat(volume, lo, hi) {
+    if volume.abs() <= flatness_bound(&soup) {
         return Err(InputError::Flat);
     }
     Ok(soup)
@@ -81,6 +81,26 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
 /// the box `lo`..`hi` (a solid flattened to a sheet, whatever its size).
 pub fn is_flat(volume: f64, lo: DVec3, hi: DVec3) -> bool {
     volume.abs() <= 1e-12 * (hi - lo).max_element().powi(3)
+}
+
+/// The volume at or below which a whole mesh encloses none: the sum of [`is_flat`]'s bound
+/// over its connected pieces (the box around all of them would call two small solids far
+/// apart flat).
+pub fn flatness_bound(soup: &TriangleSoup) -> f64 {
+    let mut sets = UnionFind::new(soup.positions.len());
+    for t in &soup.triangles {
+        sets.union(t[0], t[1]);
+        sets.union(t[0], t[2]);
+    }
+    let mut boxes: std::collections::HashMap<u32, (DVec3, DVec3)> = std::collections::HashMap::new();
+    for t in &soup.triangles {
+        let e = boxes.entry(sets.find(t[0])).or_insert((DVec3::INFINITY, DVec3::NEG_INFINITY));
+        for &v in t {
+            let p = soup.positions[v as usize];
+            *e = (e.0.min(p), e.1.max(p));
+        }
+    }
+    boxes.values().map(|(lo, hi)| 1e-12 * (*hi - *lo).max_element().powi(3)).sum()
 }
 
 #[cfg(test)]

@@ -33,7 +33,7 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::input::is_flat;
+use super::input::{flatness_bound, is_flat};
 use crate::exact::orient2d;
 use crate::mesh::covering::signed_tetra_volume;
 use crate::mesh::disjoint_sets::UnionFind;
@@ -582,11 +582,7 @@ fn drop_flat_shells(
         retain_marked(origin, &keep);
     }
     let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.0).sum();
-    let (lo, hi) = shells
-        .iter()
-        .filter(|(r, _)| !flat.contains(r))
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (_, s)| (lo.min(s.1), hi.max(s.2)));
-    if !soup.triangles.is_empty() && is_flat(volume, lo, hi) {
+    if !soup.triangles.is_empty() && volume.abs() <= flatness_bound(soup) {
         return Err(InvalidResult::NoVolume { volume });
     }
     Ok(())
