@@ -271,28 +271,21 @@ fn det3<R: Ring>(a: [&R; 3], b: [&R; 3], c: [&R; 3]) -> R {
     a[0].times(&m0).minus(&a[1].times(&m1)).plus(&a[2].times(&m2))
 }
 
-/// det of the 4×4 matrix with rows a, b, c, d.
+/// det of the 4×4 matrix with rows a, b, c, d, expanded along the last column (W, which
+/// is 1 for explicit points); no allocation, as the filter runs on every call.
 fn det4<R: Ring>(r: [&[R; 4]; 4]) -> R {
-    let minor = |skip: usize, col: usize| {
-        let rows: Vec<[&R; 3]> = (0..4)
-            .filter(|&i| i != skip)
-            .map(|i| {
-                let mut k = 0;
-                std::array::from_fn(|_| {
-                    if k == col {
-                        k += 1;
-                    }
-                    let e = &r[i][k];
-                    k += 1;
-                    e
-                })
-            })
-            .collect();
-        det3(rows[0], rows[1], rows[2])
+    let xyz = |i: usize| [&r[i][0], &r[i][1], &r[i][2]];
+    let minor = |skip: usize| {
+        let [p, q, s] = match skip {
+            0 => [1, 2, 3],
+            1 => [0, 2, 3],
+            2 => [0, 1, 3],
+            _ => [0, 1, 2],
+        };
+        det3(xyz(p), xyz(q), xyz(s))
     };
-    // Expansion along the last column (W), which is 1 for explicit points.
-    let terms: Vec<R> = (0..4).map(|i| r[i][3].times(&minor(i, 3))).collect();
-    terms[1].minus(&terms[0]).plus(&terms[3].minus(&terms[2]))
+    let term = |i: usize| r[i][3].times(&minor(i));
+    term(1).minus(&term(0)).plus(&term(3).minus(&term(2)))
 }
 
 /// Decides a determinant's sign: the filter first, the exact value when it cannot.
