@@ -401,13 +401,18 @@ pub fn soup_self_intersections_near(soup: &TriangleSoup, near: &[bool], limit: u
     crossings(soup, Some(near), limit)
 }
 
-fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(usize, usize)> {
-    let mut found: Vec<(usize, usize)> = soup
-        .failed
+/// Faces whose own triangulation failed because their edges cross or corners coincide,
+/// as (f, f) pairs.
+fn self_crossing_faces(soup: &TriangleSoup) -> Vec<(usize, usize)> {
+    soup.failed
         .iter()
         .filter(|(_, e)| *e == TriangulateError::Crossing || *e == TriangulateError::Duplicate)
         .map(|&(f, _)| (f as usize, f as usize))
-        .collect();
+        .collect()
+}
+
+fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(usize, usize)> {
+    let mut found = self_crossing_faces(soup);
     if found.len() >= limit {
         found.truncate(limit);
         return found;
@@ -528,12 +533,7 @@ mod tests {
     /// [`self_intersections`] with every triangle pair tested, no candidate search.
     fn all_pairs(mesh: &Mesh) -> Vec<(usize, usize)> {
         let soup = TriangleSoup::new(mesh);
-        let mut found: Vec<(usize, usize)> = soup
-            .failed
-            .iter()
-            .filter(|(_, e)| *e == TriangulateError::Crossing || *e == TriangulateError::Duplicate)
-            .map(|&(f, _)| (f as usize, f as usize))
-            .collect();
+        let mut found = self_crossing_faces(&soup);
         let soup = split_at_t_junctions(&soup).unwrap_or(soup);
         let n = soup.triangles.len();
         let flat: Vec<bool> = (0..n).map(|t| is_degenerate(soup.triangle(t))).collect();
