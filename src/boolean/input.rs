@@ -71,7 +71,7 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
     }
     // In the frame: the volume in the input's units may underflow.
     let volume = Covering::new(mesh).volume();
-    if volume.abs() <= flatness_bound(&soup) {
+    if volume.abs() <= flatness_bound(piece_boxes(&soup)) {
         return Err(InputError::Flat);
     }
     Ok(soup)
@@ -84,9 +84,14 @@ pub fn is_flat(volume: f64, lo: DVec3, hi: DVec3) -> bool {
 }
 
 /// The volume at or below which a whole mesh encloses none: the sum of [`is_flat`]'s bound
-/// over its connected pieces (the box around all of them would call two small solids far
-/// apart flat).
-pub fn flatness_bound(soup: &TriangleSoup) -> f64 {
+/// over its connected pieces' boxes (the box around all of them would call two small
+/// solids far apart flat).
+pub fn flatness_bound(piece_boxes: impl IntoIterator<Item = (DVec3, DVec3)>) -> f64 {
+    piece_boxes.into_iter().map(|(lo, hi)| 1e-12 * (hi - lo).max_element().powi(3)).sum()
+}
+
+/// The boxes of the connected pieces of a triangle soup.
+pub fn piece_boxes(soup: &TriangleSoup) -> Vec<(DVec3, DVec3)> {
     let mut sets = UnionFind::new(soup.positions.len());
     for t in &soup.triangles {
         sets.union(t[0], t[1]);
@@ -100,7 +105,7 @@ pub fn flatness_bound(soup: &TriangleSoup) -> f64 {
             *e = (e.0.min(p), e.1.max(p));
         }
     }
-    boxes.values().map(|(lo, hi)| 1e-12 * (*hi - *lo).max_element().powi(3)).sum()
+    boxes.into_values().collect()
 }
 
 #[cfg(test)]

@@ -582,7 +582,8 @@ fn drop_flat_shells(
         retain_marked(origin, &keep);
     }
     let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.0).sum();
-    if !soup.triangles.is_empty() && volume.abs() <= flatness_bound(soup) {
+    let bound = flatness_bound(shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| (s.1, s.2)));
+    if !soup.triangles.is_empty() && volume.abs() <= bound {
         return Err(InvalidResult::NoVolume { volume });
     }
     Ok(())
