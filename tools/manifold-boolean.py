@@ -73,7 +73,7 @@ def write_off(path, pos, tris):
     with open(path, "w") as f:
         f.write(f"OFF\n{len(pos)} {len(tris)} 0\n")
         for p in pos:
-            f.write(f"{p[0]!r} {p[1]!r} {p[2]!r}\n")
+            f.write(f"{float(p[0])!r} {float(p[1])!r} {float(p[2])!r}\n")
         for t in tris:
             f.write(f"3 {t[0]} {t[1]} {t[2]}\n")
 
