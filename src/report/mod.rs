@@ -7,7 +7,7 @@ pub mod reproduce;
 mod table;
 mod timing;
 
-pub use table::{Report, Table};
+pub use table::{Report, Table, sig};
 pub use timing::{Samples, Side, interleave, time_runs, timed};
 
 /// Where a long measurement says what it is doing: `texgeo bench` prints a line per

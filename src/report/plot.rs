@@ -67,6 +67,10 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// The most curves one chart holds: more and a reader cannot tell their colours and
+/// dash patterns apart ([`Chart::split`] makes several charts of a larger one).
+pub const MOST_SERIES: usize = 8;
+
 /// Size of every chart, pixels: the plot, and the legend in a column on its right.
 pub const WIDTH: u32 = 1000;
 pub const HEIGHT: u32 = 560;
@@ -94,12 +98,82 @@ fn label(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// The ticks of a log axis over `range`: the data's decades (1, 10, 100, …), with 2 and
+/// 5 between them when the range spans less than two decades, thinned so at most
+/// [`MOST_TICKS`] carry a label (labels never overlap); the light grid lines at every
+/// multiple 2…9 of a decade.
+fn log_ticks(range: &Range<f64>) -> (Vec<f64>, Vec<f64>) {
+    let (lo, hi) = (range.start.max(f64::MIN_POSITIVE), range.end.max(f64::MIN_POSITIVE));
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    let decades: Vec<f64> = (first..=last).map(|k| 10f64.powi(k)).filter(inside).collect();
+    let steps: &[f64] = if decades.len() >= 2 { &[1.0] } else { &[1.0, 2.0, 5.0] };
+    let mut bold: Vec<f64> =
+        (first..=last).flat_map(|k| steps.iter().map(move |m| m * 10f64.powi(k))).filter(inside).collect();
+    let stride = bold.len().div_ceil(MOST_TICKS).max(1);
+    bold = bold.into_iter().step_by(stride).collect();
+    let light = (first..=last)
+        .flat_map(|k| (2..10).map(move |m| f64::from(m) * 10f64.powi(k)))
+        .filter(inside)
+        .filter(|v| !bold.contains(v))
+        .collect();
+    (bold, light)
+}
+
+/// The most labelled ticks on an axis.
+const MOST_TICKS: usize = 8;
+
 impl Chart {
+    /// This chart, or when it holds more than [`MOST_SERIES`] curves, several charts
+    /// ("(1 of 2)", …) that split it between colours: a thesis curve stays with today's
+    /// curve of its colour.
+    pub fn split(&self) -> Vec<Chart> {
+        if self.series.len() <= MOST_SERIES {
+            return vec![self.clone()];
+        }
+        let mut groups: Vec<Vec<Series>> = Vec::new();
+        for s in &self.series {
+            match groups.iter_mut().find(|g| g[0].colour == s.colour) {
+                Some(g) => g.push(s.clone()),
+                None => groups.push(vec![s.clone()]),
+            }
+        }
+        let mut parts: Vec<Vec<Series>> = Vec::new();
+        for g in groups {
+            match parts.last_mut() {
+                Some(p) if p.len() + g.len() <= MOST_SERIES => p.extend(g),
+                _ => parts.push(g),
+            }
+        }
+        let n = parts.len();
+        parts
+            .into_iter()
+            .enumerate()
+            .map(|(i, series)| Chart {
+                title: format!("{} ({} of {n})", self.title, i + 1),
+                series,
+                ..self.clone()
+            })
+            .collect()
+    }
+
     fn points(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.series
             .iter()
             .flat_map(|s| s.points.iter().copied())
             .filter(|p| p.0.is_finite() && p.1.is_finite())
+    }
+
+    /// A chart with more curves than a reader can tell apart is not drawn ([`Chart::split`]).
+    fn check(&self) -> Result<(), String> {
+        if self.series.len() > MOST_SERIES {
+            return Err(format!(
+                "{}: {} curves, more than the {MOST_SERIES} a reader can tell apart",
+                self.title,
+                self.series.len()
+            ));
+        }
+        Ok(())
     }
 
     /// Axis range over the data, padded; positive only on a log axis.
@@ -119,6 +193,7 @@ impl Chart {
 
     /// The chart as an SVG document.
     pub fn svg(&self) -> Result<String, String> {
+        self.check()?;
         ensure_font()?;
         let mut svg = String::new();
         {
@@ -131,6 +206,7 @@ impl Chart {
 
     /// The chart as a PNG file's bytes.
     pub fn png(&self) -> Result<Vec<u8>, String> {
+        self.check()?;
         ensure_font()?;
         let mut rgb = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
         {
@@ -148,10 +224,14 @@ impl Chart {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let (x, y) = (self.range(self.x_log, |p| p.0), self.range(self.y_log, |p| p.1));
+        let log = |r: Range<f64>| {
+            let (bold, light) = log_ticks(&r);
+            r.log_scale().with_key_points(bold).with_light_points(light)
+        };
         match (self.x_log, self.y_log) {
-            (true, true) => self.draw_on(root, x.log_scale(), y.log_scale()),
-            (true, false) => self.draw_on(root, x.log_scale(), y),
-            (false, true) => self.draw_on(root, x, y.log_scale()),
+            (true, true) => self.draw_on(root, log(x), log(y)),
+            (true, false) => self.draw_on(root, log(x), y),
+            (false, true) => self.draw_on(root, x, log(y)),
             (false, false) => self.draw_on(root, x, y),
         }
     }
@@ -275,6 +355,46 @@ mod tests {
             assert_eq!(img.dimensions(), (WIDTH, HEIGHT));
             assert!(img.pixels().any(|p| p.0 != [255, 255, 255]), "something is drawn");
         }
+    }
+
+    #[test]
+    fn log_ticks_sit_at_the_data_decades_and_stay_few() {
+        let (bold, light) = log_ticks(&(0.5..2000.0));
+        assert_eq!(bold, vec![1.0, 10.0, 100.0, 1000.0]);
+        assert!(light.contains(&2.0) && light.contains(&500.0) && !light.contains(&10.0));
+        // Less than two decades: 1-2-5 steps.
+        assert_eq!(log_ticks(&(1.5..30.0)).0, vec![2.0, 5.0, 10.0, 20.0]);
+        // Twenty decades: thinned to at most MOST_TICKS labels.
+        let (bold, _) = log_ticks(&(1e-10..1e10));
+        assert!(bold.len() <= MOST_TICKS && bold.len() >= 4, "{bold:?}");
+        assert!(bold.iter().all(|v| (v.log10() - v.log10().round()).abs() < 1e-9), "{bold:?}");
+    }
+
+    #[test]
+    fn a_crowded_chart_is_refused_and_split_between_colours() {
+        let mut c = chart(true);
+        c.series = (0..7)
+            .flat_map(|i| {
+                [false, true].map(|thesis| Series {
+                    label: format!("s{i}{thesis}"),
+                    points: vec![(1.0, 1.0 + i as f64), (10.0, 2.0)],
+                    thesis,
+                    colour: i,
+                })
+            })
+            .collect();
+        assert!(c.svg().unwrap_err().contains("14 curves"));
+        let parts = c.split();
+        assert_eq!(parts.len(), 2);
+        assert!(parts.iter().all(|p| p.series.len() <= MOST_SERIES && p.svg().is_ok()));
+        assert_eq!(parts.iter().map(|p| p.series.len()).sum::<usize>(), 14);
+        // Today's curve and the thesis' of one colour stay on one chart.
+        for p in &parts {
+            for s in &p.series {
+                assert_eq!(p.series.iter().filter(|t| t.colour == s.colour).count(), 2);
+            }
+        }
+        assert!(parts[1].title.ends_with("(2 of 2)"));
     }
 
     #[test]

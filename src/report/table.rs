@@ -5,6 +5,16 @@ use std::path::{Path, PathBuf};
 
 use super::Environment;
 
+/// `v` with `digits` significant digits, in plain notation (no exponent; integers
+/// keep all their digits): 0.01234, 1.234, 1234, 123456.
+pub fn sig(v: f64, digits: usize) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (digits as i32 - 1 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    format!("{v:.decimals$}")
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Table {
     pub title: String,
@@ -116,5 +126,18 @@ impl Report {
             written.push(path);
         }
         Ok(written)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn significant_digits_are_the_same_at_every_magnitude() {
+        assert_eq!(super::sig(0.000123456, 4), "0.0001235");
+        assert_eq!(super::sig(1.23456, 4), "1.235");
+        assert_eq!(super::sig(1234.56, 4), "1235");
+        assert_eq!(super::sig(123456.0, 4), "123456");
+        assert_eq!(super::sig(-2.5, 2), "-2.5");
+        assert_eq!(super::sig(0.0, 3), "0");
     }
 }

@@ -68,9 +68,54 @@ pub fn thesis_csv(id: &str) -> &'static str {
     THESIS.iter().find(|(t, _)| *t == id).map(|(_, c)| *c).unwrap_or("")
 }
 
+/// A column of the transcribed tables in words: `feito_octants_kb` → "Feito (octants)
+/// KB", `time_32` → "32³ s".
+fn column_words(column: &str) -> String {
+    let unit = |rest: &str, unit: &str| format!("{} {unit}", column_words(rest));
+    if let Some(n) = column.strip_prefix("time_") {
+        return format!("{n}³ s");
+    }
+    if let Some(n) = column.strip_prefix("kb_") {
+        return format!("{n}³ KB");
+    }
+    if let Some(rest) = column.strip_suffix("_kb") {
+        return unit(rest, "KB");
+    }
+    if let Some(rest) = column.strip_suffix("_s") {
+        return unit(rest, "s");
+    }
+    if let Some(n) = column.strip_prefix("tetragrid_") {
+        return format!("TetraGrid {n}³");
+    }
+    if let Some(rest) = column.strip_prefix("feito_") {
+        return format!("Feito ({})", column_words(rest));
+    }
+    match column {
+        "model" | "faces" | "triangles" | "vertices" | "octants" => column.to_string(),
+        "no_optimizer" => "no optimizer".into(),
+        "basic" => "basic (CPU)".into(),
+        "cpu" => "CPU".into(),
+        "gpu" => "GPU".into(),
+        "cpu_gpu" => "CPU+GPU".into(),
+        "gpu_tetragrid_32" => "GPU + TetraGrid 32³".into(),
+        "bsp" => "BSP".into(),
+        "jordan" => "Jordan".into(),
+        "jordan_octree_6" => "Jordan + octree 6".into(),
+        other => other.replace('_', " "),
+    }
+}
+
+/// Table 4-6 as printed repeats Table 4-5's TetraGrid 2³ … 64³ columns under its six
+/// method names; said under the table wherever it is shown.
+pub const TABLE_4_6_NOTE: &str = "As printed, the thesis' Table 4-6 repeats Table 4-5's TetraGrid 2³ … 64³ columns \
+     under its six method names (its \"basic\" column equals Table 4-5's TetraGrid 2³, its CPU+GPU column TetraGrid \
+     4³, and so on): only its TetraGrid 32³ column can be the method it names. Its numbers are shown as printed, \
+     from that one table; the claims take the CPU and GPU times from Table 4-9.";
+
 fn thesis_table(id: &str) -> Table {
     let mut lines = thesis_csv(id).lines();
-    let columns: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let columns: Vec<String> = lines.next().unwrap_or("").split(',').map(column_words).collect();
+    let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
     let mut t = Table::new(
         format!("Table {id} as printed in the thesis (Pentium 4E 3.4 GHz, GeForce 7800 GTX)"),
         &columns,
@@ -79,11 +124,14 @@ fn thesis_table(id: &str) -> Table {
     for l in lines.filter(|l| !l.trim().is_empty()) {
         t.row(l.split(',').map(str::to_string).collect());
     }
+    if id == "4-6" {
+        t.note(TABLE_4_6_NOTE);
+    }
     t
 }
 
 fn secs(d: Duration) -> String {
-    format!("{:.6}", d.as_secs_f64())
+    crate::report::sig(d.as_secs_f64(), 4)
 }
 
 fn kib(bytes: usize) -> String {
@@ -163,7 +211,7 @@ impl Measured {
     fn ratio(&self, method: &str) -> String {
         let get = |m: &str| self.mean(m).map(|d| d.as_secs_f64());
         match (get("cpu"), get(method)) {
-            (Some(c), Some(m)) if m > 0.0 => format!("{:.1}×", c / m),
+            (Some(c), Some(m)) if m > 0.0 => crate::report::sig(c / m, 3),
             _ => "–".into(),
         }
     }
@@ -498,7 +546,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
     }
 
     let mut speed = Table::new(
-        "Speed-up over the single-thread exact CPU test (`cpu`), from the means above",
+        "Speed-up over the single-thread exact CPU test (`cpu`), from the means above (×)",
         &[
             "model",
             "cpu+gpu",

@@ -136,14 +136,24 @@ impl Verdict {
         }
     }
 
+    /// The words of the four verdicts, in [`Verdict::index`] order.
+    pub const WORDS: [&'static str; 4] =
+        ["holds", "does not hold", "inconclusive (within noise)", "not measurable"];
+
+    /// 0 holds, 1 does not hold, 2 inconclusive, 3 not measurable: where the verdict
+    /// is counted.
+    pub fn index(&self) -> usize {
+        match self {
+            Verdict::Holds => 0,
+            Verdict::DoesNotHold => 1,
+            Verdict::Inconclusive => 2,
+            Verdict::NotMeasurable(_) => 3,
+        }
+    }
+
     /// "holds", "does not hold", "inconclusive (within noise)", "not measurable".
     pub fn word(&self) -> &'static str {
-        match self {
-            Verdict::Holds => "holds",
-            Verdict::DoesNotHold => "does not hold",
-            Verdict::Inconclusive => "inconclusive (within noise)",
-            Verdict::NotMeasurable(_) => "not measurable",
-        }
+        Verdict::WORDS[self.index()]
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use base64::Engine as _;
 
-use super::{ReproduceError, Result};
+use super::{ReproduceError, Result, Verdict};
 use crate::report::Table;
 
 #[derive(Clone, Debug)]
@@ -37,6 +37,35 @@ pub enum Block {
         png: String,
         caption: String,
     },
+    /// What the colours of the picture above mean: (meaning, sRGB colour).
+    Legend(Vec<(String, [u8; 3])>),
+    /// The claims per verdict, in [`Verdict::index`] order: the report's headline.
+    Verdicts([usize; 4]),
+}
+
+/// The CSS classes that colour the verdicts, in [`Verdict::index`] order.
+const VERDICT_CLASSES: [&str; 4] = ["holds", "fails", "noise", "nm"];
+
+/// (word, CSS class) of each verdict.
+fn verdicts() -> impl Iterator<Item = (&'static str, &'static str)> {
+    Verdict::WORDS.into_iter().zip(VERDICT_CLASSES)
+}
+
+/// Whether a cell holds one number (a unit sign after it allowed): such columns are
+/// right-aligned.
+fn numeric(cell: &str) -> bool {
+    let c = cell.trim().trim_end_matches(['%', '×']).trim_end();
+    !c.is_empty() && c.replace(['\u{202f}', '\u{2009}'], "").parse::<f64>().is_ok()
+}
+
+/// The columns of `table` that hold numbers only ("–" for a missing one allowed).
+fn numeric_columns(table: &Table) -> Vec<bool> {
+    (0..table.columns.len())
+        .map(|i| {
+            let cells: Vec<&str> = table.rows.iter().filter_map(|r| r.get(i)).map(|c| c.trim()).collect();
+            cells.iter().any(|c| numeric(c)) && cells.iter().all(|c| numeric(c) || *c == "–" || c.is_empty())
+        })
+        .collect()
 }
 
 /// The anchor of a heading: lower case, alphanumerics and dashes (GitHub's rule, close
@@ -81,7 +110,9 @@ pub fn to_markdown(blocks: &[Block]) -> String {
                     "| {} |",
                     table.columns.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | ")
                 );
-                let _ = writeln!(s, "|{}", "---|".repeat(table.columns.len()));
+                let align: String =
+                    numeric_columns(table).iter().map(|&n| if n { "---:|" } else { "---|" }).collect();
+                let _ = writeln!(s, "|{align}");
                 for row in &table.rows {
                     let _ =
                         writeln!(s, "| {} |", row.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | "));
@@ -97,6 +128,16 @@ pub fn to_markdown(blocks: &[Block]) -> String {
             }
             Block::Plot { svg, png, caption } => {
                 let _ = writeln!(s, "![{caption}]({svg})\n\n*{caption}* ([SVG]({svg}), [PNG]({png}))\n");
+            }
+            Block::Legend(items) => {
+                let list: Vec<String> =
+                    items.iter().map(|(what, [r, g, b])| format!("{what} #{r:02x}{g:02x}{b:02x}")).collect();
+                let _ = writeln!(s, "Colours: {}.\n", list.join("; "));
+            }
+            Block::Verdicts(counts) => {
+                let parts: Vec<String> =
+                    counts.iter().zip(verdicts()).map(|(n, (word, _))| format!("**{n}** {word}")).collect();
+                let _ = writeln!(s, "Claims: {}.\n", parts.join(" · "));
             }
         }
     }
@@ -148,7 +189,18 @@ fn data_uri(root: &Path, relative: &str) -> Result<String> {
 const STYLE: &str = "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\
 table{border-collapse:collapse;margin:.5em 0 1em;font-size:90%}td,th{border:1px solid #bbb;padding:2px 6px;\
 text-align:left}th{background:#eee}tr:nth-child(even){background:#f8f8f8}figure{margin:1em 0}\
+td.n,th.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}\
+.holds{background:#d4edda;color:#155724}.fails{background:#f8d7da;color:#721c24}\
+.noise{background:#fff3cd;color:#856404}.nm{background:#e2e3e5;color:#383d41}\
+.verdicts span{display:inline-block;padding:4px 10px;margin:0 6px 6px 0;border-radius:4px;font-size:110%}\
+.legend span.sw{display:inline-block;width:1em;height:1em;margin:0 4px 0 10px;vertical-align:middle;\
+border:1px solid #888}\
 img{max-width:100%}code{background:#f2f2f2;padding:0 2px}.note{color:#555;font-size:90%}";
+
+/// The CSS class of a cell that is a verdict word, if it is one.
+fn verdict_class(cell: &str) -> Option<&'static str> {
+    verdicts().find(|(word, _)| *word == cell.trim()).map(|(_, class)| class)
+}
 
 /// One HTML page; pictures and plots (read from under `root`) are embedded as data URIs.
 pub fn to_html(title: &str, blocks: &[Block], root: &Path) -> Result<String> {
@@ -179,14 +231,23 @@ pub fn to_html(title: &str, blocks: &[Block], root: &Path) -> Result<String> {
             }
             Block::Table { table, csv } => {
                 let _ = write!(s, "<p><strong>{}</strong></p>\n<table><tr>", inline_html(&table.title));
-                for c in &table.columns {
-                    let _ = write!(s, "<th>{}</th>", inline_html(c));
+                let numbers = numeric_columns(table);
+                let class = |i: usize| if numbers.get(i) == Some(&true) { " class=\"n\"" } else { "" };
+                for (i, c) in table.columns.iter().enumerate() {
+                    let _ = write!(s, "<th{}>{}</th>", class(i), inline_html(c));
                 }
                 s.push_str("</tr>\n");
                 for row in &table.rows {
                     s.push_str("<tr>");
-                    for c in row {
-                        let _ = write!(s, "<td>{}</td>", inline_html(c));
+                    for (i, c) in row.iter().enumerate() {
+                        match verdict_class(c) {
+                            Some(v) => {
+                                let _ = write!(s, "<td class=\"{v}\">{}</td>", inline_html(c));
+                            }
+                            None => {
+                                let _ = write!(s, "<td{}>{}</td>", class(i), inline_html(c));
+                            }
+                        }
                     }
                     s.push_str("</tr>\n");
                 }
@@ -194,7 +255,7 @@ pub fn to_html(title: &str, blocks: &[Block], root: &Path) -> Result<String> {
                 for n in &table.notes {
                     let _ = writeln!(s, "<p class=\"note\">{}</p>", inline_html(n));
                 }
-                let _ = writeln!(s, "<p class=\"note\">CSV: <code>{}</code></p>", escape(csv));
+                let _ = writeln!(s, "<p class=\"note\">CSV: <a href=\"{0}\">{0}</a></p>", escape(csv));
             }
             Block::Image { path, caption, width, height } => {
                 let _ = writeln!(
@@ -213,6 +274,24 @@ pub fn to_html(title: &str, blocks: &[Block], root: &Path) -> Result<String> {
                     escape(caption),
                     inline_html(caption)
                 );
+            }
+            Block::Legend(items) => {
+                s.push_str("<p class=\"legend\">Colours:");
+                for (what, [r, g, b]) in items {
+                    let _ = write!(
+                        s,
+                        "<span class=\"sw\" style=\"background:#{r:02x}{g:02x}{b:02x}\"></span>{}",
+                        inline_html(what)
+                    );
+                }
+                s.push_str("</p>\n");
+            }
+            Block::Verdicts(counts) => {
+                s.push_str("<p class=\"verdicts\">Claims:");
+                for (n, (word, class)) in counts.iter().zip(verdicts()) {
+                    let _ = write!(s, " <span class=\"{class}\"><strong>{n}</strong> {word}</span>");
+                }
+                s.push_str("</p>\n");
             }
         }
     }
@@ -245,5 +324,35 @@ mod tests {
         let md = to_markdown(&[Block::Table { table: t, csv: "csv/t.csv".into() }]);
         assert!(md.contains("| 1/2 | 3 |"), "{md}");
         assert!(md.contains("CSV: [csv/t.csv](csv/t.csv)"));
+    }
+
+    #[test]
+    fn numbers_align_right_verdicts_are_coloured_and_csvs_are_links() {
+        let mut t = Table::new("T", &["name", "time (s)", "verdict"]);
+        t.row(vec!["a".into(), "0.01234".into(), "holds".into()]);
+        t.row(vec!["b".into(), "–".into(), "does not hold".into()]);
+        t.row(vec!["c".into(), "12.5 %".into(), "inconclusive (within noise)".into()]);
+        assert_eq!(numeric_columns(&t), vec![false, true, false]);
+        let blocks = [Block::Verdicts([3, 1, 2, 0]), Block::Table { table: t, csv: "csv/t.csv".into() }];
+        let md = to_markdown(&blocks);
+        assert!(md.contains("|---|---:|---|"), "{md}");
+        assert!(md.contains("Claims: **3** holds · **1** does not hold"), "{md}");
+        let html = to_html("t", &blocks, Path::new(".")).unwrap();
+        assert!(
+            html.contains("<td class=\"n\">0.01234</td>") && html.contains("<th class=\"n\">time (s)</th>")
+        );
+        assert!(html.contains("<td class=\"holds\">holds</td>"), "{html}");
+        assert!(html.contains("<td class=\"fails\">does not hold</td>"));
+        assert!(html.contains("<td class=\"noise\">inconclusive (within noise)</td>"));
+        assert!(html.contains("<span class=\"holds\"><strong>3</strong> holds</span>"));
+        assert!(html.contains("<a href=\"csv/t.csv\">csv/t.csv</a>"), "{html}");
+    }
+
+    #[test]
+    fn a_legend_names_each_colour() {
+        let b = [Block::Legend(vec![("operand A".into(), [214, 120, 80]), ("result".into(), [1, 2, 3])])];
+        assert!(to_markdown(&b).contains("Colours: operand A #d67850; result #010203."));
+        let html = to_html("t", &b, Path::new(".")).unwrap();
+        assert!(html.contains("background:#d67850\"></span>operand A"), "{html}");
     }
 }

@@ -19,6 +19,22 @@ use crate::subdiv::{cpu, fragment};
 use crate::voxel::aspect::Aspect;
 use crate::voxel::{self, Method as VoxelMethod};
 
+/// A legend block: what each colour of a picture means.
+fn legend(items: &[(&str, colour::Rgba)]) -> Block {
+    Block::Legend(items.iter().map(|(what, [r, g, b, _])| (what.to_string(), [*r, *g, *b])).collect())
+}
+
+/// The valence colours (`colour::valence_colour`), as a legend.
+fn valence_legend() -> Block {
+    let names = ["2 or less", "3", "4 (regular)", "5", "6", "7", "8 or more"];
+    let items: Vec<(String, colour::Rgba)> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (format!("valence {n}"), colour::valence_colour(i + 2)))
+        .collect();
+    legend(&items.iter().map(|(w, c)| (w.as_str(), *c)).collect::<Vec<_>>())
+}
+
 /// Picture size, pixels.
 pub const WIDTH: u32 = 800;
 pub const HEIGHT: u32 = 600;
@@ -154,12 +170,14 @@ pub fn valence_levels(run: &mut Run) -> Result<Vec<Block>> {
     let r = DVec3::splat(1.0 / 3f64.sqrt());
     let camera = Camera::fit(-r, r, Camera::YAW, Camera::PITCH, aspect());
     let look = Look { valence: true, wireframe: false, shading: Shading::Smooth, colour: colour::SURFACE };
-    let mut blocks = vec![Block::Para(
-        "Valence colours: 3 red, 4 grey, 5 green, 6 blue, 7 magenta, 8 or more yellow, 2 or less cyan. Each level \
-         is refined on the GPU (fragment passes from level 2 on; levels 0–1 are the input and the CPU's first \
-         level), smooth-shaded, colours interpolated between vertices."
-            .into(),
-    )];
+    let mut blocks = vec![
+        Block::Para(
+            "Each level is refined on the GPU (fragment passes from level 2 on; levels 0–1 are the input and the \
+             CPU's first level), smooth-shaded, vertices coloured by valence, colours interpolated between them."
+                .into(),
+        ),
+        valence_legend(),
+    ];
     for level in 0..=3 {
         let mut model = Model::new(run.ctx, Content::Mesh(base.clone()), level, look, None)?;
         let (vertices, faces) = model.counts();
@@ -270,9 +288,12 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
         colour,
         size: 3.0,
     };
-    let inside = group(Class::Inside, [90, 200, 100, 255]);
-    let outside = group(Class::Outside, [110, 112, 120, 255]);
-    let on = group(Class::OnBoundary, [230, 60, 50, 255]);
+    const INSIDE: colour::Rgba = [90, 200, 100, 255];
+    const OUTSIDE: colour::Rgba = [110, 112, 120, 255];
+    const ON: colour::Rgba = [230, 60, 50, 255];
+    let inside = group(Class::Inside, INSIDE);
+    let outside = group(Class::Outside, OUTSIDE);
+    let on = group(Class::OnBoundary, ON);
     let counts = (inside.positions.len(), outside.positions.len(), on.positions.len());
     let mut scene = Scene::new().with_points(outside).with_points(inside).with_points(on);
     // The cut of every triangle by the plane, lifted a little towards the camera so the
@@ -312,7 +333,15 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
          {} inside (green), {} outside (grey), {} on the boundary (red); the plane's cut through the surface in yellow",
         counts.0, counts.1, counts.2
     );
-    Ok(vec![run.picture(&picture, "inclusion-slice", &caption, record)?])
+    Ok(vec![
+        run.picture(&picture, "inclusion-slice", &caption, record)?,
+        legend(&[
+            ("inside", INSIDE),
+            ("outside", OUTSIDE),
+            ("on the boundary", ON),
+            ("the plane's cut through the surface", colour::CURVE),
+        ]),
+    ])
 }
 
 /// One fragment of the cube after two fragment passes (ring radius 5 = 2² + 1), in
@@ -356,13 +385,14 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
     let surface = cpu::refine(&cube, 1 + 2)?;
     let mut scene = Scene::new()
         .with_mesh(SceneMesh::new(&surface, colour::SURFACE).wireframe(colour::EDGE).shading(Shading::Flat));
-    scene = scene.with_line(Polyline::new(entries.clone(), [250, 220, 60, 255], 1.5));
+    const SUPPORT: colour::Rgba = [140, 140, 150, 255];
+    const CENTRE: colour::Rgba = [255, 255, 255, 255];
+    scene = scene.with_line(Polyline::new(entries.clone(), colour::CURVE, 1.5));
     for (s, pts) in owned.into_iter().enumerate() {
         scene = scene.with_points(Points { positions: pts, colour: SECTOR[s % SECTOR.len()], size: 9.0 });
     }
-    scene = scene.with_points(Points { positions: support, colour: [140, 140, 150, 255], size: 6.0 });
-    scene =
-        scene.with_points(Points { positions: vec![entries[0]], colour: [255, 255, 255, 255], size: 13.0 });
+    scene = scene.with_points(Points { positions: support, colour: SUPPORT, size: 6.0 });
+    scene = scene.with_points(Points { positions: vec![entries[0]], colour: CENTRE, size: 13.0 });
     let centre = entries[0];
     let d = centre.normalize_or(DVec3::Z);
     let (plo, phi) = entries.iter().fold((centre, centre), |(a, b), &p| (a.min(p), b.max(p)));
@@ -386,7 +416,11 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
          {k} faces around the corner), the support ring grey (dropped after the last pass); the yellow line joins \
          the entries in storage order — the centre, then ring by ring, sector by sector (SPEC §5.2)"
     );
-    Ok(vec![run.picture(&picture, "fragment-layout", &caption, record)?])
+    let sector_names: Vec<String> = (1..=sectors).map(|s| format!("sector {s}")).collect();
+    let mut items: Vec<(&str, colour::Rgba)> = vec![("centre", CENTRE)];
+    items.extend(sector_names.iter().enumerate().map(|(s, n)| (n.as_str(), SECTOR[s % SECTOR.len()])));
+    items.extend([("support ring", SUPPORT), ("storage order", colour::CURVE)]);
+    Ok(vec![run.picture(&picture, "fragment-layout", &caption, record)?, legend(&items)])
 }
 
 /// Union, intersection and difference of a torus and a sphere through its tube (2006
@@ -431,6 +465,11 @@ pub fn boolean_results(run: &mut Run) -> Result<Vec<Block>> {
         };
         let caption = format!("A {} B: torus and sphere, {faces} result triangles", op.symbol());
         blocks.push(run.picture(&picture, &format!("boolean-{}", op.name()), &caption, record)?);
+        blocks.push(legend(&[
+            ("operand A, and the result's faces from A", colour::FIRST),
+            ("operand B, and the result's faces from B", colour::SECOND),
+            ("cut curve", colour::CURVE),
+        ]));
     }
     Ok(blocks)
 }

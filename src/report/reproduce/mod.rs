@@ -209,13 +209,22 @@ impl Run<'_> {
         Ok(Block::Table { table, csv })
     }
 
-    /// `chart` as `plots/STEM.svg` and `.png`.
-    pub fn plot(&mut self, chart: &crate::report::plot::Chart, stem: &str) -> Result<Block> {
-        self.unique(&format!("plots/{stem}"))?;
-        let (svg, png) = (format!("{}/{stem}.svg", Layout::PLOTS), format!("{}/{stem}.png", Layout::PLOTS));
-        self.layout.write(&svg, chart.svg().map_err(ReproduceError::Plot)?.as_bytes())?;
-        self.layout.write(&png, &chart.png().map_err(ReproduceError::Plot)?)?;
-        Ok(Block::Plot { svg, png, caption: chart.title.clone() })
+    /// `chart` as `plots/STEM.svg` and `.png`; a chart with more curves than a reader
+    /// can tell apart as several (`STEM.svg`, `STEM-2.svg`, …, [`Chart::split`]).
+    ///
+    /// [`Chart::split`]: crate::report::plot::Chart::split
+    pub fn plot(&mut self, chart: &crate::report::plot::Chart, stem: &str) -> Result<Vec<Block>> {
+        let mut blocks = Vec::new();
+        for (i, part) in chart.split().iter().enumerate() {
+            let stem = if i == 0 { stem.to_string() } else { format!("{stem}-{}", i + 1) };
+            self.unique(&format!("plots/{stem}"))?;
+            let (svg, png) =
+                (format!("{}/{stem}.svg", Layout::PLOTS), format!("{}/{stem}.png", Layout::PLOTS));
+            self.layout.write(&svg, part.svg().map_err(ReproduceError::Plot)?.as_bytes())?;
+            self.layout.write(&png, &part.png().map_err(ReproduceError::Plot)?)?;
+            blocks.push(Block::Plot { svg, png, caption: part.title.clone() });
+        }
+        Ok(blocks)
     }
 
     /// A rendered picture as `figures/STEM.png`, described in `figures.json`.
@@ -355,12 +364,7 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
             let then = (c.measure)(&thesis);
             let now = (c.measure)(&today);
             let verdict = Verdict::of(&now);
-            verdicts[match verdict {
-                Verdict::Holds => 0,
-                Verdict::DoesNotHold => 1,
-                Verdict::Inconclusive => 2,
-                Verdict::NotMeasurable(_) => 3,
-            }] += 1;
+            verdicts[verdict.index()] += 1;
             let thesis_cell = match &then {
                 Ok((shown, _)) => format!("{shown} ({})", Verdict::of(&then).word()),
                 Err(why) => format!("– ({why})"),
@@ -406,7 +410,8 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
         layout.write(&csv, t.to_csv().as_bytes())?;
         Ok(Block::Table { table: t, csv })
     };
-    let mut blocks: Vec<Block> = warning.into_iter().collect();
+    let mut blocks = vec![Block::Verdicts(verdicts)];
+    blocks.extend(warning);
     blocks.push(write_table(header.table(elapsed, longest), "run")?);
     blocks.push(header::Header::note());
     let mut summary =

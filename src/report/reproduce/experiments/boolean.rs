@@ -323,7 +323,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         y_log: true,
         series,
     };
-    blocks.push(r.plot(&chart, "boolean-time")?);
+    blocks.extend(r.plot(&chart, "boolean-time")?);
     let mut series = both(
         "phase 2 plain / grouped",
         0,
@@ -344,6 +344,6 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         y_log: true,
         series,
     };
-    blocks.push(r.plot(&chart, "boolean-speedup")?);
+    blocks.extend(r.plot(&chart, "boolean-speedup")?);
     Ok(blocks)
 }

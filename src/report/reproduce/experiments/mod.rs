@@ -11,7 +11,7 @@ use std::path::Path;
 
 use super::claims::{self, Claim};
 use super::doc::Block;
-use super::facts::Facts;
+use super::facts::{Facts, Stat};
 use super::figures;
 use super::{Result, Run};
 use crate::mesh::{Mesh, formats, procedural};
@@ -174,11 +174,16 @@ pub fn models_table(experiment: &'static str, run: &Run, models: &[(String, &str
 
 /// A number with four significant digits (no exponent).
 pub fn num(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
+    crate::report::sig(v, 4)
+}
+
+/// The spread of a value's runs beside it: half their range as a share of the value, in
+/// per cent ("–" for a single number or a count).
+pub fn spread(s: &Stat) -> String {
+    if s.runs < 2 || s.value == 0.0 {
+        return "–".into();
     }
-    let digits = (3 - v.abs().log10().floor() as i32).clamp(0, 9) as usize;
-    format!("{v:.digits$}")
+    crate::report::sig(50.0 * (s.max - s.min) / s.value.abs(), 2)
 }
 
 /// One quantity of a comparison table: its label, today's key and the thesis' key.
@@ -216,8 +221,13 @@ pub fn comparison(
             "quantity",
             &format!("thesis ({unit})"),
             &format!("today ({unit})"),
-            "today / thesis",
+            "spread of today's runs (± %)",
+            "today / thesis (×)",
         ],
+    );
+    t.note(
+        "today: the mean (inclusion) or median (other experiments) of the runs; spread: half the range of the runs \
+         as a share of that value (\"–\": one build, a count or bytes).",
     );
     for (model, _) in run.facts.models_of(experiment) {
         let thesis_model = run.facts.thesis_name(experiment, &model);
@@ -228,7 +238,7 @@ pub fn comparison(
                 continue; // not part of this run (e.g. a resolution not measured)
             }
             let ratio = match (&today, &then) {
-                (Ok(a), Ok(b)) if b.value > 0.0 => format!("{}×", num(a.value / b.value)),
+                (Ok(a), Ok(b)) if b.value > 0.0 => crate::report::sig(a.value / b.value, 3),
                 _ => "–".to_string(),
             };
             t.row(vec![
@@ -236,7 +246,8 @@ pub fn comparison(
                 model.clone(),
                 q.label.clone(),
                 then.map_or_else(|_| "–".to_string(), |s| num(s.value)),
-                today.map_or_else(|why| format!("not measurable: {why}"), |s| num(s.value)),
+                today.as_ref().map_or_else(|why| format!("not measurable: {why}"), |s| num(s.value)),
+                today.as_ref().map_or_else(|_| "–".to_string(), spread),
                 ratio,
             ]);
         }

@@ -166,7 +166,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             },
         ],
     };
-    blocks.push(r.plot(&chart, "subdivide-time-vs-level")?);
+    blocks.extend(r.plot(&chart, "subdivide-time-vs-level")?);
 
     let mut series =
         both("GPU path", 0, curve(r.facts, EXP, "time:gpu-path"), curve(r.thesis, EXP, "time:gpu-path"));
@@ -185,7 +185,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         y_log: true,
         series,
     };
-    blocks.push(r.plot(&chart, "subdivide-time-vs-faces")?);
+    blocks.extend(r.plot(&chart, "subdivide-time-vs-faces")?);
 
     let mut series = both(
         "CPU / GPU path",
@@ -207,7 +207,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         y_log: true,
         series,
     };
-    blocks.push(r.plot(&chart, "subdivide-speedup")?);
+    blocks.extend(r.plot(&chart, "subdivide-speedup")?);
 
     blocks.push(Block::Heading(3, "Details (as `texgeo bench subdivide` prints them)".into()));
     let details = subdiv::report(&measured, settings, Environment::new(r.ctx.info().label()));

@@ -121,7 +121,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             y_log: true,
             series,
         };
-        blocks.push(r.plot(&chart, &format!("voxelize-time-{}", k + 1))?);
+        blocks.extend(r.plot(&chart, &format!("voxelize-time-{}", k + 1))?);
     }
     let mut series = Vec::new();
     for (k, (model, _)) in r.facts.models_of(EXP).into_iter().enumerate() {
@@ -166,7 +166,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         y_log: true,
         series,
     };
-    blocks.push(r.plot(&chart, "voxelize-speedup")?);
+    blocks.extend(r.plot(&chart, "voxelize-speedup")?);
 
     blocks.push(Block::Heading(3, "Details (as `texgeo bench voxelize` prints them)".into()));
     let details = voxelize::report(&measured, &cfg, Environment::new(r.ctx.info().label()));
