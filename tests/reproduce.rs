@@ -151,6 +151,12 @@ fn csvs_hold_the_numbers_of_the_markdown() {
             .map(|rec| rec.unwrap().iter().map(|c| c.replace('|', "/").replace('\n', " ")).collect())
             .collect();
         assert_eq!(rows, t.rows, "{}: CSV and Markdown differ", t.csv);
+        // A ratio is a number: its unit sits in the column's name, not after each value.
+        if !t.title.starts_with("Claims") {
+            for row in &rows {
+                assert!(row.iter().all(|c| !c.ends_with('×')), "{}: {row:?}", t.csv);
+            }
+        }
     }
     // Every measured value is there with the range of its runs.
     let mut m = csv::Reader::from_path(dir.join("csv/measurements.csv")).unwrap();
@@ -365,6 +371,21 @@ fn the_html_report_is_self_contained() {
     for img in images {
         assert!(img.starts_with("data:image/png;base64,") || img.starts_with("data:image/svg+xml;base64,"));
     }
+    // Every CSV a table names is a link to it, and the pictures' colours are named.
+    assert_eq!(html.matches("<p class=\"note\">CSV: <a href=\"csv/").count(), md_tables);
+    for legend in ["operand A", "valence 3", "on the boundary", "support ring"] {
+        assert!(html.contains(&format!("</span>{legend}")), "a legend names {legend}");
+    }
+    // The verdict counts head the report, coloured, and every verdict cell is coloured.
+    let head = html.find("<p class=\"verdicts\">").expect("verdict counts");
+    assert!(head < html.find("<table>").unwrap(), "the counts come before the first table");
+    let claims = html.split("Claims of the theses").nth(1).unwrap().split("</table>").next().unwrap();
+    let rows = claims.matches("<tr>").count() - 1;
+    let coloured: usize = ["holds", "fails", "noise", "nm"]
+        .iter()
+        .map(|c| claims.matches(&format!("<td class=\"{c}\">")).count())
+        .sum();
+    assert_eq!(coloured, rows, "one coloured verdict per claim");
 }
 
 #[test]
@@ -375,6 +396,19 @@ fn a_run_compared_with_itself_moved_nothing() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("beyond the noise of their runs (0 of"), "{out}");
     assert!(out.contains("Claims whose verdict changed (0)"), "{out}");
+    // Side by side: every claim of claims.csv with the same verdict twice, and the
+    // GPU's speed-ups over the CPU on both.
+    let mut r = csv::Reader::from_path(quick().join("csv/claims.csv")).unwrap();
+    let claims: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert!(out.contains(&format!("## Claims on both ({})", claims.len())), "{out}");
+    for c in &claims {
+        let row = out
+            .lines()
+            .find(|l| l.starts_with(&format!("| {} |", &c[0])))
+            .unwrap_or_else(|| panic!("{}", &c[0]));
+        assert_eq!(row.matches(&format!("| {} |", &c[6])).count(), 2, "{row}");
+    }
+    assert!(out.contains("| inclusion | Feito-Torres: CPU / GPU | builtin:knot | Torusknot |"), "{out}");
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! `texgeo reproduce -o DIR`: every experiment of both theses, one report (Markdown,
-//! HTML, CSV, plots, pictures, claims); `--compare OLD NEW` says what moved.
+//! HTML, CSV, plots, pictures, claims); `--compare A B` sets two runs side by side.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -27,8 +27,10 @@ pub struct Args {
     /// Output folder: report.md, report.html, csv/, plots/, figures/, run.json.
     #[arg(short = 'o', long = "out", value_name = "DIR", required_unless_present = "compare")]
     out: Option<PathBuf>,
-    /// Compare two report folders: print the values that moved by more than the noise
-    /// their repeated runs showed, and the claims whose verdict changed.
+    /// Compare two report folders (two devices, or two runs): every claim's verdict on
+    /// both side by side, the GPU's speed-ups over the CPU on both beside the thesis',
+    /// the values that moved by more than the noise their repeated runs showed, and the
+    /// claims whose verdict changed.
     #[arg(long, num_args = 2, value_names = ["OLD", "NEW"], conflicts_with_all = ["quick", "only", "out"])]
     compare: Option<Vec<PathBuf>>,
 }
