@@ -36,6 +36,18 @@ impl Samples {
         }
     }
 
+    /// Half the range of the runs as a share of `centre` (their mean or median), in per
+    /// cent: the spread shown beside a value ("–" in a table for fewer than two runs).
+    pub fn spread_percent(&self, centre: Duration) -> Option<f64> {
+        (self.0.len() >= 2 && !centre.is_zero())
+            .then(|| 50.0 * (self.max() - self.min()).as_secs_f64() / centre.as_secs_f64())
+    }
+
+    /// [`Samples::spread_percent`] about the median, as a table cell.
+    pub fn spread_cell(&self) -> String {
+        self.spread_percent(self.median()).map_or_else(|| "–".to_string(), |p| super::sig(p, 2))
+    }
+
     pub fn median_ms(&self) -> f64 {
         self.median().as_secs_f64() * 1e3
     }

@@ -416,13 +416,36 @@ pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report, Incl
     Ok(report(&measured, cfg, Environment::new(ctx.info().label())))
 }
 
-/// The thesis' tables for `measured`, today's beside the thesis'.
-pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> Report {
-    let res = &cfg.resolutions;
-    let label = |m: &Measured| format!("{} ({})", m.name, m.thesis);
+/// A model's row label: "name (thesis model)".
+fn label(m: &Measured) -> String {
+    format!("{} ({})", m.name, m.thesis)
+}
 
+/// The thesis' tables for `measured`, today's beside the thesis', then the speed-ups
+/// and the spread of the timed sets.
+pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> Report {
+    let (t47, t48) = index_tables(measured);
+    let mut tables = Vec::new();
+    for (id, today) in [
+        ("4-4", table_4_4(measured, cfg)),
+        ("4-5", table_4_5(measured, cfg)),
+        ("4-6", table_4_6(measured, cfg)),
+        ("4-7", t47),
+        ("4-8", t48),
+        ("4-9", table_4_9(measured, cfg)),
+    ] {
+        tables.push(today.named(&format!("table{id}")));
+        tables.push(thesis_table(id));
+    }
+    tables.push(speed_ups(measured, cfg).named("speedup"));
+    tables.push(spread_table(measured));
+    Report { name: "inclusion".into(), environment, tables }
+}
+
+/// Table 4-4: each TetraGrid resolution's build time and memory.
+fn table_4_4(measured: &[Measured], cfg: &Config) -> Table {
     let mut cols = vec!["model".to_string(), "vertices".into(), "tetrahedra".into()];
-    for n in res {
+    for n in &cfg.resolutions {
         cols.push(format!("{n}³ s"));
         cols.push(format!("{n}³ KiB"));
     }
@@ -439,9 +462,13 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         }
         t44.row(row);
     }
+    t44
+}
 
+/// Table 4-5: the CPU test without an optimizer and with each TetraGrid resolution.
+fn table_4_5(measured: &[Measured], cfg: &Config) -> Table {
     let mut cols = vec!["model".to_string(), "faces".into(), "no optimizer".into()];
-    cols.extend(res.iter().map(|n| format!("TetraGrid {n}³")));
+    cols.extend(cfg.resolutions.iter().map(|n| format!("TetraGrid {n}³")));
     let mut t45 = Table {
         title: format!(
             "Table 4-5: Feito-Torres without and with TetraGrid, s per set of {} points",
@@ -455,7 +482,11 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         row.extend(m.grid_times.iter().map(|t| secs(t.mean())));
         t45.row(row);
     }
+    t45
+}
 
+/// Table 4-6: the versions of the Feito-Torres test.
+fn table_4_6(measured: &[Measured], cfg: &Config) -> Table {
     let mut t46 = Table::new(
         format!("Table 4-6: versions of Feito-Torres, s per set of {} points", cfg.points),
         &[
@@ -483,7 +514,11 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
             m.time("gpu+tetragrid"),
         ]);
     }
+    t46
+}
 
+/// Tables 4-7 and 4-8: each method's index, its memory and its build time.
+fn index_tables(measured: &[Measured]) -> (Table, Table) {
     let pre = ["octants", "tetragrid", "bvh", "jordan-octree"];
     let mut t47 = Table::new(
         "Table 4-7: memory of each method's index (KiB; BVH stands where the thesis had BSP)",
@@ -518,7 +553,11 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         t47.row(mem);
         t48.row(time);
     }
+    (t47, t48)
+}
 
+/// Table 4-9: the inclusion tests of both families.
+fn table_4_9(measured: &[Measured], cfg: &Config) -> Table {
     let mut t49 = Table::new(
         format!("Table 4-9: inclusion tests, s per set of {} points", cfg.points),
         &[
@@ -544,7 +583,11 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
             m.time("jordan-octree"),
         ]);
     }
+    t49
+}
 
+/// The speed-up of every method over the CPU test, with what was measured and how.
+fn speed_ups(measured: &[Measured], cfg: &Config) -> Table {
     let mut speed = Table::new(
         "Speed-up over the single-thread exact CPU test (`cpu`), from the means above (×)",
         &[
@@ -596,12 +639,39 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         crate::inclusion::solver::GPU_BATCH,
         crate::inclusion::solver::GPU_GRID_BATCH
     ));
+    speed
+}
 
-    let mut tables = Vec::new();
-    for (id, today) in [("4-4", t44), ("4-5", t45), ("4-6", t46), ("4-7", t47), ("4-8", t48), ("4-9", t49)] {
-        tables.push(today.named(&format!("table{id}")));
-        tables.push(thesis_table(id));
+/// The spread of the sets' times beside the means of Tables 4-5, 4-6 and 4-9.
+fn spread_table(measured: &[Measured]) -> Table {
+    let timed = [
+        "cpu",
+        "cpu+gpu",
+        "gpu",
+        "gpu-batch-1",
+        "octants",
+        "tetragrid",
+        "gpu+tetragrid",
+        "bvh",
+        "jordan",
+        "jordan-octree",
+    ];
+    let mut columns = vec!["model".to_string()];
+    columns.extend(timed.iter().map(|m| format!("{m} ± %")));
+    let mut spread = Table {
+        title: "Spread of the sets' times: half their range as a share of the mean shown above (± %)".into(),
+        columns,
+        ..Default::default()
     }
-    tables.push(speed.named("speedup"));
-    Report { name: "inclusion".into(), environment, tables }
+    .named("spread");
+    for m in measured {
+        let mut row = vec![label(m)];
+        row.extend(timed.iter().map(|k| {
+            m.samples(k)
+                .and_then(|s| s.spread_percent(s.mean()))
+                .map_or_else(|| "–".to_string(), |p| crate::report::sig(p, 2))
+        }));
+        spread.row(row);
+    }
+    spread
 }

@@ -199,6 +199,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
             "N",
             "method",
             "total ms",
+            "total spread ± %",
             "excl. prepare ms",
             "prepare ms",
             "draw ms",
@@ -238,7 +239,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
                 Err(why) => {
                     let mut row =
                         vec![model.clone(), m.triangles.to_string(), n.to_string(), m.method.to_string()];
-                    row.extend((0..11).map(|_| "–".to_string()));
+                    row.extend((0..12).map(|_| "–".to_string()));
                     row.push(thesis);
                     table.row(row);
                     failures.push(format!("{model} {n}³ {}: {why}", m.method));
@@ -254,6 +255,7 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
                 n.to_string(),
                 m.method.to_string(),
                 ms(total),
+                r.times.total.spread_cell(),
                 ms(total.saturating_sub(prepare)),
                 ms(prepare),
                 ms(r.times.draw.median()),
@@ -296,7 +298,8 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
         table.note(format!("not measured on this device: {f}"));
     }
     table.note(format!(
-        "{} timed runs after one warm-up; medians. total = wall time of one voxelization from the \
+        "{} timed runs after one warm-up; medians; total spread: half the range of the runs' totals as a share \
+         of their median. total = wall time of one voxelization from the \
          mesh's covering to the finished bit volume, including the CPU preparation (sorting tetras, \
          display lists / zone copies, per-slice triangles for fgpu and fang), which the thesis left out \
          (\"excl. prepare\" is the thesis' convention). draw and copy are GPU timestamps around the render \
