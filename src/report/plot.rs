@@ -89,10 +89,22 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(0x17, 0xbe, 0xcf),
 ];
 
-/// A tick label without trailing zeros: 1, 10, 0.1, 2.5e-5.
+/// A tick label without trailing zeros: 1, 10, 0.1, 2.5e-5; thousands grouped by thin
+/// spaces (10 000, 1 000 000) so a log axis reads alike from end to end.
 fn label(v: f64) -> String {
-    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e9) {
         return format!("{v:.0e}");
+    }
+    if v.abs() >= 1e4 && v.fract() == 0.0 {
+        let digits = format!("{:.0}", v.abs());
+        let mut grouped = String::new();
+        for (i, c) in digits.chars().enumerate() {
+            if i > 0 && (digits.len() - i) % 3 == 0 {
+                grouped.push('\u{2009}');
+            }
+            grouped.push(c);
+        }
+        return if v < 0.0 { format!("-{grouped}") } else { grouped };
     }
     let s = format!("{v:.3}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
@@ -402,5 +414,8 @@ mod tests {
         assert_eq!(label(10.0), "10");
         assert_eq!(label(0.25), "0.25");
         assert_eq!(label(3e-5), "3e-5");
+        assert_eq!(label(1e6), "1\u{2009}000\u{2009}000");
+        assert_eq!(label(10_000.0), "10\u{2009}000");
+        assert_eq!(label(1000.0), "1000");
     }
 }

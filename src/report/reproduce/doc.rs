@@ -51,6 +51,18 @@ fn verdicts() -> impl Iterator<Item = (&'static str, &'static str)> {
     Verdict::WORDS.into_iter().zip(VERDICT_CLASSES)
 }
 
+/// The verdicts as counts read them: "3 hold", "1 does not hold".
+fn counted(n: usize, index: usize) -> String {
+    let word = match (index, n) {
+        (0, 1) => "holds",
+        (0, _) => "hold",
+        (1, 1) => "does not hold",
+        (1, _) => "do not hold",
+        (i, _) => Verdict::WORDS[i.min(3)],
+    };
+    format!("{n} {word}")
+}
+
 /// Whether a cell holds one number (a unit sign after it allowed): such columns are
 /// right-aligned.
 fn numeric(cell: &str) -> bool {
@@ -136,7 +148,7 @@ pub fn to_markdown(blocks: &[Block]) -> String {
             }
             Block::Verdicts(counts) => {
                 let parts: Vec<String> =
-                    counts.iter().zip(verdicts()).map(|(n, (word, _))| format!("**{n}** {word}")).collect();
+                    counts.iter().enumerate().map(|(i, n)| format!("**{}**", counted(*n, i))).collect();
                 let _ = writeln!(s, "Claims: {}.\n", parts.join(" · "));
             }
         }
@@ -288,8 +300,8 @@ pub fn to_html(title: &str, blocks: &[Block], root: &Path) -> Result<String> {
             }
             Block::Verdicts(counts) => {
                 s.push_str("<p class=\"verdicts\">Claims:");
-                for (n, (word, class)) in counts.iter().zip(verdicts()) {
-                    let _ = write!(s, " <span class=\"{class}\"><strong>{n}</strong> {word}</span>");
+                for (i, (n, (_, class))) in counts.iter().zip(verdicts()).enumerate() {
+                    let _ = write!(s, " <span class=\"{class}\">{}</span>", counted(*n, i));
                 }
                 s.push_str("</p>\n");
             }
@@ -336,7 +348,10 @@ mod tests {
         let blocks = [Block::Verdicts([3, 1, 2, 0]), Block::Table { table: t, csv: "csv/t.csv".into() }];
         let md = to_markdown(&blocks);
         assert!(md.contains("|---|---:|---|"), "{md}");
-        assert!(md.contains("Claims: **3** holds · **1** does not hold"), "{md}");
+        assert!(
+            md.contains("Claims: **3 hold** · **1 does not hold** · **2 inconclusive (within noise)**"),
+            "{md}"
+        );
         let html = to_html("t", &blocks, Path::new(".")).unwrap();
         assert!(
             html.contains("<td class=\"n\">0.01234</td>") && html.contains("<th class=\"n\">time (s)</th>")
@@ -344,7 +359,7 @@ mod tests {
         assert!(html.contains("<td class=\"holds\">holds</td>"), "{html}");
         assert!(html.contains("<td class=\"fails\">does not hold</td>"));
         assert!(html.contains("<td class=\"noise\">inconclusive (within noise)</td>"));
-        assert!(html.contains("<span class=\"holds\"><strong>3</strong> holds</span>"));
+        assert!(html.contains("<span class=\"holds\">3 hold</span>"), "{html}");
         assert!(html.contains("<a href=\"csv/t.csv\">csv/t.csv</a>"), "{html}");
     }
 

@@ -11,11 +11,14 @@ use crate::report::{Environment, Table};
 
 const EXP: &str = "inclusion";
 
+/// A chart's subject, its file stem and its methods (key, label).
+type Curves = (&'static str, &'static str, &'static [(&'static str, &'static str)]);
+
 /// The time curves, two charts of methods with their labels (the CPU test on both, as
 /// the yardstick): few enough curves per chart to tell apart.
-const METHODS: [(&str, &str, &[(&str, &str)]); 2] = [
+const METHODS: [Curves; 2] = [
     (
-        "Feito-Torres on the GPU and with TetraGrid",
+        "the GPU and TetraGrid",
         "inclusion-time-vs-triangles",
         &[
             ("cpu", "Feito-Torres CPU"),
@@ -25,7 +28,7 @@ const METHODS: [(&str, &str, &[(&str, &str)]); 2] = [
         ],
     ),
     (
-        "other indexes and Jordan's test",
+        "octants and Jordan",
         "inclusion-time-indexes",
         &[
             ("cpu", "Feito-Torres CPU"),
@@ -198,9 +201,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             series.extend(both(label, i, curve(r.facts, EXP, &k), curve(r.thesis, EXP, &k)));
         }
         let chart = Chart {
-            title: format!(
-                "Point in solid, {what}: time per set of points against triangles (Figs. 4-7, 4-10)"
-            ),
+            title: format!("Point in solid, {what}: time against triangles (Figs. 4-7, 4-10)"),
             x_label: "triangles".into(),
             y_label: format!("s per set of {} points", cfg.points),
             x_log: true,
