@@ -167,9 +167,10 @@ fn claims_side_by_side(s: &mut String, a: &[ClaimRow], b: &[ClaimRow]) {
             cell(&y.verdict)
         );
     }
-    let count = |rows: &[ClaimRow], v: &str| rows.iter().filter(|c| c.verdict == v).count();
     let counts = |rows: &[ClaimRow]| {
-        super::Verdict::WORDS.iter().map(|v| format!("{} {v}", count(rows, v))).collect::<Vec<_>>().join(", ")
+        let count = |v: &str| rows.iter().filter(|c| c.verdict == v).count();
+        let words = super::Verdict::WORDS.iter().enumerate();
+        words.map(|(i, v)| super::doc::counted(count(v), i)).collect::<Vec<_>>().join(", ")
     };
     let _ = writeln!(s, "\nold: {}; new: {}.", counts(a), counts(b));
 }

@@ -51,8 +51,9 @@ fn verdicts() -> impl Iterator<Item = (&'static str, &'static str)> {
     Verdict::WORDS.into_iter().zip(VERDICT_CLASSES)
 }
 
-/// The verdicts as counts read them: "3 hold", "1 does not hold".
-fn counted(n: usize, index: usize) -> String {
+/// The verdicts as counts read them: "3 hold", "1 does not hold" (`index` as in
+/// [`Verdict::index`]).
+pub fn counted(n: usize, index: usize) -> String {
     let word = match (index, n) {
         (0, 1) => "holds",
         (0, _) => "hold",
