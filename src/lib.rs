@@ -14,7 +14,7 @@
 //! - [`report`]: benchmarks and the reproduction report; [`sweep`]: one task over a mesh
 //!   collection; [`check`]: every shader and pass against its CPU reference on the device
 //!   at hand (`texgeo check`).
-//! - [`output`]: every file written atomically; [`cache`]: the user's cache folder;
+//! - [`output`]: every file written atomically; [`json`]: the commands' `--json` output; [`cache`]: the user's cache folder;
 //!   [`scratch`]: private temporary folders for helper processes; [`host`]: the machine
 //!   texgeo runs on; [`random`]: seeded random numbers; [`terminal`]: every message for a
 //!   person.
@@ -30,6 +30,7 @@ pub mod exact;
 pub mod gpu;
 pub mod host;
 pub mod inclusion;
+pub mod json;
 pub mod mesh;
 pub mod output;
 pub mod random;

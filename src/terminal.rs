@@ -39,9 +39,14 @@ pub fn escape(text: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// Set while a command prints JSON ([`crate::json::text_to_stderr`]): its text lines go
+/// to standard error.
+pub(crate) static TEXT_TO_STDERR: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// Writes one line, escaped, to standard output or standard error; a closed or full
 /// stream loses it. What [`say!`](crate::say) and [`note!`](crate::note) call.
 pub fn print_line(to_stderr: bool, args: std::fmt::Arguments<'_>) {
+    let to_stderr = to_stderr || TEXT_TO_STDERR.load(std::sync::atomic::Ordering::Relaxed);
     let text = args.to_string();
     let text = escape(&text);
     let _ = if to_stderr {

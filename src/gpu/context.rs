@@ -52,8 +52,8 @@ pub struct ContextOptions {
     pub validation: Option<bool>,
 }
 
-/// What `texgeo info` prints and benchmark reports quote.
-#[derive(Clone, Debug)]
+/// What `texgeo info` prints (`--json`: these fields) and benchmark reports quote.
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct DeviceInfo {
     pub index: usize,
     pub name: String,

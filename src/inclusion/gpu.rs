@@ -80,8 +80,8 @@ impl Default for GpuOptions {
     }
 }
 
-/// Where the time of the last `classify_all` went.
-#[derive(Clone, Debug, Default)]
+/// Where the time of the last `classify_all` went (`inclusion --json`: times in ms).
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct GpuStats {
     /// Points sent to the GPU (the rest were decided on the host).
     pub gpu_points: usize,
@@ -89,10 +89,13 @@ pub struct GpuStats {
     pub flagged: usize,
     pub draws: u32,
     /// Wall time of the GPU submissions (phase 1, phase 2, readback).
+    #[serde(rename = "gpu_ms", serialize_with = "crate::json::ms")]
     pub gpu: Duration,
     /// Host-side phase 2 (`Phase2::Host`) and decoding.
+    #[serde(rename = "host_ms", serialize_with = "crate::json::ms")]
     pub host: Duration,
     /// Exact CPU answers for flagged points.
+    #[serde(rename = "fallback_ms", serialize_with = "crate::json::ms")]
     pub fallback: Duration,
 }
 

@@ -514,7 +514,9 @@ pub fn write_classes(out: &mut impl Write, classes: &[super::classifier::Class])
     out.flush()
 }
 
-fn write_npy_header(out: &mut impl Write, descr: &str, shape: &str) -> std::io::Result<()> {
+/// The header of a version 1 `.npy` file of `descr` elements in C order (also what
+/// [`crate::voxel::npy`] writes its volumes with).
+pub fn write_npy_header(out: &mut impl Write, descr: &str, shape: &str) -> std::io::Result<()> {
     let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
     // Magic (6) + version (2) + length (2) + header + newline: a multiple of 64 bytes.
     while (10 + header.len() + 1) % 64 != 0 {

@@ -32,6 +32,34 @@ use crate::mesh::covering::Covering;
 pub const GPU_BATCH: u32 = super::gpu::DEFAULT_BATCH;
 pub const GPU_GRID_BATCH: u32 = super::gpu_grid::DEFAULT_BATCH;
 
+/// What `texgeo inclusion --json` prints: the counts of each class, the method and where
+/// the time went (milliseconds).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Summary {
+    pub points: usize,
+    pub inside: usize,
+    pub outside: usize,
+    pub boundary: usize,
+    /// The method as the CLI spells it.
+    pub method: String,
+    /// What `--method auto` chose and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub auto: Option<String>,
+    #[serde(rename = "build_ms", serialize_with = "crate::json::ms")]
+    pub build: std::time::Duration,
+    /// Heap bytes of the method's structures.
+    pub structure_bytes: usize,
+    /// Reading and classifying the points.
+    #[serde(rename = "classify_ms", serialize_with = "crate::json::ms")]
+    pub classify: std::time::Duration,
+    /// The GPU methods' counts and times.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu: Option<GpuStats>,
+    /// The device's label, for the GPU methods.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
+}
+
 /// Any inclusion method, ready to classify points.
 pub enum Solver {
     Cpu(Box<dyn Classifier>),
@@ -65,6 +93,43 @@ pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Optio
         options.voxel_space_resolution = choice.resolution;
     }
     (choice.method, options, Some(choice))
+}
+
+/// Classifies `points`, given in the input's units, against a mesh that
+/// [`require_solid`](crate::mesh::solidity::require_solid) accepted, as `texgeo inclusion`
+/// does: the options from the verdict, `auto` resolved for the number of points, the
+/// points moved into the mesh's frame. `ctx` is called only for a GPU method. Returns
+/// the classes and the name of the method that ran (Python's `Mesh.contains`).
+pub fn classify_accepted(
+    solid: &crate::mesh::solidity::Accepted,
+    points: &[DVec3],
+    method: Method,
+    allow_open: bool,
+    ctx: impl FnOnce() -> std::result::Result<Context, crate::gpu::GpuError>,
+) -> Result<(Vec<Class>, String)> {
+    if solid.non_solid.is_some() && !method.is_cpu() {
+        return Err(InclusionError::NotForNonSolids(method.name()));
+    }
+    let options = Options {
+        points: points.len(),
+        allow_open,
+        non_solid: solid.non_solid.is_some(),
+        known_closed: !matches!(solid.non_solid, Some(crate::mesh::solidity::Defect::Open(_))),
+        ..Options::default()
+    };
+    let (method, options, _) = resolve(method, &solid.mesh, &options);
+    let ctx = if method.is_cpu() { None } else { Some(ctx()?) };
+    let mut solver = Solver::new(method, &solid.mesh, &options, ctx.as_ref(), None)?;
+    let frame = solid.frame;
+    let framed: Vec<DVec3>;
+    let points = if frame.is_identity() {
+        points
+    } else {
+        framed = points.iter().map(|&p| frame.point_in(p)).collect();
+        &framed
+    };
+    let classes = solver.classify_all(points)?;
+    Ok((classes, solver.name().to_string()))
 }
 
 /// Builds the CPU classifier `method` for `mesh` (GPU methods: [`Solver::new`]).

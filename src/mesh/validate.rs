@@ -17,7 +17,7 @@ use super::disjoint_sets::UnionFind;
 ///
 /// Edges are undirected vertex pairs used by at least one face side; a side whose two
 /// ends are the same vertex (a face repeating an index consecutively) is not an edge.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct Report {
     pub vertices: usize,
     pub faces: usize,

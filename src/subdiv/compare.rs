@@ -27,8 +27,9 @@ use crate::mesh::Mesh;
 /// Unmatched vertex marker.
 const NONE: u32 = u32::MAX;
 
-/// The outcome of comparing `mesh` with `reference`.
-#[derive(Clone, Debug, PartialEq)]
+/// The outcome of comparing `mesh` with `reference` (`subdivide --validate --json`: these
+/// fields).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Comparison {
     /// Vertex counts of mesh and reference.
     pub vertices: [usize; 2],
@@ -56,7 +57,8 @@ pub struct Comparison {
 }
 
 /// How [`Comparison`] put the vertices in correspondence (see the module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Matching {
     SameOrder,
     Faces,

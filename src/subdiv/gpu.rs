@@ -155,23 +155,31 @@ pub struct Options {
 }
 
 /// Where the time of one GPU subdivision went.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct Times {
     /// CPU levels up to the base level (one or two Catmull-Clark levels).
+    #[serde(rename = "base_ms", serialize_with = "crate::json::ms")]
     pub base: Duration,
     /// Cutting the base level into fragments and writing their texel stream.
+    #[serde(rename = "fragments_ms", serialize_with = "crate::json::ms")]
     pub fragments: Duration,
     /// GPU: copying the base stream into the first target (timestamps).
+    #[serde(rename = "upload_ms", serialize_with = "crate::json::ms")]
     pub upload: Duration,
     /// GPU: each fragment pass (timestamps).
+    #[serde(rename = "passes_ms", serialize_with = "crate::json::ms_list")]
     pub passes: Vec<Duration>,
     /// GPU: copying the last stream into host memory (timestamps).
+    #[serde(rename = "readback_ms", serialize_with = "crate::json::ms")]
     pub readback: Duration,
     /// Wall time of the one submission (staging, upload, passes, readback, waiting).
+    #[serde(rename = "submit_ms", serialize_with = "crate::json::ms")]
     pub submit: Duration,
     /// Discarding support rings and welding the result (CPU).
+    #[serde(rename = "assembly_ms", serialize_with = "crate::json::ms")]
     pub assembly: Duration,
     /// Everything, wall clock.
+    #[serde(rename = "total_ms", serialize_with = "crate::json::ms")]
     pub total: Duration,
 }
 
@@ -181,12 +189,14 @@ impl Times {
     }
 }
 
-/// What one GPU subdivision did.
-#[derive(Debug)]
+/// What one GPU subdivision did (`subdivide --json`: the counts and times, ms).
+#[derive(Debug, serde::Serialize)]
 pub struct Run {
+    #[serde(skip)]
     pub mesh: Mesh,
     /// The refined edges on sharp control edges (creases, boundary, non-manifold edges),
     /// numbered as `mesh`'s vertices: what a renderer draws over the surface.
+    #[serde(skip)]
     pub sharp_edges: Vec<SharpEdge>,
     /// Catmull-Clark levels done on the CPU and by fragment passes on the GPU.
     pub cpu_levels: u32,

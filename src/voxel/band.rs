@@ -39,7 +39,7 @@ pub fn tolerance_gpu(n: usize, sub_pixel_bits: u32) -> f64 {
 }
 
 /// What the fallback did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct BandReport {
     /// τ in voxels.
     pub tolerance: f64,

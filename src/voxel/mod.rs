@@ -38,6 +38,7 @@ mod fang;
 mod fgpu;
 pub mod grid;
 mod layers;
+pub mod npy;
 pub mod pgpu;
 pub mod pictures;
 pub mod raster;
@@ -180,22 +181,73 @@ impl std::fmt::Display for Method {
     }
 }
 
-/// Where the time of one voxelization went.
-#[derive(Clone, Copy, Debug, Default)]
+/// Where the time of one voxelization went (`voxelize --json`: in ms).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct Timings {
     /// CPU work before drawing: tetras, vertex buffers, zones, slab pieces.
+    #[serde(rename = "prepare_ms", serialize_with = "crate::json::ms")]
     pub prepare: Duration,
     /// Rasterization: GPU time of the draws (timestamps), or the CPU rasterizer.
+    #[serde(rename = "draw_ms", serialize_with = "crate::json::ms")]
     pub draw: Duration,
     /// GPU time of the image-to-buffer copies.
+    #[serde(rename = "copy_ms", serialize_with = "crate::json::ms")]
     pub copy: Duration,
     /// Host side of the readback: bits moved from the 32-slices-per-texel layers into
     /// the volume.
+    #[serde(rename = "readback_ms", serialize_with = "crate::json::ms")]
     pub readback: Duration,
     /// Finding the centres near the surface and classifying them exactly.
+    #[serde(rename = "fallback_ms", serialize_with = "crate::json::ms")]
     pub fallback: Duration,
     /// Wall time of the whole call.
+    #[serde(rename = "total_ms", serialize_with = "crate::json::ms")]
     pub total: Duration,
+}
+
+/// What `texgeo voxelize --json` prints.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Summary {
+    /// Voxels per side.
+    pub resolution: usize,
+    pub occupied: u64,
+    /// The method as the CLI spells it (`fast-winding` for a mesh taken by `--allow-open`).
+    pub method: String,
+    /// The grid: voxel (i, j, k)'s centre is `origin + (i + ½, j + ½, k + ½) · pitch`.
+    pub origin: [f64; 3],
+    pub pitch: f64,
+    pub timings: Timings,
+    /// The exact fallback near the surface (GPU methods).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_fallback: Option<BandReport>,
+    /// The written file.
+    pub output: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
+}
+
+impl Summary {
+    /// A summary of `occupied` voxels on `grid` by `method`; the rest as given.
+    pub fn new(
+        grid: &Grid,
+        occupied: u64,
+        method: &str,
+        timings: Timings,
+        output: &std::path::Path,
+    ) -> Summary {
+        let (origin, side) = grid.cube_out();
+        Summary {
+            resolution: grid.n,
+            occupied,
+            method: method.to_string(),
+            origin: origin.to_array(),
+            pitch: side / grid.n as f64,
+            timings,
+            exact_fallback: None,
+            output: output.display().to_string(),
+            device: None,
+        }
+    }
 }
 
 /// The result of one voxelization.
@@ -205,6 +257,60 @@ pub struct Voxelization {
     pub volume: Volume,
     pub band: BandReport,
     pub timings: Timings,
+}
+
+/// Voxelizes `n`³ voxels of a mesh that
+/// [`require_solid`](crate::mesh::solidity::require_solid) accepted, as `texgeo voxelize`
+/// does: a mesh taken under allow-open by its generalized winding number on the CPU, a
+/// solid by `choice` (`auto`: the fastest by the cost models, opening the device with
+/// `ctx` only when a GPU method might win). Returns the grid, the volume and the name of
+/// the method that ran (Python's `Mesh.voxelize`).
+pub fn voxelize_accepted(
+    accepted: &crate::mesh::solidity::Accepted,
+    n: usize,
+    choice: Choice,
+    ctx: impl FnOnce() -> Result<Context>,
+) -> Result<(Grid, Volume, String)> {
+    let grid = Grid::for_mesh(&accepted.mesh, n)?.in_frame(accepted.frame);
+    if accepted.non_solid.is_some() {
+        if let Choice::Method(m) = choice {
+            if m.uses_gpu() {
+                return Err(VoxelError::Usage(format!(
+                    "method {m} voxelizes solids only; a mesh that is not a solid is voxelized by its \
+                     generalized winding number on the CPU (auto, cpu or scanline)"
+                )));
+            }
+        }
+        let winding = crate::inclusion::fast_winding::FastWinding::for_voxels(&accepted.mesh)
+            .map_err(|e| VoxelError::Mesh(e.to_string()))?;
+        return Ok((grid, winding.voxelize(&grid)?, "fast-winding".to_string()));
+    }
+    let solid = Solid::new(&accepted.mesh)?;
+    let mut ctx = Some(ctx);
+    let mut open = || ctx.take().map_or_else(|| Err(VoxelError::Usage("no device".into())), |f| f());
+    let mut opened = None;
+    let method = match choice {
+        Choice::Method(m) => m,
+        Choice::Auto => {
+            let counts = auto::Counts::new(&solid, &grid);
+            let threads = rayon::current_num_threads();
+            let mut plan = auto::Plan::choose(counts, auto::Device::Gpu, threads);
+            if plan.method.uses_gpu() {
+                let c = open()?;
+                let kind = if c.info().kind == "cpu" { auto::Device::Cpu } else { auto::Device::Gpu };
+                plan = auto::Plan::choose(counts, kind, threads);
+                opened = Some(c);
+            }
+            plan.method
+        }
+    };
+    let ctx = match opened {
+        Some(c) => Some(c),
+        None if method.uses_gpu() => Some(open()?),
+        None => None,
+    };
+    let result = Voxelizer::new(ctx).run(&solid, &grid, method)?;
+    Ok((grid, result.volume, method.name().to_string()))
 }
 
 /// Runs methods, keeping GPU pipelines alive between runs (a benchmark runs many).

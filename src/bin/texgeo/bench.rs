@@ -23,7 +23,7 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = vec![2, 4, 8, 16, 32, 64])]
         resolutions: Vec<usize>,
         /// Folder for the Markdown and CSV files.
-        #[arg(long, short, default_value = "out/bench")]
+        #[arg(short, long = "output", alias = "out", value_name = "DIR", default_value = "out/bench")]
         out: PathBuf,
     },
     /// Voxelization: the thesis' Table 5-2 (64³ … 512³, every method), time split and ratios.
@@ -43,7 +43,7 @@ pub enum Command {
         #[arg(long, default_value_t = 3, value_parser = crate::args::positive_usize)]
         runs: usize,
         /// Folder for the Markdown and CSV files.
-        #[arg(long, short, default_value = "out/bench")]
+        #[arg(short, long = "output", alias = "out", value_name = "DIR", default_value = "out/bench")]
         out: PathBuf,
     },
     /// Booleans: the thesis' Table 6-1 (phases, plain vs grouped, CPU vs GPU point tests,
@@ -101,7 +101,7 @@ pub enum Command {
         /// Timed runs per measurement (the median is reported).
         runs: usize,
         /// Folder for the Markdown and CSV files.
-        #[arg(long, short, default_value = "out/bench")]
+        #[arg(short, long = "output", alias = "out", value_name = "DIR", default_value = "out/bench")]
         out: PathBuf,
     },
     /// XOR rasterization (logic op) of random triangles against the CPU scanline rasterizer.
@@ -198,7 +198,7 @@ pub struct Common {
     #[arg(long, default_value_t = 5, value_parser = crate::args::positive_usize)]
     runs: usize,
     /// Folder for the Markdown and CSV files.
-    #[arg(long, short, default_value = "out/bench")]
+    #[arg(short, long = "output", alias = "out", value_name = "DIR", default_value = "out/bench")]
     out: PathBuf,
 }
 

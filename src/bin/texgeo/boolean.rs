@@ -79,6 +79,10 @@ pub struct Evaluate {
     /// (of each operation, for several).
     #[arg(long)]
     stats: bool,
+    /// Print one JSON object on stdout (each result's triangles, volume and file; with
+    /// --stats the counts and times, in ms); the text lines go to stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 impl Evaluate {
@@ -161,6 +165,51 @@ fn evaluation_lines(a: &str, b: &str, ev: &Evaluation) -> [String; 3] {
     ]
 }
 
+/// The `--stats --json` object of one evaluation of A against B, before its times.
+fn evaluation_json(a: &str, b: &str, ev: &Evaluation) -> serde_json::Value {
+    let r = &ev.refinement.stats;
+    let c = &ev.classification.stats;
+    serde_json::json!({
+        "a": { "name": a, "triangles": ev.a.triangles.len() },
+        "b": { "name": b, "triangles": ev.b.triangles.len() },
+        "refinement": {
+            "candidate_pairs": r.candidate_pairs,
+            "meeting_pairs": r.meeting_pairs,
+            "coplanar_pairs": r.coplanar_pairs,
+            "new_points": r.new_points,
+            "merged_points": r.merged_points,
+            "cut_a": r.cut_a,
+            "cut_b": r.cut_b,
+            "refined_a": ev.refinement.a.triangles.len(),
+            "refined_b": ev.refinement.b.triangles.len(),
+        },
+        "classification": {
+            "method": ev.method.to_string(),
+            "triangles": c.triangles,
+            "on": c.on,
+            "groups": c.groups,
+            "point_tests": c.point_tests,
+            "saved_share": c.saved_share(),
+            "exact_fallbacks": c.exact_fallbacks,
+        },
+    })
+}
+
+/// What rounding the result to f64 did, for `--stats --json`.
+fn repair_json(r: &boolean::Repair) -> serde_json::Value {
+    serde_json::json!({
+        "tested": r.tested,
+        "crossings": r.crossings,
+        "flat_triangles": r.flat_triangles,
+        "collapsed_edges": r.collapsed_edges,
+        "removed_triangles": r.removed_triangles,
+        "pockets": r.pockets,
+        "pocket_triangles": r.pocket_triangles,
+        "dropped_shells": r.dropped_shells,
+        "moved": r.moved,
+    })
+}
+
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
@@ -180,6 +229,9 @@ pub fn run_expression(
     evaluate: &Evaluate,
     title: &str,
 ) -> anyhow::Result<()> {
+    if evaluate.json {
+        texgeo::json::text_to_stderr();
+    }
     let total = Instant::now();
     let read = Instant::now();
     let meshes: Vec<anyhow::Result<Mesh>> =
@@ -192,12 +244,28 @@ pub fn run_expression(
 
     let ctx = if evaluate.method.is_cpu() { None } else { Some(crate::open_context(device)?) };
     let mut lines = Vec::new();
+    let mut steps_json = Vec::new();
     let steps = expr.operations();
     let result = expr::evaluate(expr, &named, &evaluate.options(), ctx.as_ref(), |s| {
         if !evaluate.stats {
             return;
         }
         let t = &s.evaluation.timings;
+        if evaluate.json {
+            let mut step = evaluation_json(s.names.a, s.names.b, s.evaluation);
+            step["expr"] = s.expr.to_string().into();
+            step["op"] = s.op.name().into();
+            step["triangles"] = s.result.num_faces().into();
+            step["repair"] = repair_json(&s.repair);
+            step["time"] = serde_json::json!({
+                "check_ms": ms(t.check),
+                "refine_ms": ms(t.refine),
+                "classifiers_ms": ms(t.classifiers),
+                "classify_ms": ms(t.classify),
+                "assemble_ms": ms(s.assemble),
+            });
+            steps_json.push(step);
+        }
         lines.push(format!(
             "step {}/{steps}: {} {} {} = {}: {} triangles",
             s.index,
@@ -223,6 +291,25 @@ pub fn run_expression(
     write_mesh(output, &result)?;
     let write = write.elapsed();
     say!("{title}: {} triangles, volume {} -> {}", result.num_faces(), volume(&result), output.display());
+    if evaluate.json {
+        let mut object = serde_json::json!({
+            "expr": title,
+            "triangles": result.num_faces(),
+            "volume": volume(&result),
+            "output": output.display().to_string(),
+        });
+        if evaluate.stats {
+            object["steps"] = steps_json.into();
+            object["time"] = serde_json::json!({
+                "read_ms": ms(read),
+                "operations_ms": ms(booleans),
+                "write_ms": ms(write),
+                "total_ms": ms(total.elapsed()),
+            });
+            object["device"] = ctx.as_ref().map(|c| c.info().label()).into();
+        }
+        texgeo::json::print(&object);
+    }
     if evaluate.stats {
         for l in &lines {
             say!("{l}");
@@ -281,6 +368,9 @@ fn run_many(device: Option<&str>, args: Args) -> anyhow::Result<()> {
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if args.operands.len() > 2 {
         return run_many(device, args);
+    }
+    if args.evaluate.json {
+        texgeo::json::text_to_stderr();
     }
     let total = Instant::now();
     // Everything a user can get wrong is checked before any work.
@@ -359,6 +449,41 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             volume(mesh),
             path.display()
         );
+    }
+    if args.evaluate.json {
+        let operations: Vec<serde_json::Value> = results
+            .iter()
+            .map(|(op, path, out)| {
+                let mut o = serde_json::json!({
+                    "op": op.name(),
+                    "regularized": regularized,
+                    "triangles": out.mesh.num_faces(),
+                    "volume": volume(&out.mesh),
+                    "output": path.display().to_string(),
+                });
+                if args.evaluate.stats && regularized {
+                    o["repair"] = repair_json(&out.repair);
+                }
+                o
+            })
+            .collect();
+        let mut object = serde_json::json!({ "operations": operations });
+        if args.evaluate.stats {
+            let t = &ev.timings;
+            object["stats"] = evaluation_json(&a_name, &b_name, &ev);
+            object["time"] = serde_json::json!({
+                "read_ms": ms(read),
+                "check_ms": ms(t.check),
+                "refine_ms": ms(t.refine),
+                "classifiers_ms": ms(t.classifiers),
+                "classify_ms": ms(t.classify),
+                "assemble_ms": ms(assemble),
+                "write_ms": ms(write),
+                "total_ms": ms(total.elapsed()),
+            });
+            object["device"] = ctx.as_ref().map(|c| c.info().label()).into();
+        }
+        texgeo::json::print(&object);
     }
     if args.evaluate.stats {
         let t = &ev.timings;

@@ -11,7 +11,7 @@ use texgeo::voxel;
 #[derive(clap::Args)]
 pub struct Args {
     /// Folder for pictures and outputs.
-    #[arg(long, short, default_value = "out/demo")]
+    #[arg(short, long = "output", alias = "out", value_name = "DIR", default_value = "out/demo")]
     out: PathBuf,
 }
 

@@ -49,6 +49,9 @@ pub struct Args {
     /// of those values.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Print one JSON object: the counts, the method, its times (ms) and the GPU's.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Extensions of `-o`: text, or NumPy.
@@ -124,6 +127,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     };
     let t = Instant::now();
     let (method, options, choice) = resolve(args.method, &mesh, &options);
+    let auto = choice
+        .as_ref()
+        .map(|c| if solid.non_solid.is_some() { "fast-winding".to_string() } else { c.to_string() });
     match &choice {
         Some(_) if solid.non_solid.is_some() => note!(
             "texgeo: --method auto: the generalized winding number (fast-winding) for {} faces and {} points",
@@ -192,9 +198,27 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             points::write_classes_npy(&mut file, &all).map_err(|e| file.error(e))?;
         }
         file.commit()?;
-        return Ok(());
+        if !args.json {
+            return Ok(());
+        }
     }
     let total: usize = counts.iter().sum();
+    if args.json {
+        texgeo::json::print(&texgeo::inclusion::solver::Summary {
+            points: total,
+            inside: counts[Class::Inside as usize],
+            outside: counts[Class::Outside as usize],
+            boundary: counts[Class::OnBoundary as usize],
+            method: solver.name().to_string(),
+            auto,
+            build,
+            structure_bytes: solver.build_stats().bytes,
+            classify: run,
+            gpu: solver.gpu_stats().map(|_| gpu.clone()),
+            device: ctx.as_ref().filter(|_| solver.gpu_stats().is_some()).map(|c| c.info().label()),
+        });
+        return Ok(());
+    }
     say!(
         "{}: {} points, {} inside, {} outside, {} on the boundary",
         args.mesh,

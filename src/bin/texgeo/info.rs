@@ -7,6 +7,10 @@ pub struct Args {
     /// List every Vulkan device, not only the one texgeo would use.
     #[arg(long)]
     all: bool,
+    /// Print one JSON object instead: `{"device": {…}, "validation": bool}`, or with --all
+    /// `{"devices": [{…}, …]}`.
+    #[arg(long)]
+    json: bool,
 }
 
 fn yes(b: bool) -> &'static str {
@@ -39,6 +43,10 @@ fn print(d: &DeviceInfo) {
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
+    if args.all && args.json {
+        texgeo::json::print(&serde_json::json!({ "devices": list_devices()? }));
+        return Ok(());
+    }
     if args.all {
         for (i, d) in list_devices()?.iter().enumerate() {
             if i > 0 {
@@ -49,6 +57,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let ctx = crate::open_context(device)?;
+    if args.json {
+        texgeo::json::print(&serde_json::json!({ "device": ctx.info(), "validation": ctx.validating() }));
+        return Ok(());
+    }
     print(ctx.info());
     say!(
         "validation layer: {}",

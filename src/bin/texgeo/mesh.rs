@@ -7,6 +7,7 @@ use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::frame::Frame;
 use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
+use texgeo::mesh::stats::Stats;
 use texgeo::mesh::{Mesh, formats, procedural};
 use texgeo::subdiv::Features;
 use texgeo::subdiv::tags::{self, Tagged, TaggedOptions};
@@ -18,6 +19,9 @@ pub enum Command {
     Stats {
         /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
         mesh: MeshArg,
+        /// Print one JSON object instead (the same keys as Python's `Mesh.stats()`).
+        #[arg(long)]
+        json: bool,
     },
     /// Convert between formats (chosen by extension); polygons are triangulated for STL.
     Convert {
@@ -152,19 +156,27 @@ fn allow_open_line(m: &Mesh, defect: &Defect) -> String {
 
 pub fn run(cmd: Command) -> anyhow::Result<()> {
     match cmd {
-        Command::Stats { mesh } => {
+        Command::Stats { mesh, json } => {
             let m = load(&mesh)?;
-            say!("{mesh}");
-            say!("{}", m.report());
+            let report = m.report();
             let solidity = solidity::check(&m);
-            say!("{solidity}");
-            if let Some(d) = solidity.defects.first() {
-                say!("with --allow-open       {}", allow_open_line(&m, d));
+            if !json {
+                say!("{mesh}");
+                say!("{report}");
+                say!("{solidity}");
+                if let Some(d) = solidity.defects.first() {
+                    say!("with --allow-open       {}", allow_open_line(&m, d));
+                }
             }
             if let Some(Defect::Overflow { .. }) = solidity.defects.first() {
                 anyhow::bail!("{mesh}: cannot measure it: {}", solidity.defects[0]);
             }
-            print_measures(&m, &solidity);
+            let stats = Stats::new(&m, report, &solidity);
+            if json {
+                texgeo::json::print(&stats);
+            } else {
+                print_measures(&m, &stats);
+            }
             Ok(())
         }
         Command::Convert { input, output } => {
@@ -187,29 +199,27 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
 }
 
 /// Volume, area and centroids from the simplicial covering (SPEC §2).
-fn print_measures(m: &Mesh, solidity: &solidity::Solidity) {
-    // Measured in the mesh's frame (scale-free), reported in its units.
-    let frame = Frame::of(&[m]);
-    let c = Covering::new(&frame.mesh_in_ref(m));
-    let (lo, hi) = m.bounds();
-    say!("bounding box           {lo} .. {hi}");
-    // + 0.0: an empty sum is −0.
-    say!("area                   {}", solidity.area + 0.0);
-    match solidity.volume.map(|v| v + 0.0) {
+fn print_measures(m: &Mesh, stats: &Stats) {
+    let v3 = |a: [f64; 3]| glam::DVec3::from_array(a);
+    say!("bounding box           {} .. {}", v3(stats.bbox[0]), v3(stats.bbox[1]));
+    say!("area                   {}", stats.area);
+    match stats.volume {
         Some(v) => {
             say!("volume                 {v} (signed tetrahedra, Alg. 3-1)");
-            if let Some(g) = c.centroid() {
-                say!("centroid               {} (volume)", frame.point_out(g));
+            if let Some(g) = stats.centroid {
+                say!("centroid               {} (volume)", v3(g));
             }
         }
         None => {
+            let frame = Frame::of(&[m]);
+            let c = Covering::new(&frame.mesh_in_ref(m));
             let why = c.unbalanced_edge().map(|e| e.to_string()).unwrap_or_default();
             say!(
                 "volume                 undefined: the surface is not closed and consistently oriented ({why})"
             )
         }
     }
-    if let Some(g) = c.face_weighted_centroid() {
-        say!("centroid               {} (face vertices, thesis §3.6.1)", frame.point_out(g));
+    if let Some(g) = stats.face_centroid {
+        say!("centroid               {} (face vertices, thesis §3.6.1)", v3(g));
     }
 }

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Output folder: report.md, report.html, csv/, plots/, figures/, run.json.
-    #[arg(short = 'o', long = "out", value_name = "DIR", required_unless_present = "compare")]
+    #[arg(short, long = "output", alias = "out", value_name = "DIR", required_unless_present = "compare")]
     out: Option<PathBuf>,
     /// Compare two report folders (two devices, or two runs): every claim's verdict on
     /// both side by side, the GPU's speed-ups over the CPU on both beside the thesis',

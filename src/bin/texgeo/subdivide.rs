@@ -83,6 +83,10 @@ pub struct Args {
     /// (1e-5 × bounding-box diagonal for the GPU, 1e-12 for the CPU).
     #[arg(long)]
     validate: bool,
+    /// Print one JSON object on stdout (counts, features, times in ms, the GPU run and the
+    /// --validate comparison); the text lines go to stderr.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Relative tolerances of `--validate` (SPEC §5.1, §5.4).
@@ -225,6 +229,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         formats::Format::from_path(out)?;
         texgeo::output::check_output(out, &crate::mesh::MeshArg::files([&args.input]))?;
     }
+    if args.json {
+        texgeo::json::text_to_stderr();
+    }
     let tagged = crate::mesh::load_tagged(&args.input)?;
     for ignored in &tagged.ignored {
         say!("{}:{}: tag '{}' ignored: {}", args.input, ignored.line, ignored.name, ignored.why);
@@ -262,6 +269,8 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     check_size(mesh, args.level, args.method, args.output.as_deref())?;
     say!("{}: {} vertices, {} faces", args.input, mesh.num_vertices(), mesh.num_faces());
     describe_features(&surface);
+    let start = Instant::now();
+    let mut gpu_run = None;
     let refined = match args.method {
         Method::Gpu => {
             let ctx = crate::open_context_for(device, "cpu")?;
@@ -271,6 +280,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                 .refine_surface(&ctx, &surface, args.level, &Options::default())
                 .map_err(explain)?;
             describe_gpu(&run);
+            gpu_run = Some(serde_json::to_value(&run)?);
             run.mesh
         }
         Method::Cpu => {
@@ -286,25 +296,59 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         formats::write(out, &refined)?;
         say!("wrote {} in {:.1} ms", out.display(), ms(t.elapsed()));
     }
-    if args.validate && !validate(&surface, &refined, args.level, args.method)? {
+    let time = start.elapsed();
+    let comparison =
+        if args.validate { Some(validate(&surface, &refined, args.level, args.method)?) } else { None };
+    if args.json {
+        let f = &surface.features;
+        texgeo::json::print(&serde_json::json!({
+            "input": args.input.to_string(),
+            "vertices": mesh.num_vertices(),
+            "faces": mesh.num_faces(),
+            "level": args.level,
+            "method": if args.method == Method::Gpu { "gpu" } else { "cpu" },
+            "features": {
+                "creases": f.creases.len(),
+                "infinite_creases": f.creases.iter().filter(|c| crease::is_infinite(c.sharpness)).count(),
+                "corners": f.corners.len(),
+                "holes": f.holes.len(),
+            },
+            "refined_vertices": refined.num_vertices(),
+            "refined_faces": refined.num_faces(),
+            "time_ms": ms(time),
+            "gpu": gpu_run,
+            "output": args.output.as_ref().map(|p| p.display().to_string()),
+            "validation": comparison.as_ref().map(|(c, tolerance)| serde_json::json!({
+                "passed": c.is_match(),
+                "tolerance": tolerance,
+                "comparison": c,
+            })),
+        }));
+    }
+    if comparison.is_some_and(|(c, _)| !c.is_match()) {
         std::process::exit(1);
     }
     Ok(())
 }
 
 /// Compares with OpenSubdiv; prints the comparison and whether it is within tolerance.
-fn validate(surface: &Surface, refined: &Mesh, level: u32, method: Method) -> anyhow::Result<bool> {
+/// Returns it and the relative tolerance.
+fn validate(
+    surface: &Surface,
+    refined: &Mesh,
+    level: u32,
+    method: Method,
+) -> anyhow::Result<(Comparison, f64)> {
     let start = Instant::now();
     let reference = osd::refine_surface(surface, level)?;
     let tolerance = if method == Method::Gpu { GPU_TOLERANCE } else { CPU_TOLERANCE };
     let c = Comparison::new(refined, &reference, tolerance);
     say!("OpenSubdiv ({:.1} ms incl. files): {c}", ms(start.elapsed()));
-    let ok = c.is_match();
     say!(
         "validation {}: tolerance {tolerance:e} × bounding-box diagonal",
-        if ok { "passed" } else { "FAILED" }
+        if c.is_match() { "passed" } else { "FAILED" }
     );
-    Ok(ok)
+    Ok((c, tolerance))
 }
 
 /// Adds what to do about input that cannot be refined.

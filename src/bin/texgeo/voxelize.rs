@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use texgeo::mesh::solidity::Policy;
 use texgeo::voxel::aspect::{self, Aspect, Material};
 use texgeo::voxel::auto::{self as plan, Counts, Plan};
-use texgeo::voxel::{Choice, Grid, Method, Solid, Voxelizer, Zone, binvox, pictures};
+use texgeo::voxel::{Choice, Grid, Method, Solid, Summary, Timings, Voxelizer, Zone, binvox, npy, pictures};
 
 /// Aspect functions (Fig. 5-9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -26,7 +26,8 @@ pub struct Args {
     /// named on stderr), cpu, fgpu, pgpu, zoned, fang or scanline: all give the same voxels.
     #[arg(long, short, default_value_t = Choice::Auto)]
     method: Choice,
-    /// Output .binvox file (written atomically).
+    /// Output file, written atomically: .binvox, or .npy (an N×N×N bool array indexed
+    /// [x, y, z]; the grid — origin, pitch — in a .json file of the same stem beside it).
     #[arg(long, short)]
     output: PathBuf,
     /// Also write one PNG per y slice into this folder.
@@ -57,13 +58,29 @@ pub struct Args {
     /// GPU methods refuse such a mesh). Solids are voxelized as without the flag.
     #[arg(long)]
     allow_open: bool,
+    /// Print one JSON object on stdout (resolution, occupied voxels, method, grid, times in
+    /// ms); the text lines go to stderr.
+    #[arg(long)]
+    json: bool,
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     // Check the request and every output path before touching the mesh or the device.
     texgeo::voxel::grid::check_resolution(args.res)?;
-    texgeo::output::check_extension(&args.output, &["binvox"], "the volume is written as binvox")?;
-    texgeo::output::check_output(&args.output, &crate::mesh::MeshArg::files([&args.mesh]))?;
+    texgeo::output::check_extension(
+        &args.output,
+        &["binvox", "npy"],
+        "the volume is written as binvox or NumPy",
+    )?;
+    let inputs = crate::mesh::MeshArg::files([&args.mesh]);
+    texgeo::output::check_output(&args.output, &inputs)?;
+    let npy = npy::is_npy(&args.output);
+    if npy {
+        texgeo::output::check_output(npy::sidecar(&args.output), &inputs)?;
+    }
+    if args.json {
+        texgeo::json::text_to_stderr();
+    }
     if let Some(dir) = &args.slices {
         texgeo::output::check_dir(dir)?;
     }
@@ -104,11 +121,16 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             volume.count(),
             t.elapsed().as_secs_f64() * 1e3
         );
+        let timings = Timings { total: t.elapsed(), ..Timings::default() };
         let ctx = match args.aspect {
             Some(_) => Some(crate::open_context_for(device, "cpu, without --aspect")?),
             None => None,
         };
-        return write_outputs(&args, &grid, &volume, ctx.as_ref(), aspect_dir.as_deref());
+        write_outputs(&args, &grid, &volume, ctx.as_ref(), aspect_dir.as_deref())?;
+        if args.json {
+            texgeo::json::print(&Summary::new(&grid, volume.count(), "fast-winding", timings, &args.output));
+        }
+        return Ok(());
     }
     let solid = Solid::new(&mesh)?;
     let mut opened = None;
@@ -142,7 +164,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(ctx) = &ctx {
         say!("device: {}", ctx.info().label());
     }
-    if method == Method::Scanline && args.slices.is_none() && args.aspect.is_none() {
+    if method == Method::Scanline && args.slices.is_none() && args.aspect.is_none() && !npy {
         // Only the file is wanted: it is written while the volume is computed, a few x
         // planes in memory at a time instead of N³ bits.
         let t = std::time::Instant::now();
@@ -160,6 +182,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
                 ""
             }
         );
+        if args.json {
+            let timings = Timings { total: t.elapsed(), ..Timings::default() };
+            texgeo::json::print(&Summary::new(&grid, streamed.occupied, "scanline", timings, &args.output));
+        }
         return Ok(());
     }
     let mut voxelizer = Voxelizer::new(ctx.clone());
@@ -188,10 +214,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             result.band.changed
         );
     }
-    write_outputs(&args, &grid, &result.volume, ctx.as_ref(), aspect_dir.as_deref())
+    write_outputs(&args, &grid, &result.volume, ctx.as_ref(), aspect_dir.as_deref())?;
+    if args.json {
+        let mut summary = Summary::new(&grid, result.volume.count(), method.name(), t, &args.output);
+        summary.exact_fallback = (result.band.tolerance > 0.0).then_some(result.band);
+        summary.device = ctx.as_ref().map(|c| c.info().label());
+        texgeo::json::print(&summary);
+    }
+    Ok(())
 }
 
-/// Writes the volume (binvox), and the slices and aspect pictures when asked for.
+/// Writes the volume (binvox or .npy), and the slices and aspect pictures when asked for.
 fn write_outputs(
     args: &Args,
     grid: &Grid,
@@ -201,7 +234,7 @@ fn write_outputs(
 ) -> anyhow::Result<()> {
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
-    binvox::write(&args.output, grid, volume)?;
+    npy::write_by_extension(&args.output, grid, volume)?;
     say!("wrote {} in {:.1} ms", args.output.display(), ms(t.elapsed()));
     if let Some(dir) = &args.slices {
         let files = pictures::write_slices(volume, dir)?;
