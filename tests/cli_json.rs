@@ -238,3 +238,17 @@ fn info_json_names_the_text_device() {
     let all = json(&["info", "--all"]);
     assert!(all["devices"].as_array().unwrap().iter().any(|d| d["name"] == *name), "{all}");
 }
+
+#[test]
+fn every_output_is_spelled_dash_o_or_output() {
+    for cmd in
+        [&["demo"][..], &["reproduce"], &["bench", "reduce"], &["voxelize"], &["inclusion"], &["subdivide"]]
+    {
+        let help = stdout(&run(&[cmd, &["--help"][..]].concat()));
+        assert!(help.contains("-o, --output"), "{cmd:?}: {help}");
+        assert!(!help.contains("--out "), "{cmd:?}: the old spelling is a hidden alias: {help}");
+    }
+    // The old spelling still works.
+    let o = texgeo(&["reproduce", "--out", "/nonexistent-dir/x", "--only", "nothing"]);
+    assert!(!stderr(&o).contains("unexpected argument '--out'"), "{}", stderr(&o));
+}
