@@ -2,27 +2,37 @@
 //! vice versa.
 //!
 //! - **On** (§6.2.2): a piece of a triangle that has coplanar partners in the other mesh
-//!   is on the other surface when its centroid lies inside one of them — an exact 2D
-//!   test in the common plane. The partner's orientation makes it *same* or *opposite*.
+//!   is on the other surface when its three corners lie in one of them (the partner's
+//!   edges are constraints, so a piece is wholly in or out of it) — exact 2D
+//!   orientations of the implicit corners in the common plane, no tolerance. The
+//!   partner's orientation makes it *same* or *opposite*.
 //! - **Groups** (§6.5.1): triangles connected across edges that are not on the cut
-//!   curve lie on the same side of the other solid, so each group is classified by one
-//!   interior point: the centroid of its largest triangle. [`Grouping::Plain`] tests
-//!   every triangle's centroid instead (the thesis' "Nuevo" columns of Table 6-1); a
-//!   sliver whose centroid lies within the method's tolerance of the other surface then
-//!   takes the class its group's other answers give.
+//!   curve lie on the same side of the other solid, so each group is classified once,
+//!   from a probe that needs no rounded intersection point: an input vertex of the
+//!   group off the other surface (an f64 point, tested with the inclusion method), else
+//!   a corner of one of its triangles inside a face of the other mesh, whose side of
+//!   that face's plane — the exact sign of an implicit point — is the group's side
+//!   there. Only a group with neither (none in the tests) falls back to the centroid
+//!   of its largest triangle, counted in [`ClassifyStats::rounded_probes`].
+//!   [`Grouping::Plain`] probes every triangle instead (the thesis' "Nuevo" columns of
+//!   Table 6-1).
 //! - **Point tests** go to the inclusion module through the caller (any method, the GPU
 //!   ones included). A point the method finds *on the boundary* — within its tolerance
 //!   of the other surface, although the piece is not on it (a thin sliver) — is decided
 //!   by an exact ray-parity test on the f64 point ([`exact_parity`]).
 
+use std::sync::OnceLock;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::refine::{Refined, Refinement, Side, edge_key};
-use crate::exact::{orient2d, orient3d};
+use super::intersect::Simplex;
+use super::refine::{Refined, Refinement, Side, edge_key, plane_axes};
+use crate::exact::implicit::{self, Point, orient2d_implicit, orient3d_implicit};
+use crate::exact::orient3d;
 use crate::inclusion;
 use crate::mesh::disjoint_sets::UnionFind;
-use crate::mesh::intersect::{TriangleSoup, segment_meets_triangle, triangle_projection};
+use crate::mesh::intersect::{TriangleSoup, segment_meets_triangle};
 
 /// Where a refined triangle lies relative to the other solid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -58,14 +68,22 @@ pub struct ClassifyStats {
     pub point_tests: usize,
     /// Points the inclusion method put on the boundary, decided by exact ray parity.
     pub exact_fallbacks: usize,
+    /// Groups (or, plain, triangles) decided by the exact side of an implicit corner,
+    /// without a point test.
+    pub local_sides: usize,
+    /// Groups (or triangles) with no exact probe, tested at a rounded centroid.
+    pub rounded_probes: usize,
+    /// Signs on implicit points the filter left to exact arithmetic.
+    pub exact_signs: usize,
 }
 
 impl ClassifyStats {
-    /// Share of point tests saved against one test per triangle off the other surface
-    /// (the thesis' "reducción", §6.6).
+    /// Share of probes (point tests and exact local sides) saved against one per
+    /// triangle off the other surface (the thesis' "reducción", §6.6).
     pub fn saved_share(&self) -> f64 {
         let plain = self.triangles - self.on;
-        if plain == 0 { 0.0 } else { 1.0 - self.point_tests as f64 / plain as f64 }
+        let probes = self.point_tests + self.local_sides;
+        if plain == 0 { 0.0 } else { 1.0 - probes as f64 / plain as f64 }
     }
 }
 
@@ -103,15 +121,11 @@ pub fn classify(
     grouping: Grouping,
     test: &mut PointTest,
 ) -> Result<Classification, ClassifyError> {
+    let exact_before = implicit::exact_signs();
     let mut b_coplanar: Vec<(u32, u32, bool)> = r.coplanar.iter().map(|&(t, u, s)| (u, t, s)).collect();
     b_coplanar.sort_unstable_by_key(|c| (c.0, c.1));
-    let (mut on_a, mut on_b) = rayon::join(
-        || on_status(&r.a, &r.points, a, b, &r.coplanar),
-        || on_status(&r.b, &r.points, b, a, &b_coplanar),
-    );
-    if r.stats.merged_points > 0 {
-        coincident(r, &mut on_a, &mut on_b);
-    }
+    let (on_a, on_b) =
+        rayon::join(|| on_status(r, &r.a, a, b, &r.coplanar), || on_status(r, &r.b, b, a, &b_coplanar));
     let ((groups_a, count_a), (groups_b, count_b)) =
         rayon::join(|| groups(&r.a, &on_a, r), || groups(&r.b, &on_b, r));
 
@@ -125,43 +139,95 @@ pub fn classify(
     for (side, refined, on, (group, count), other) in
         [(Side::A, &r.a, &on_a, (&groups_a, count_a), b), (Side::B, &r.b, &on_b, (&groups_b, count_b), a)]
     {
-        // Grouped: one point per group. Plain: one per off-surface triangle.
-        let tested: Vec<u32> = match grouping {
-            Grouping::Grouped => representatives(refined, &r.points, group, count),
-            Grouping::Plain => {
-                (0..refined.triangles.len() as u32).filter(|&t| on[t as usize].is_none()).collect()
+        // Grouped: one probe per group. Plain: one per off-surface triangle.
+        // The other mesh's triangles by their sorted vertex ids, built when first asked.
+        let by_vertices: OnceLock<Vec<([u32; 3], u32)>> = OnceLock::new();
+        let faces = |s: [u32; 3]| -> Option<u32> {
+            let list = by_vertices.get_or_init(|| {
+                let mut v: Vec<([u32; 3], u32)> = (0..other.triangles.len() as u32)
+                    .map(|u| {
+                        let mut k = other.triangles[u as usize];
+                        k.sort_unstable();
+                        (k, u)
+                    })
+                    .collect();
+                v.par_sort_unstable();
+                v
+            });
+            let i = list.partition_point(|x| x.0 < s);
+            // One triangle over these vertices (two would be coincident faces).
+            match list.get(i..i + 2) {
+                Some([x, y]) if x.0 == s && y.0 == s => None,
+                _ => list.get(i).filter(|x| x.0 == s).map(|x| x.1),
             }
         };
-        let points: Vec<DVec3> = tested.iter().map(|&t| centroid(refined, &r.points, t)).collect();
+        let probes: Vec<(u32, Probe)> = match grouping {
+            Grouping::Grouped => group_probes(r, refined, group, count, other, side, &faces),
+            Grouping::Plain => (0..refined.triangles.len() as u32)
+                .into_par_iter()
+                .with_min_len(1024)
+                .filter(|&t| on[t as usize].is_none())
+                .map(|t| (t, probe(r, refined, t, other, side, &faces).unwrap_or(Probe::Centroid(t))))
+                .collect(),
+        };
+        let mut tested: Vec<u32> = Vec::new();
+        let mut points: Vec<DVec3> = Vec::new();
+        let mut known: Vec<(u32, Class)> = Vec::new();
+        for &(t, p) in &probes {
+            match p {
+                Probe::Vertex(v) => {
+                    tested.push(t);
+                    points.push(r.points[v as usize]);
+                }
+                Probe::Centroid(c) => {
+                    stats.rounded_probes += 1;
+                    tested.push(t);
+                    points.push(centroid(refined, &r.points, c));
+                }
+                Probe::Known(class) => known.push((t, class)),
+            }
+        }
+        stats.local_sides += known.len();
         stats.point_tests += points.len();
         let other_side = if side == Side::A { Side::B } else { Side::A };
-        let answers = test(other_side, &points)?;
+        let answers = if points.is_empty() { Vec::new() } else { test(other_side, &points)? };
         let decisive = |c: &inclusion::Class| match c {
             inclusion::Class::Inside => Some(Class::In),
             inclusion::Class::Outside => Some(Class::Out),
             inclusion::Class::OnBoundary => None,
         };
-        // A group takes the class of its decisive answers (all equal: the group lies on
-        // one side). Plain mode keeps each triangle's own answer where it is decisive.
+        // A group takes the class of its probe (all its triangles lie on one side). Plain
+        // mode keeps each triangle's own answer.
         let mut group_class: Vec<Option<Class>> = vec![None; count];
-        for (&t, c) in tested.iter().zip(&answers) {
-            if let Some(c) = decisive(c) {
-                group_class[group[t as usize] as usize].get_or_insert(c);
-            }
-        }
         let mut own: Vec<Option<Class>> = vec![None; refined.triangles.len()];
-        if grouping == Grouping::Plain {
-            for (&t, c) in tested.iter().zip(&answers) {
-                own[t as usize] = decisive(c);
+        let mut pending_points: Vec<(usize, Option<DVec3>)> = Vec::new();
+        for ((&t, c), &p) in tested.iter().zip(&answers).zip(&points) {
+            let g = group[t as usize] as usize;
+            match decisive(c) {
+                Some(c) => {
+                    group_class[g].get_or_insert(c);
+                    own[t as usize] = Some(c);
+                }
+                None => pending_points.push((g, Some(p))),
             }
         }
-        // A point within the method's tolerance of the other surface (a thin piece):
-        // groups with no decisive answer are decided exactly, trying other triangles.
-        let pending: Vec<usize> = (0..count).filter(|&g| group_class[g].is_none()).collect();
-        stats.exact_fallbacks += answers.iter().filter(|c| decisive(c).is_none()).count();
+        for &(t, c) in &known {
+            group_class[group[t as usize] as usize].get_or_insert(c);
+            own[t as usize] = Some(c);
+        }
+        if grouping == Grouping::Grouped {
+            own.iter_mut().for_each(|o| *o = None);
+        }
+        // A probe within the method's tolerance of the other surface: decided by exact
+        // ray parity, trying the group's other triangles after it.
+        stats.exact_fallbacks += pending_points.len();
+        let mut pending: Vec<(usize, Option<DVec3>)> =
+            pending_points.into_iter().filter(|&(g, _)| group_class[g].is_none()).collect();
+        pending.sort_by_key(|x| x.0);
+        pending.dedup_by_key(|x| x.0);
         if !pending.is_empty() {
             let decided = decide_exactly(refined, &r.points, group, &pending, other, side)?;
-            for (g, c) in pending.into_iter().zip(decided) {
+            for ((g, _), c) in pending.into_iter().zip(decided) {
                 group_class[g] = Some(c);
             }
         }
@@ -171,9 +237,135 @@ pub fn classify(
             .collect();
         classes.push(cls);
     }
+    stats.exact_signs = implicit::exact_signs() - exact_before;
     let b_classes = classes.pop().unwrap_or_default();
     let a_classes = classes.pop().unwrap_or_default();
     Ok(Classification { a: a_classes, b: b_classes, stats })
+}
+
+/// How a group (or a triangle) is classified.
+#[derive(Clone, Copy, Debug)]
+enum Probe {
+    /// By a point test at this input vertex (point id), which lies off the other surface.
+    Vertex(u32),
+    /// Already decided, by the exact side of an implicit corner.
+    Known(Class),
+    /// By a point test at this triangle's rounded centroid (no exact probe found).
+    Centroid(u32),
+}
+
+/// An exact probe of refined triangle `t` of `side` against the other solid `other`: a
+/// corner that is an input vertex off the other surface, or else the triangle's side of
+/// a face u of the other mesh that it touches inside u — at a corner in u's interior, or
+/// along an edge whose ends lie on two different edges of u (or a corner of u and its
+/// opposite edge). Near such a place the other surface is u's plane alone and the
+/// triangle cannot cross it (that crossing would be a cut edge), so the exact side of
+/// its corners off u's plane is its side: behind u (u faces outward) is in.
+/// `faces(s)` finds the other mesh's triangle over the sorted vertex ids `s`.
+fn probe(
+    r: &Refinement,
+    refined: &Refined,
+    t: u32,
+    other: &TriangleSoup,
+    side: Side,
+    faces: &dyn Fn([u32; 3]) -> Option<u32>,
+) -> Option<Probe> {
+    let tri = refined.triangles[t as usize];
+    if let Some(&v) = tri.iter().find(|&&v| v < r.first_new && r.key_of(v).is_none()) {
+        return Some(Probe::Vertex(v));
+    }
+    let simplex = |id: u32| r.key_of(id).map(|key| if side == Side::A { key.b } else { key.a });
+    let sx = tri.map(simplex);
+    let side_of = |u: u32, corners: &[usize]| -> Option<Probe> {
+        let [p, q, s] = other.triangle(u as usize).map(Point::explicit);
+        corners.iter().find_map(|&j| match orient3d_implicit(&p, &q, &s, &r.point(tri[j])) {
+            0 => None,
+            x if x < 0 => Some(Probe::Known(Class::In)),
+            _ => Some(Probe::Known(Class::Out)),
+        })
+    };
+    for k in 0..3 {
+        if let Some(Simplex::Face(u)) = sx[k] {
+            if let Some(p) = side_of(u, &[(k + 1) % 3, (k + 2) % 3]) {
+                return Some(p);
+            }
+        }
+    }
+    let vertices = |s: Simplex| -> Vec<u32> {
+        match s {
+            Simplex::Vertex(v) => vec![v],
+            Simplex::Edge(p, q) => vec![p, q],
+            Simplex::Face(_) => Vec::new(),
+        }
+    };
+    for k in 0..3 {
+        let (Some(x), Some(y)) = (sx[k], sx[(k + 1) % 3]) else { continue };
+        // Two different edges, or a vertex and an edge not through it, span one triangle.
+        let (vx, vy) = (vertices(x), vertices(y));
+        if vx.is_empty() || vy.is_empty() || vx.len() + vy.len() < 3 {
+            continue;
+        }
+        let mut all: Vec<u32> = vx.iter().chain(&vy).copied().collect();
+        all.sort_unstable();
+        all.dedup();
+        let Ok(span) = <[u32; 3]>::try_from(all.as_slice()) else { continue };
+        if vx.iter().all(|v| vy.contains(v)) || vy.iter().all(|v| vx.contains(v)) {
+            continue;
+        }
+        if let Some(p) = faces(span).and_then(|u| side_of(u, &[(k + 2) % 3])) {
+            return Some(p);
+        }
+    }
+    None
+}
+
+/// One probe per off-surface group (the triangle it comes from, and the probe): the
+/// first exact one among its triangles, else its largest triangle's centroid.
+fn group_probes(
+    r: &Refinement,
+    refined: &Refined,
+    group: &[u32],
+    count: usize,
+    other: &TriangleSoup,
+    side: Side,
+    faces: &(dyn Fn([u32; 3]) -> Option<u32> + Sync),
+) -> Vec<(u32, Probe)> {
+    // Triangles by group (counting sort).
+    let mut starts = vec![0u32; count + 1];
+    for &g in group {
+        if (g as usize) < count {
+            starts[g as usize + 1] += 1;
+        }
+    }
+    for g in 0..count {
+        starts[g + 1] += starts[g];
+    }
+    let mut fill = starts.clone();
+    let mut members = vec![0u32; starts[count] as usize];
+    for (t, &g) in group.iter().enumerate() {
+        if (g as usize) < count {
+            members[fill[g as usize] as usize] = t as u32;
+            fill[g as usize] += 1;
+        }
+    }
+    (0..count)
+        .into_par_iter()
+        .map(|g| {
+            let list = &members[starts[g] as usize..starts[g + 1] as usize];
+            list.iter()
+                .find_map(|&t| probe(r, refined, t, other, side, faces).map(|p| (t, p)))
+                .unwrap_or_else(|| {
+                    let largest = list
+                        .iter()
+                        .copied()
+                        .max_by(|&s, &t| {
+                            double_area(refined, &r.points, s).total_cmp(&double_area(refined, &r.points, t))
+                        })
+                        .unwrap_or(0);
+                    (largest, Probe::Centroid(largest))
+                })
+        })
+        .collect()
 }
 
 fn centroid(refined: &Refined, points: &[DVec3], t: u32) -> DVec3 {
@@ -187,10 +379,11 @@ fn double_area(refined: &Refined, points: &[DVec3], t: u32) -> f64 {
 }
 
 /// On-status of every refined triangle of one side: `Some(OnSame | OnOpposite)` when
-/// its centroid lies strictly inside a coplanar triangle of the other mesh.
+/// its three corners lie in a coplanar triangle of the other mesh (exact orientations of
+/// the implicit corners in the plane's axis-aligned projection).
 fn on_status(
+    r: &Refinement,
     refined: &Refined,
-    points: &[DVec3],
     own: &TriangleSoup,
     other: &TriangleSoup,
     coplanar: &[(u32, u32, bool)],
@@ -204,57 +397,23 @@ fn on_status(
         .map(|t| {
             let parent = refined.parent[t as usize];
             let lo = coplanar.partition_point(|c| c.0 < parent);
-            let partners = coplanar[lo..].iter().take_while(|c| c.0 == parent);
-            let [p0, p1, p2] = own.triangle(parent as usize);
-            let proj = triangle_projection(p0, p1, p2)?;
-            let x = proj.apply(centroid(refined, points, t));
+            let mut partners = coplanar[lo..].iter().take_while(|c| c.0 == parent).peekable();
+            partners.peek()?;
+            let axes = plane_axes(own.triangle(parent as usize))?;
+            let corners = refined.triangles[t as usize].map(|id| r.point(id));
             for &(_, u, same) in partners {
-                let tri = other.triangle(u as usize).map(|p| proj.apply(p));
-                let s = orient2d(tri[0], tri[1], tri[2]);
-                if (0..3).all(|k| s * orient2d(tri[k], tri[(k + 1) % 3], x) > 0) {
+                let tri = other.triangle(u as usize).map(Point::explicit);
+                let s = orient2d_implicit(axes, &tri[0], &tri[1], &tri[2]);
+                let within = (0..3).all(|k| {
+                    corners.iter().all(|x| s * orient2d_implicit(axes, &tri[k], &tri[(k + 1) % 3], x) >= 0)
+                });
+                if s != 0 && within {
                     return Some(if same { Class::OnSame } else { Class::OnOpposite });
                 }
             }
             None
         })
         .collect()
-}
-
-/// Pieces of A and B over the same three points are on each other's surface. Without
-/// merged points (`super::snap`) that happens only to coplanar pairs, which
-/// [`on_status`] decides; a merge can collapse a sliver of space between two cut
-/// triangles that are not coplanar, leaving one triangle in both meshes.
-fn coincident(r: &Refinement, on_a: &mut [Option<Class>], on_b: &mut [Option<Class>]) {
-    // (sorted corners, piece, corners rotated to start at the smallest).
-    let pieces = |refined: &Refined| -> Vec<([u32; 3], u32, [u32; 3])> {
-        let mut v: Vec<([u32; 3], u32, [u32; 3])> = (0..refined.triangles.len() as u32)
-            .filter(|&t| refined.cut[refined.parent[t as usize] as usize])
-            .map(|t| {
-                let c = refined.triangles[t as usize];
-                let k = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
-                let mut sorted = c;
-                sorted.sort_unstable();
-                (sorted, t, [c[k], c[(k + 1) % 3], c[(k + 2) % 3]])
-            })
-            .collect();
-        v.sort_unstable();
-        v
-    };
-    let (pa, pb) = (pieces(&r.a), pieces(&r.b));
-    let (mut i, mut j) = (0, 0);
-    while i < pa.len() && j < pb.len() {
-        match pa[i].0.cmp(&pb[j].0) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                let class = if pa[i].2 == pb[j].2 { Class::OnSame } else { Class::OnOpposite };
-                on_a[pa[i].1 as usize].get_or_insert(class);
-                on_b[pb[j].1 as usize].get_or_insert(class);
-                i += 1;
-                j += 1;
-            }
-        }
-    }
 }
 
 /// Group id of every refined triangle (on-triangles get their own groups, which are
@@ -315,33 +474,23 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
     (group, count as usize)
 }
 
-/// One triangle per off-surface group: its largest.
-fn representatives(refined: &Refined, points: &[DVec3], group: &[u32], count: usize) -> Vec<u32> {
-    let mut best = vec![(f64::NEG_INFINITY, 0u32); count];
-    for (t, &g) in group.iter().enumerate() {
-        if (g as usize) < count {
-            let a = double_area(refined, points, t as u32);
-            if a > best[g as usize].0 {
-                best[g as usize] = (a, t as u32);
-            }
-        }
-    }
-    best.into_iter().map(|b| b.1).collect()
-}
-
-/// Decides the groups `pending` by exact ray parity against `other`, trying the
-/// group's triangles from the largest down until one centroid is off the surface.
+/// Decides the groups `pending` (with the point their probe tested) by exact ray parity
+/// against `other`: that point first, then the group's triangles' centroids from the
+/// largest down until one is off the surface.
 fn decide_exactly(
     refined: &Refined,
     points: &[DVec3],
     group: &[u32],
-    pending: &[usize],
+    pending: &[(usize, Option<DVec3>)],
     other: &TriangleSoup,
     side: Side,
 ) -> Result<Vec<Class>, ClassifyError> {
     pending
         .par_iter()
-        .map(|&g| {
+        .map(|&(g, first)| {
+            if let Some(inside) = first.and_then(|p| exact_parity(p, other)) {
+                return Ok(if inside { Class::In } else { Class::Out });
+            }
             let mut members: Vec<u32> =
                 (0..group.len() as u32).filter(|&t| group[t as usize] as usize == g).collect();
             members.sort_by(|&s, &t| {

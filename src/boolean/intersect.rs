@@ -17,9 +17,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::exact::{line_crossing, orient2d, orient3d, plane_crossing};
+use crate::exact::implicit::Point;
+use crate::exact::{line_crossing, orient2d, orient3d};
 use crate::mesh::intersect::triangle_projection;
-use crate::mesh::triangulate::Projection;
 
 /// The smallest simplex of one mesh that holds a point (vertex ids are position-welded
 /// ids of that mesh; an edge's ends are in increasing order).
@@ -71,45 +71,51 @@ impl Operands<'_> {
 }
 
 impl Key {
-    /// The point's coordinates, computed from the key alone (so every triangle that
-    /// uses the point sees the same f64 value): an input vertex as it is, an edge
-    /// crossing a triangle's plane, or two edges crossing each other.
-    pub fn position(&self, ops: &Operands) -> DVec3 {
+    /// The point itself, from the key alone, as an implicit point
+    /// ([`crate::exact::implicit`]): an input vertex as it is, an edge crossing a
+    /// triangle's plane, or two coplanar edges crossing each other. Every predicate on it
+    /// is exact; `None` only for keys no pair produces (two faces), or inputs that are not
+    /// what the exact tests said.
+    pub fn point(&self, ops: &Operands) -> Option<Point> {
         let (pa, pb) = (ops.a_positions, ops.b_positions);
         match (self.a, self.b) {
-            (Simplex::Vertex(v), _) => pa[v as usize],
-            (_, Simplex::Vertex(v)) => pb[v as usize],
+            (Simplex::Vertex(v), _) => Some(Point::explicit(pa[v as usize])),
+            (_, Simplex::Vertex(v)) => Some(Point::explicit(pb[v as usize])),
             (Simplex::Edge(p, q), Simplex::Face(u)) => {
-                edge_plane(pa[p as usize], pa[q as usize], ops.b_tri(u))
+                Point::edge_plane(pa[p as usize], pa[q as usize], ops.b_tri(u)).ok()
             }
             (Simplex::Face(t), Simplex::Edge(p, q)) => {
-                edge_plane(pb[p as usize], pb[q as usize], ops.a_tri(t))
+                Point::edge_plane(pb[p as usize], pb[q as usize], ops.a_tri(t)).ok()
             }
             (Simplex::Edge(p, q), Simplex::Edge(r, s)) => {
-                edge_edge(pa[p as usize], pa[q as usize], pb[r as usize], pb[s as usize])
+                let (p, q, r, s) = (pa[p as usize], pa[q as usize], pb[r as usize], pb[s as usize]);
+                // Any point off the two edges' plane names the crossing; one a unit step
+                // from p along an axis, the normal's largest component first.
+                let n = (q - p).cross(s - r).abs();
+                let mut axes = [0, 1, 2];
+                axes.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
+                axes.into_iter().find_map(|k| {
+                    let mut off = p;
+                    off[k] += if p[k] > 0.0 { -1.0 } else { 1.0 };
+                    Point::edge_edge(p, q, r, s, off).ok()
+                })
             }
             // Two triangles' interiors never hold an end of their intersection.
-            (Simplex::Face(t), Simplex::Face(_)) => {
-                let [a, b, c] = ops.a_tri(t);
-                (a + b + c) / 3.0
-            }
+            (Simplex::Face(_), Simplex::Face(_)) => None,
         }
     }
-}
 
-/// Where segment pq crosses the plane of t (p, q strictly on opposite sides).
-fn edge_plane(p: DVec3, q: DVec3, t: [DVec3; 3]) -> DVec3 {
-    let l = plane_crossing(t[0], t[1], t[2], p, q).clamp(0.0, 1.0);
-    if l.is_finite() { p + (q - p) * l } else { p }
-}
-
-/// Where the coplanar segments pq and rs cross.
-fn edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> DVec3 {
-    let n = (q - p).cross(s - r);
-    let Some(proj) = Projection::along(n) else { return (p + q) * 0.5 };
-    let [p2, q2, r2, s2] = [p, q, r, s].map(|x| proj.apply(x));
-    let l = line_crossing(r2, s2, p2, q2).clamp(0.0, 1.0);
-    if l.is_finite() { p + (q - p) * l } else { p }
+    /// The point's coordinates rounded to f64 ([`Point::position`]), for output and
+    /// pictures only; a key no pair produces gives the first corner of A's simplex.
+    pub fn position(&self, ops: &Operands) -> DVec3 {
+        match self.point(ops) {
+            Some(x) => x.position(),
+            None => match self.a {
+                Simplex::Vertex(v) | Simplex::Edge(v, _) => ops.a_positions[v as usize],
+                Simplex::Face(t) => ops.a_tri(t)[0],
+            },
+        }
+    }
 }
 
 /// How one candidate pair meets.
@@ -287,9 +293,11 @@ fn emit(pts: &[(f64, Key)], segments: &mut Vec<[Key; 2]>, points: &mut Vec<Key>)
 }
 
 /// The keys of the points of segment pr (ids ip, ir, one mesh) that lie in the
-/// coplanar triangle `tri` (ids `tid`, face `face`, the other mesh), sorted along pr
-/// (by their parameter). `key(own, other)` builds a key from the segment's simplex and
-/// the triangle's.
+/// coplanar triangle `tri` (ids `tid`, face `face`, the other mesh), sorted along pr.
+/// The order is exact: more than two points occur only where pr runs along an edge of
+/// `tri`, and then all are input vertices on one line, ordered by their coordinate along
+/// pr's larger component (an edge crossing, inexact, is then never among them).
+/// `key(own, other)` builds a key from the segment's simplex and the triangle's.
 #[allow(clippy::too_many_arguments)]
 fn clip(
     p: DVec2,
@@ -308,12 +316,13 @@ fn clip(
         }
     };
     let d = r - p;
-    let param = |x: DVec2| (x - p).dot(d) / d.length_squared();
+    let axis = if d.x.abs() >= d.y.abs() { 0 } else { 1 };
+    let along = |x: DVec2| if d[axis] > 0.0 { x[axis] } else { -x[axis] };
     if let Some(s) = locate_2d(tri, tid, face, p) {
-        push(0.0, key(Simplex::Vertex(ip), s));
+        push(along(p), key(Simplex::Vertex(ip), s));
     }
     if let Some(s) = locate_2d(tri, tid, face, r) {
-        push(1.0, key(Simplex::Vertex(ir), s));
+        push(along(r), key(Simplex::Vertex(ir), s));
     }
     let own_edge = Simplex::edge(ip, ir);
     for k in 0..3 {
@@ -325,15 +334,14 @@ fn clip(
         if oa * ob < 0 && op * or < 0 {
             // Proper crossing of the two edges' interiors.
             let l = line_crossing(a, b, p, r);
-            push(l, key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
+            push(along(p) + l * d[axis].abs(), key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
         }
         // A corner of the triangle on the segment's interior.
         for (o, v, id) in [(oa, a, tid[k]), (ob, b, tid[(k + 1) % 3])] {
             if o == 0 {
-                let l = param(v);
-                let within = (v - p).dot(d) > 0.0 && (v - r).dot(d) < 0.0;
-                if within {
-                    push(l, key(own_edge, Simplex::Vertex(id)));
+                // On pr's line: strictly between p and r by the coordinate, exactly.
+                if along(p) < along(v) && along(v) < along(r) {
+                    push(along(v), key(own_edge, Simplex::Vertex(id)));
                 }
             }
         }

@@ -7,12 +7,14 @@
 //!    [`transform`] places B (the thesis applies a full transform to each mesh).
 //! 1. **Refinement** (§6.4) — [`index`] finds candidate triangle pairs in one spatial
 //!    index over both meshes, [`intersect`] decides each pair with exact predicates and
-//!    names every intersection point symbolically, [`refine`] re-triangulates each cut
-//!    triangle by constrained Delaunay with the intersection segments as constraints.
-//!    Afterwards every triangle of A is wholly in, out or on B, and vice versa.
+//!    names every intersection point symbolically, [`refine`] keeps each one implicit
+//!    (never rounded while deciding) and re-triangulates each cut triangle by exact
+//!    orientations with the intersection segments as constraints. Afterwards every
+//!    triangle of A is wholly in, out or on B, and vice versa.
 //! 2. **Classification** (§6.5) — [`classify`]: "on" triangles exactly, the others by
-//!    groups of connected triangles (§6.5.1), one point-in-solid test per group with
-//!    any inclusion method: the thesis' GPU test with its exact fallback, or a CPU one
+//!    groups of connected triangles (§6.5.1), one exact probe per group: the exact side
+//!    of a piece against the other surface, or a point-in-solid test at an input vertex
+//!    with any inclusion method: the thesis' GPU test with its exact fallback, or a CPU one
 //!    (the default, `octants`, is the fastest exact one for the few points grouped
 //!    classification tests; on lavapipe the GPU test's set-up alone costs more).
 //! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
@@ -48,7 +50,6 @@ pub mod intersect;
 pub mod output;
 pub mod refine;
 pub mod select;
-pub mod snap;
 pub mod transform;
 
 pub use classify::{Class, Classification, ClassifyStats, Grouping};

@@ -21,7 +21,8 @@
 //! **Repair.** For every crossing pair or flat triangle, its shortest edge with an
 //! intersection point at one end is collapsed if it is shorter than [`COLLAPSE`] × the
 //! operands' diagonal: the intersection point moves onto the other end (an input vertex
-//! never moves). A collapse keeps every directed edge balanced — the triangles on the
+//! never moves). A flat triangle with no such edge (a corner on its opposite edge) is
+//! removed by splitting its neighbour across that edge at the corner. A collapse keeps every directed edge balanced — the triangles on the
 //! edge vanish and their other edges pair up — so the result stays closed and oriented;
 //! two triangles that come to coincide with opposite orientations cancel. The moved
 //! triangles are checked again, for a few rounds. A shell that encloses no volume by the
@@ -49,6 +50,14 @@ pub const COLLAPSE: f64 = 1e-7;
 /// Rounds of collapse and re-check before giving up.
 const ROUNDS: usize = 8;
 
+/// How thin a region between two nearly coincident faces may be to count as flat, for
+/// points with coordinates up to `max_abs` and operands of bounding-box diagonal
+/// `diagonal`: far below any feature of a real model, far above the few ulps by which
+/// rounding moves a point.
+fn flat_thickness(max_abs: f64, diagonal: f64) -> f64 {
+    (1e-12 * diagonal).max(64.0 * f64::EPSILON * max_abs)
+}
+
 /// What the check found and the repair did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Repair {
@@ -67,6 +76,9 @@ pub struct Repair {
     pub pockets: usize,
     /// Triangles those regions had.
     pub pocket_triangles: usize,
+    /// Long flat triangles (a corner on the opposite edge once rounded) removed by
+    /// splitting the neighbour across that edge at the corner.
+    pub flipped: usize,
     /// Shells dropped because they enclose no volume.
     pub dropped_shells: usize,
     /// Farthest any point moved.
@@ -76,7 +88,11 @@ pub struct Repair {
 impl Repair {
     /// True when the result was written as selected.
     pub fn is_clean(&self) -> bool {
-        self.crossings == 0 && self.flat_triangles == 0 && self.pockets == 0 && self.dropped_shells == 0
+        self.crossings == 0
+            && self.flat_triangles == 0
+            && self.pockets == 0
+            && self.flipped == 0
+            && self.dropped_shells == 0
     }
 }
 
@@ -85,7 +101,8 @@ impl std::fmt::Display for Repair {
         write!(
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} edges collapsed \
-             ({} triangles removed, points moved at most {:e}), {} flat slivers removed ({} triangles rebuilt), {} flat shells dropped",
+             ({} triangles removed, points moved at most {:e}), {} flat slivers removed ({} triangles rebuilt), \
+             {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
@@ -94,6 +111,7 @@ impl std::fmt::Display for Repair {
             self.moved,
             self.pockets,
             self.pocket_triangles,
+            self.flipped,
             self.dropped_shells
         )
     }
@@ -167,7 +185,7 @@ pub fn finish(
     repair.tested = changed.iter().filter(|&&c| c).count();
     let limit = COLLAPSE * diagonal;
     let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-    let thickness = super::snap::tolerance(max_abs, diagonal);
+    let thickness = flat_thickness(max_abs, diagonal);
     let is_new = |v: u32| v >= first_new;
     for round in 0..=ROUNDS {
         let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
@@ -223,6 +241,44 @@ pub fn finish(
                     stuck = stuck.or_else(|| Some(crossing(c)));
                     wide.push(*c);
                 }
+            }
+        }
+        let mut long_flat = Vec::new();
+        for &f in &flat {
+            match shortest(&[f]) {
+                Some(e) => edges.push(e),
+                None => long_flat.push(f),
+            }
+        }
+        // Flat triangles without a short edge: one corner lies on the opposite edge once
+        // rounded; the neighbour across that edge is split there instead, which covers the
+        // same area, and everything is checked again.
+        if !long_flat.is_empty() && round < ROUNDS {
+            let by_edge = edge_faces(&soup);
+            let mut gone = vec![false; soup.triangles.len()];
+            let mut added = Vec::new();
+            for &f in &long_flat {
+                if let Some((g, pieces)) =
+                    split_neighbour(&soup, &by_edge, f).filter(|x| !gone[f] && !gone[x.0])
+                {
+                    gone[f] = true;
+                    gone[g] = true;
+                    added.extend(pieces.map(|t| (t, origin[g])));
+                    repair.flipped += 1;
+                }
+            }
+            if gone.iter().any(|&g| g) {
+                let keep: Vec<bool> = gone.iter().map(|g| !g).collect();
+                retain_marked(&mut soup.triangles, &keep);
+                retain_marked(&mut origin, &keep);
+                retain_marked(&mut changed, &keep);
+                for (t, o) in added {
+                    soup.triangles.push(t);
+                    origin.push(o);
+                    changed.push(true);
+                }
+                soup.face_of = (0..soup.triangles.len() as u32).collect();
+                continue;
             }
         }
         // Crossings without a short edge: the flat region around them is rebuilt without
@@ -310,6 +366,32 @@ pub fn finish(
     }
     drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
     Ok(Finished { triangles: soup.triangles, origin, repair })
+}
+
+/// For a flat triangle f (a, b, m) whose corner m lies strictly inside its edge ab once
+/// rounded: the neighbour g = (b, a, c) across ab, when it is the only one, and g split at
+/// m into (b, m, c) and (m, a, c), which replace f and g with the same surface.
+fn split_neighbour(soup: &TriangleSoup, by_edge: &EdgeFaces, f: usize) -> Option<(usize, [[u32; 3]; 2])> {
+    let tri = soup.triangles[f];
+    let pos = soup.triangle(f);
+    let length = |k: usize| pos[k].distance(pos[(k + 1) % 3]);
+    let k = (0..3).max_by(|&i, &j| length(i).total_cmp(&length(j)))?;
+    let (a, b, m) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+    let (pa, pb, pm) = (pos[k], pos[(k + 1) % 3], pos[(k + 2) % 3]);
+    // Strictly between: a corner at an end is a collapse, not a split.
+    if pm == pa || pm == pb || (pm - pa).dot(pb - pa) <= 0.0 || (pm - pb).dot(pa - pb) <= 0.0 {
+        return None;
+    }
+    let around = by_edge.get(&(a.min(b), a.max(b)))?;
+    let [x, y] = around.as_slice() else { return None };
+    let g = if *x == f { *y } else { *x };
+    let other = soup.triangles[g];
+    let j = (0..3).find(|&j| other[j] == b && other[(j + 1) % 3] == a)?;
+    let c = other[(j + 2) % 3];
+    if c == m {
+        return None;
+    }
+    Some((g, [[b, m, c], [m, a, c]]))
 }
 
 /// The triangles on each edge (ends in increasing order).

@@ -3,27 +3,34 @@
 //!
 //! 1. Candidate pairs from the shared index ([`super::index`]); each pair decided
 //!    exactly ([`super::intersect::meet`]).
-//! 2. Every intersection point, named by its [`Key`], gets one id and one position,
-//!    shared by A and B. Ids: A's vertices first, then B's, then the new points; a
-//!    vertex of B at the position of a vertex of A takes A's id.
+//! 2. Every intersection point, named by its [`Key`], gets one id, shared by A and B,
+//!    and is kept *implicit* ([`crate::exact::implicit`]): an input edge crossing an
+//!    input triangle's plane, or two coplanar input edges crossing, never rounded while
+//!    the refinement and the classification decide anything on it (its rounded position
+//!    is for the output only). Ids: A's vertices first, then B's, then the new points; a
+//!    vertex of B exactly at a vertex of A takes A's id.
 //! 3. Each cut triangle — one that has points on its edges or inside, or intersection
-//!    segments — is re-triangulated in its own plane by constrained Delaunay
-//!    ([`crate::mesh::triangulate::cdt`]): its corners and the points on its edges (in
-//!    order, shared with the neighbour across each edge) form the outline, points
-//!    inside are inserted, intersection segments are constraints, so the cut curve
-//!    appears as edges of both meshes. Uncut triangles are kept as they are.
+//!    segments — is re-triangulated in its own plane ([`crate::mesh::constrained`]), every
+//!    decision an exact orientation of implicit points in the triangle's axis-aligned
+//!    projection: its corners and the points on its edges (in their exact order along
+//!    the edge, shared with the neighbour across it) form the outline, points inside are
+//!    inserted, intersection segments are constraints, so the cut curve appears as edges
+//!    of both meshes. Uncut triangles are kept as they are.
 //! 4. The cut curve's edges are recorded ([`Refinement::cut_edges`]): the constraints
 //!    the triangulations contain, and the pieces of input edges that lie on the other
 //!    surface. Classification groups triangles across every other edge.
 
-use glam::DVec3;
+use std::borrow::Cow;
+
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::index::candidate_pairs;
 use super::intersect::{Key, Meeting, Operands, Simplex, meet};
-use super::snap;
-use crate::mesh::intersect::{TriangleSoup, triangle_projection};
-use crate::mesh::triangulate::{self, TriangulateError};
+use crate::exact::implicit::{self, Point, compare_implicit, orient2d_implicit};
+use crate::exact::orient2d;
+use crate::mesh::constrained::{self, Constrained, ConstrainedError};
+use crate::mesh::intersect::TriangleSoup;
 
 /// Which operand.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -41,19 +48,17 @@ impl std::fmt::Display for Side {
     }
 }
 
-/// A cut triangle could not be re-triangulated.
+/// The refinement could not be completed: with exact predicates on implicit points
+/// neither can happen on valid operands, so both are reported as internal errors.
 #[derive(Clone, Debug, thiserror::Error)]
-#[error(
-    "triangle {triangle} of {side} (face {face}) cannot be re-triangulated near ({x}, {y}, {z}): {reason}; \
-     the intersection is numerically degenerate there (points closer than rounding)",
-    x = near.x, y = near.y, z = near.z
-)]
-pub struct RefineError {
-    pub side: Side,
-    pub triangle: u32,
-    pub face: u32,
-    pub near: DVec3,
-    pub reason: TriangulateError,
+pub enum RefineError {
+    #[error(
+        "internal error: triangle {triangle} of {side} (face {face}) cannot be re-triangulated near ({x}, {y}, {z}): {reason}; please report it",
+        x = near.x, y = near.y, z = near.z
+    )]
+    Triangulate { side: Side, triangle: u32, face: u32, near: DVec3, reason: ConstrainedError },
+    #[error("internal error: the intersection point {key:?} cannot be constructed; please report it")]
+    Point { key: Key },
 }
 
 /// One mesh after refinement.
@@ -78,10 +83,9 @@ pub struct RefineStats {
     pub coplanar_pairs: usize,
     /// Intersection points that are not input vertices.
     pub new_points: usize,
-    /// Points merged because rounding cannot tell them apart ([`super::snap`]): new
-    /// points merged into a cluster or onto an input vertex, and vertices of B merged
-    /// onto vertices of A.
-    pub merged_points: usize,
+    /// Signs of predicates on implicit points that the floating-point filter could not
+    /// decide and exact arithmetic did (see [`implicit::exact_signs`]).
+    pub exact_signs: usize,
     /// Input triangles re-triangulated in A and in B.
     pub cut_a: usize,
     pub cut_b: usize,
@@ -90,8 +94,17 @@ pub struct RefineStats {
 /// Both meshes refined against each other.
 #[derive(Clone, Debug, Default)]
 pub struct Refinement {
-    /// All points: A's positions, then B's, then the new intersection points.
+    /// All points: A's positions, then B's, then the new intersection points rounded to
+    /// f64 (for the output: decisions use [`Refinement::point`]).
     pub points: Vec<DVec3>,
+    /// The new intersection points, exactly: point id `first_new + k` is `implicit[k]`,
+    /// named by `new_keys[k]`.
+    pub implicit: Vec<Point>,
+    pub new_keys: Vec<Key>,
+    /// Id of the first new point (A's and B's vertex counts).
+    pub first_new: u32,
+    /// Input vertices on the other surface: (point id, its key), sorted by id.
+    pub vertex_keys: Vec<(u32, Key)>,
     /// Number of A's positions (B's vertex v has id `b_offset + v`, unless it sits on
     /// a vertex of A).
     pub b_offset: u32,
@@ -119,11 +132,34 @@ impl Refinement {
         self.cut_edges.binary_search(&edge_key(a, b)).is_ok()
     }
 
+    /// Point `id` exactly: an input vertex or an implicit intersection point.
+    pub fn point(&self, id: u32) -> Cow<'_, Point> {
+        point_of(&self.points, self.first_new, &self.implicit, id)
+    }
+
+    /// The key of point `id` when it lies on both surfaces (a new point, or an input
+    /// vertex on the other surface).
+    pub fn key_of(&self, id: u32) -> Option<Key> {
+        if id >= self.first_new {
+            return self.new_keys.get((id - self.first_new) as usize).copied();
+        }
+        self.vertex_keys.binary_search_by_key(&id, |x| x.0).ok().map(|i| self.vertex_keys[i].1)
+    }
+
     pub fn side(&self, side: Side) -> &Refined {
         match side {
             Side::A => &self.a,
             Side::B => &self.b,
         }
+    }
+}
+
+/// Point `id` of `points` (ids from `first` on: `implicit`) as an exact point.
+fn point_of<'a>(points: &[DVec3], first: u32, implicit: &'a [Point], id: u32) -> Cow<'a, Point> {
+    if id < first {
+        Cow::Owned(Point::explicit(points[id as usize]))
+    } else {
+        Cow::Borrowed(&implicit[(id - first) as usize])
     }
 }
 
@@ -149,29 +185,58 @@ impl EdgePoints {
         }
     }
 
-    /// From (edge, point id, parameter) entries.
-    fn build(mut entries: Vec<((u32, u32), f64, u32)>) -> EdgePoints {
-        entries.par_sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+    /// From (edge, point id) entries: the points of each edge in their exact order from
+    /// its lower vertex id to the higher (`positions`: the mesh's vertices; `point`: a
+    /// point id's exact point).
+    fn build<'p>(
+        mut entries: Vec<((u32, u32), u32)>,
+        positions: &[DVec3],
+        point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
+    ) -> EdgePoints {
+        entries.par_sort_unstable();
         let mut e =
             EdgePoints { edges: Vec::new(), starts: Vec::new(), ids: Vec::with_capacity(entries.len()) };
-        for (edge, _, id) in entries {
+        for (edge, id) in entries {
             if e.edges.last() != Some(&edge) {
                 e.edges.push(edge);
                 e.starts.push(e.ids.len() as u32);
-            } else if e.ids[*e.starts.last().unwrap_or(&0) as usize..].contains(&id) {
-                // A merged point named twice along the edge: its first place only, the
-                // same for both triangles sharing the edge.
-                continue;
             }
             e.ids.push(id);
         }
         e.starts.push(e.ids.len() as u32);
+        // Every point lies exactly on its edge's line: their order along the edge is their
+        // order along the axis where the edge is longest.
+        let mut runs: Vec<&mut [u32]> = Vec::with_capacity(e.edges.len());
+        let mut rest: &mut [u32] = &mut e.ids;
+        for w in e.starts.windows(2) {
+            let (run, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
+            runs.push(run);
+            rest = tail;
+        }
+        runs.into_par_iter().zip(&e.edges).with_min_len(256).for_each(|(run, &(p, q))| {
+            if run.len() < 2 {
+                return;
+            }
+            let d = positions[q as usize] - positions[p as usize];
+            let axis = d.abs().max_position();
+            let forward = d[axis] > 0.0;
+            let exact: Vec<(u32, Cow<'p, Point>)> = run.iter().map(|&id| (id, point(id))).collect();
+            let mut order: Vec<usize> = (0..run.len()).collect();
+            order.sort_by(|&i, &j| {
+                let o = compare_implicit(axis, &exact[i].1, &exact[j].1);
+                if forward { o } else { o.reverse() }
+            });
+            for (slot, i) in run.iter_mut().zip(order) {
+                *slot = exact[i].0;
+            }
+        });
         e
     }
 }
 
 /// Refines the triangles of A and B against each other (§6.4).
 pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineError> {
+    let exact_before = implicit::exact_signs();
     let ops = Operands {
         a_positions: &a.positions,
         a_triangles: &a.triangles,
@@ -214,34 +279,12 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     keys.dedup();
     let na = a.positions.len() as u32;
     let nb = b.positions.len() as u32;
-    let (lo, hi) = a
-        .positions
-        .iter()
-        .chain(&b.positions)
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    let tolerance = snap::tolerance(lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
     let mut b_alias: Vec<u32> = (0..nb).map(|v| na + v).collect();
-    // A vertex of B closer than rounding to a vertex of A (a copy turned by 90°, whose
-    // cosines are not exactly 0) is that vertex, as if they coincided exactly: otherwise
-    // both, and the points around them, would be distinct points a few ulps apart.
-    {
-        let mut taken = vec![false; na as usize];
-        for (t, u, _) in &meetings {
-            for va in a.triangles[*t as usize] {
-                for vb in b.triangles[*u as usize] {
-                    let (pa, pb) = (a.positions[va as usize], b.positions[vb as usize]);
-                    if b_alias[vb as usize] == na + vb && !taken[va as usize] && pa.distance(pb) <= tolerance
-                    {
-                        b_alias[vb as usize] = va;
-                        taken[va as usize] = true;
-                        stats.merged_points += usize::from(pa != pb);
-                    }
-                }
-            }
-        }
-    }
     let mut ids = Vec::with_capacity(keys.len());
     let mut new_keys = Vec::new();
+    let mut vertex_keys = Vec::new();
+    // Keys naming a vertex of A come first (`Simplex` orders vertices first), so a vertex
+    // of B exactly at a vertex of A is aliased before any other key names it.
     for k in &keys {
         let id = match (k.a, k.b) {
             (Simplex::Vertex(va), Simplex::Vertex(vb)) => {
@@ -255,140 +298,51 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
                 na + nb + new_keys.len() as u32 - 1
             }
         };
+        if id < na + nb {
+            vertex_keys.push((id, *k));
+        }
         ids.push(id);
     }
+    vertex_keys.sort_unstable_by_key(|x| x.0);
+    vertex_keys.dedup_by_key(|x| x.0);
     // B's welded ids → point ids (aliased onto A's coincident vertices).
     let b_id = |v: u32| b_alias[v as usize];
-    let new_positions: Vec<DVec3> = new_keys.par_iter().map(|k| k.position(&ops)).collect();
-    stats.new_points = new_positions.len();
-    let mut points = Vec::with_capacity((na + nb) as usize + new_positions.len());
+    let first = na + nb;
+    let implicit: Vec<Option<Point>> = new_keys.par_iter().with_min_len(256).map(|k| k.point(&ops)).collect();
+    if let Some(k) = implicit.iter().position(Option::is_none) {
+        return Err(RefineError::Point { key: new_keys[k] });
+    }
+    let implicit: Vec<Point> = implicit.into_iter().flatten().collect();
+    stats.new_points = implicit.len();
+    let mut points = Vec::with_capacity(first as usize + implicit.len());
     points.extend_from_slice(&a.positions);
     points.extend_from_slice(&b.positions);
-    points.extend(new_positions);
-    // Points closer than rounding become one (see `snap`), onto an input vertex of a
-    // simplex naming one of them when there is one.
-    let first = na + nb;
-    let corners = |s: Simplex, tris: &[[u32; 3]], id: &dyn Fn(u32) -> u32, out: &mut Vec<u32>| match s {
-        Simplex::Vertex(v) => out.push(id(v)),
-        Simplex::Edge(p, q) => out.extend([id(p), id(q)]),
-        Simplex::Face(t) => out.extend(tris[t as usize].map(id)),
-    };
-    let merged = snap::merge(&points, first, tolerance, |k, out| {
-        corners(new_keys[k].a, &a.triangles, &|v| v, out);
-        corners(new_keys[k].b, &b.triangles, &b_id, out);
-    });
-    stats.merged_points += merged.iter().enumerate().filter(|&(k, &m)| m != first + k as u32).count();
-    if stats.merged_points > 0 {
-        for id in ids.iter_mut().filter(|id| **id >= first) {
-            *id = merged[(*id - first) as usize];
+    points.par_extend(implicit.par_iter().with_min_len(256).map(Point::position));
+    let point = |id: u32| point_of(&points, first, &implicit, id);
+
+    // Points on edges and inside triangles, per mesh: exactly where their keys say.
+    let mut a_edge_entries = Vec::new();
+    let mut b_edge_entries = Vec::new();
+    let mut a_inside: Vec<(u32, u32)> = Vec::new();
+    let mut b_inside: Vec<(u32, u32)> = Vec::new();
+    for (k, &id) in keys.iter().zip(&ids) {
+        match k.a {
+            Simplex::Edge(p, q) => a_edge_entries.push(((p, q), id)),
+            Simplex::Face(t) => a_inside.push((t, id)),
+            Simplex::Vertex(_) => {}
+        }
+        match k.b {
+            Simplex::Edge(p, q) => b_edge_entries.push(((p, q), id)),
+            Simplex::Face(u) => b_inside.push((u, id)),
+            Simplex::Vertex(_) => {}
         }
     }
-
-    // Points on edges and inside triangles, per mesh.
-    let param = |p: DVec3, q: DVec3, x: DVec3| (x - p).dot(q - p);
-    // A new point inside a triangle but closer than rounding to one of its edges (an
-    // edge of the other mesh running a hair off this one's) goes onto that edge, for
-    // both triangles sharing it: rounded, it may even lie across the edge.
-    let onto_edge = |tri: [u32; 3], pos: &[DVec3], id: u32| -> Option<((u32, u32), f64)> {
-        if id < first {
-            return None;
-        }
-        let x = points[id as usize];
-        (0..3).find_map(|e| {
-            let (p, q) = (tri[e].min(tri[(e + 1) % 3]), tri[e].max(tri[(e + 1) % 3]));
-            let (pp, pq) = (pos[p as usize], pos[q as usize]);
-            let l = param(pp, pq, x);
-            let closest = pp + (pq - pp) * (l / (pq - pp).length_squared()).clamp(0.0, 1.0);
-            (closest.distance(x) <= tolerance).then_some(((p, q), l))
-        })
-    };
-    let mut rounds = 0;
-    let (a_edges, b_edges, a_inside, b_inside) = loop {
-        let mut snapped = 0;
-        let mut a_edge_entries = Vec::new();
-        let mut b_edge_entries = Vec::new();
-        let mut a_inside: Vec<(u32, u32)> = Vec::new();
-        let mut b_inside: Vec<(u32, u32)> = Vec::new();
-        for (k, &id) in keys.iter().zip(&ids) {
-            match k.a {
-                Simplex::Edge(p, q) => {
-                    let l = param(a.positions[p as usize], a.positions[q as usize], points[id as usize]);
-                    a_edge_entries.push(((p, q), l, id));
-                }
-                Simplex::Face(t) => match onto_edge(a.triangles[t as usize], &a.positions, id) {
-                    Some((edge, l)) => {
-                        a_edge_entries.push((edge, l, id));
-                        snapped += 1;
-                    }
-                    None => a_inside.push((t, id)),
-                },
-                Simplex::Vertex(_) => {}
-            }
-            match k.b {
-                Simplex::Edge(p, q) => {
-                    let l = param(b.positions[p as usize], b.positions[q as usize], points[id as usize]);
-                    b_edge_entries.push(((p, q), l, id));
-                }
-                Simplex::Face(u) => match onto_edge(b.triangles[u as usize], &b.positions, id) {
-                    Some((edge, l)) => {
-                        b_edge_entries.push((edge, l, id));
-                        snapped += 1;
-                    }
-                    None => b_inside.push((u, id)),
-                },
-                Simplex::Vertex(_) => {}
-            }
-        }
-        a_inside.sort_unstable();
-        b_inside.par_sort_unstable();
-        let (a_edges, b_edges) =
-            rayon::join(|| EdgePoints::build(a_edge_entries), || EdgePoints::build(b_edge_entries));
-        // A merged point on two edges of one triangle is its corner there (it was a
-        // cluster around that corner not quite within the tolerance of it): merge it onto
-        // the corner everywhere, and sort the points again.
-        rounds += 1;
-        if rounds == 1 {
-            stats.merged_points += snapped;
-        }
-        if stats.merged_points == 0 || rounds > 3 {
-            break (a_edges, b_edges, a_inside, b_inside);
-        }
-        let mut onto: Vec<(u32, u32)> = Vec::new();
-        for (soup, edges, id) in
-            [(a, &a_edges, &(|v: u32| v) as &dyn Fn(u32) -> u32), (b, &b_edges, &b_id as &dyn Fn(u32) -> u32)]
-        {
-            for tri in &soup.triangles {
-                let chains = [0, 1, 2].map(|e| edges.get(tri[e], tri[(e + 1) % 3]));
-                if chains.iter().all(|c| c.is_empty()) {
-                    continue;
-                }
-                for e in 0..3 {
-                    for &x in chains[e] {
-                        // Edges e and e + 1 share corner e + 1, edges e and e + 2 corner e.
-                        if chains[(e + 1) % 3].contains(&x) {
-                            onto.push((x, id(tri[(e + 1) % 3])));
-                        } else if chains[(e + 2) % 3].contains(&x) {
-                            onto.push((x, id(tri[e])));
-                        } else if x == id(tri[(e + 2) % 3]) {
-                            onto.push((x, x));
-                        }
-                    }
-                }
-            }
-        }
-        onto.retain(|&(x, v)| x != v && x >= first);
-        if onto.is_empty() {
-            break (a_edges, b_edges, a_inside, b_inside);
-        }
-        onto.sort_unstable();
-        onto.dedup_by_key(|o| o.0);
-        stats.merged_points += onto.len();
-        for id in ids.iter_mut() {
-            if let Ok(i) = onto.binary_search_by_key(id, |o| o.0) {
-                *id = onto[i].1;
-            }
-        }
-    };
+    a_inside.sort_unstable();
+    b_inside.par_sort_unstable();
+    let (a_edges, b_edges) = rayon::join(
+        || EdgePoints::build(a_edge_entries, &a.positions, &point),
+        || EdgePoints::build(b_edge_entries, &b.positions, &point),
+    );
 
     let id_of =
         |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
@@ -428,8 +382,8 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     let a_input = SideInput { side: Side::A, soup: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
     let b_input = SideInput { side: Side::B, soup: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
     let ((ra, cut_a), (rb, cut_b)) = rayon::join(
-        || refine_side(&a_input, a_segments, &points, &id_of),
-        || refine_side(&b_input, b_segments, &points, &id_of),
+        || refine_side(&a_input, a_segments, &points, &point, &id_of),
+        || refine_side(&b_input, b_segments, &points, &point, &id_of),
     );
     let (ra, mut cut_edges) = (ra?, cut_a);
     let (rb, cut_b) = (rb?, cut_b);
@@ -438,7 +392,21 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     cut_edges.dedup();
     stats.cut_a = ra.cut.iter().filter(|&&c| c).count();
     stats.cut_b = rb.cut.iter().filter(|&&c| c).count();
-    Ok(Refinement { points, b_offset: na, a: ra, b: rb, cut_edges, curve, coplanar, stats })
+    stats.exact_signs = implicit::exact_signs() - exact_before;
+    Ok(Refinement {
+        points,
+        implicit,
+        new_keys,
+        first_new: first,
+        vertex_keys,
+        b_offset: na,
+        a: ra,
+        b: rb,
+        cut_edges,
+        curve,
+        coplanar,
+        stats,
+    })
 }
 
 /// What refining one side needs to know about it.
@@ -454,10 +422,11 @@ struct SideInput<'a> {
 
 /// Re-triangulates the cut triangles of one side. Returns the refined mesh and the cut
 /// edges found on this side.
-fn refine_side(
+fn refine_side<'p>(
     input: &SideInput,
     mut segments: Vec<TriangleSegment>,
     points: &[DVec3],
+    point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
     id_of: &(dyn Fn(&Key) -> u32 + Sync),
 ) -> (Result<Refined, RefineError>, Vec<u64>) {
     let soup = input.soup;
@@ -473,7 +442,7 @@ fn refine_side(
             continue;
         }
         // A segment with both ends on one edge's chain (its ends, the points on it, and
-        // those snapped onto it) runs along that edge.
+        // nothing else) runs along that edge.
         let along = (0..3).find_map(|e| {
             let (p, q) = (tri[e], tri[(e + 1) % 3]);
             let (lo, hi) = (p.min(q), p.max(q));
@@ -515,7 +484,7 @@ fn refine_side(
     };
     let cut: Vec<bool> = (0..n as u32).into_par_iter().with_min_len(4096).map(is_cut).collect();
     let cut_ids: Vec<u32> = (0..n as u32).filter(|&t| cut[t as usize]).collect();
-    let pieces: Vec<Result<(u32, triangulate::Cdt), RefineError>> = cut_ids
+    let pieces: Vec<Result<(u32, Constrained), RefineError>> = cut_ids
         .par_iter()
         .with_min_len(16)
         .map(|&t| {
@@ -532,9 +501,9 @@ fn refine_side(
                 .collect();
             cons.sort_unstable();
             cons.dedup();
-            retriangulate(soup.triangle(t as usize), corners, chains, &inside, &cons, points)
-                .map(|cdt| (t, cdt))
-                .map_err(|(reason, near)| RefineError {
+            retriangulate(soup.triangle(t as usize), corners, chains, &inside, &cons, points, point)
+                .map(|pieces| (t, pieces))
+                .map_err(|(reason, near)| RefineError::Triangulate {
                     side: input.side,
                     triangle: t,
                     face: soup.face_of[t as usize],
@@ -561,7 +530,7 @@ fn refine_side(
                 refined.triangles.push(piece);
                 refined.parent.push(t);
             }
-            cut_edges.extend(next.1.constraint_edges.iter().map(|&[x, y]| edge_key(x, y)));
+            cut_edges.extend(next.1.segment_edges.iter().map(|&[x, y]| edge_key(x, y)));
         } else {
             refined.triangles.push(soup.triangles[t as usize].map(|v| (input.vertex_id)(v)));
             refined.parent.push(t);
@@ -571,63 +540,70 @@ fn refine_side(
     (Ok(refined), cut_edges)
 }
 
+/// The two coordinate axes of the projection that drops the largest component of the
+/// triangle's normal, in the order that keeps it counter-clockwise (decided exactly; the
+/// drop only matters for the pieces' shapes, any non-degenerate one is exact); `None`
+/// for a triangle without area.
+pub fn plane_axes(tri: [DVec3; 3]) -> Option<[usize; 2]> {
+    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).abs();
+    let mut drops = [0, 1, 2];
+    drops.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
+    drops.into_iter().find_map(|k| {
+        let axes = [(k + 1) % 3, (k + 2) % 3];
+        let q = |p: DVec3| DVec2::new(p[axes[0]], p[axes[1]]);
+        match orient2d(q(tri[0]), q(tri[1]), q(tri[2])) {
+            0 => None,
+            s if s > 0 => Some(axes),
+            _ => Some([axes[1], axes[0]]),
+        }
+    })
+}
+
 /// Re-triangulates one cut triangle (corners `pos`, point ids `corners`): outline =
 /// corners and the points on each edge (`chains[e]`: the points of edge e in increasing
 /// vertex-id order, and whether that runs against the triangle's direction), plus
-/// interior points and constraints. Returns the pieces over point ids.
-fn retriangulate(
+/// interior points and constraints. Every decision is an exact orientation of the exact
+/// points (`point`) in the axis-aligned projection that keeps the triangle
+/// counter-clockwise; the rounded `points` only shape the triangles. Returns the pieces
+/// over point ids.
+fn retriangulate<'p>(
     pos: [DVec3; 3],
     corners: [u32; 3],
     chains: [(&[u32], bool); 3],
     inside: &[u32],
     constraints: &[[u32; 2]],
     points: &[DVec3],
-) -> Result<triangulate::Cdt, (TriangulateError, DVec3)> {
+    point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
+) -> Result<Constrained, (ConstrainedError, DVec3)> {
     let near = (pos[0] + pos[1] + pos[2]) / 3.0;
-    let proj = triangle_projection(pos[0], pos[1], pos[2]).ok_or((TriangulateError::Degenerate, near))?;
     let mut ids: Vec<u32> = Vec::with_capacity(8 + inside.len());
-    for e in 0..3 {
-        ids.push(corners[e]);
-        let (chain, reversed) = chains[e];
+    // Per point, the triangle's edges it lies on (bit e: edge e, from corner e to e + 1):
+    // three points on one edge are collinear by construction, which no filter can decide.
+    let mut exact: Vec<(u32, Cow<'p, Point>, u8)> = Vec::with_capacity(11 + inside.len());
+    for (e, (chain, reversed)) in chains.into_iter().enumerate() {
         if reversed {
             ids.extend(chain.iter().rev());
         } else {
             ids.extend_from_slice(chain);
         }
+        exact.push((corners[e], point(corners[e]), 1 << e | 1 << ((e + 2) % 3)));
+        exact.extend(chain.iter().map(|&id| (id, point(id), 1 << e)));
     }
-    // Merged points (`snap`) may repeat a neighbour or a corner: drop the repeats, the
-    // same way on both sides of a shared edge.
-    ids.dedup();
-    while ids.len() > 1 && ids.first() == ids.last() {
-        ids.pop();
-    }
-    let outline_len = ids.len();
-    let mut outline_sorted = ids.clone();
-    outline_sorted.sort_unstable();
-    let mut interior: Vec<u32> =
-        inside.iter().copied().filter(|g| outline_sorted.binary_search(g).is_err()).collect();
-    interior.sort_unstable();
-    interior.dedup();
-    ids.extend(interior);
-    // Local index of each point id.
-    let mut lookup: Vec<(u32, u32)> = ids.iter().enumerate().map(|(i, &g)| (g, i as u32)).collect();
-    lookup.sort_unstable();
-    if lookup.windows(2).any(|w| w[0].0 == w[1].0) {
-        return Err((TriangulateError::Duplicate, near));
-    }
-    let local = |g: u32| lookup.binary_search_by_key(&g, |x| x.0).ok().map(|i| lookup[i].1);
-    let mut cons = Vec::with_capacity(constraints.len());
-    for &[x, y] in constraints {
-        let (Some(lx), Some(ly)) = (local(x), local(y)) else {
-            return Err((TriangulateError::Crossing, points[x as usize]));
-        };
-        cons.push([lx, ly]);
-    }
-    let p2: Vec<glam::DVec2> = ids.iter().map(|&g| proj.apply(points[g as usize])).collect();
-    let outline: Vec<u32> = (0..outline_len as u32).collect();
-    let out = triangulate::cdt(&p2, &outline, &cons).map_err(|e| (e, near))?;
-    Ok(triangulate::Cdt {
-        triangles: out.triangles.into_iter().map(|t| t.map(|l| ids[l as usize])).collect(),
-        constraint_edges: out.constraint_edges.into_iter().map(|e| e.map(|l| ids[l as usize])).collect(),
-    })
+    ids.extend_from_slice(inside);
+    exact.extend(inside.iter().map(|&id| (id, point(id), 0)));
+    exact.sort_unstable_by_key(|x| x.0);
+    let get = |id: u32| match exact.binary_search_by_key(&id, |x| x.0) {
+        Ok(i) => (&*exact[i].1, exact[i].2),
+        Err(_) => unreachable!("every point of the triangle is listed"),
+    };
+    let axes = plane_axes(pos).ok_or((ConstrainedError::Corners, near))?;
+    let orient = |a: u32, b: u32, c: u32| {
+        let ((pa, ma), (pb, mb), (pc, mc)) = (get(a), get(b), get(c));
+        if ma & mb & mc != 0 { 0 } else { orient2d_implicit(axes, pa, pb, pc) }
+    };
+    let at = |id: u32| {
+        let p = points[id as usize];
+        DVec2::new(p[axes[0]], p[axes[1]])
+    };
+    constrained::triangulate(corners, &ids, constraints, orient, at).map_err(|e| (e, near))
 }

@@ -26,6 +26,7 @@
 
 use std::cmp::Ordering;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
 
 use glam::DVec3;
 
@@ -220,7 +221,7 @@ impl Point {
     fn w_sign(&self) -> Sign {
         match self.approx[3].sign() {
             Some(s) => s,
-            None => self.exact()[3].sign(),
+            None => exact_sign(&self.exact()[3]),
         }
     }
 
@@ -288,9 +289,23 @@ fn det4<R: Ring>(r: [&[R; 4]; 4]) -> R {
     term(1).minus(&term(0)).plus(&term(3).minus(&term(2)))
 }
 
+/// How many signs the filter left to the exact path, process-wide (for `--stats`).
+static EXACT_SIGNS: AtomicUsize = AtomicUsize::new(0);
+
+/// The number of signs decided by the exact path so far in this process: read it before
+/// and after a computation to see how often its filter failed.
+pub fn exact_signs() -> usize {
+    EXACT_SIGNS.load(AtomicOrdering::Relaxed)
+}
+
+fn exact_sign(e: &Exact) -> Sign {
+    EXACT_SIGNS.fetch_add(1, AtomicOrdering::Relaxed);
+    e.sign()
+}
+
 /// Decides a determinant's sign: the filter first, the exact value when it cannot.
 fn decide(filter: impl FnOnce() -> Interval, exact: impl FnOnce() -> Exact) -> Sign {
-    filter().sign().unwrap_or_else(|| exact().sign())
+    filter().sign().unwrap_or_else(|| exact_sign(&exact()))
 }
 
 /// [`orient3d`] on implicit points: positive when d lies on the side the normal

@@ -418,6 +418,19 @@ fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(u
         return found;
     }
     let split = split_at_t_junctions(soup);
+    // The split soup has more triangles: a piece is marked when its face has a marked one.
+    let split_near: Option<Vec<bool>> = match (&split, near) {
+        (Some(s), Some(near)) => {
+            let faces = soup.face_of.iter().chain(&s.face_of).map(|&f| f as usize + 1).max().unwrap_or(0);
+            let mut marked = vec![false; faces];
+            for (t, &f) in soup.face_of.iter().enumerate() {
+                marked[f as usize] |= near[t];
+            }
+            Some(s.face_of.iter().map(|&f| marked[f as usize]).collect())
+        }
+        _ => None,
+    };
+    let near = split_near.as_deref().or(near);
     let soup = split.as_ref().unwrap_or(soup);
     let n = soup.triangles.len();
     let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();

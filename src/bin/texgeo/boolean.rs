@@ -141,26 +141,29 @@ fn evaluation_lines(a: &str, b: &str, ev: &Evaluation) -> [String; 3] {
             ev.b.triangles.len()
         ),
         format!(
-            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points ({} merged), cut triangles A {} B {}, refined triangles A {} B {}",
+            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points (implicit; {} signs decided by exact arithmetic past the filter), cut triangles A {} B {}, refined triangles A {} B {}",
             r.candidate_pairs,
             r.meeting_pairs,
             r.coplanar_pairs,
             r.new_points,
-            r.merged_points,
+            r.exact_signs,
             r.cut_a,
             r.cut_b,
             ev.refinement.a.triangles.len(),
             ev.refinement.b.triangles.len()
         ),
         format!(
-            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved), {} exact fallbacks",
+            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved), {} decided by an exact local side, {} at a rounded centroid, {} exact fallbacks, {} signs by exact arithmetic",
             ev.method,
             c.triangles,
             c.on,
             c.groups,
             c.point_tests,
             100.0 * c.saved_share(),
-            c.exact_fallbacks
+            c.local_sides,
+            c.rounded_probes,
+            c.exact_fallbacks,
+            c.exact_signs
         ),
     ]
 }
