@@ -284,8 +284,8 @@ fn probe(
             _ => Some(Probe::Known(Class::Out)),
         })
     };
-    for k in 0..3 {
-        if let Some(Simplex::Face(u)) = sx[k] {
+    for (k, s) in sx.iter().enumerate() {
+        if let Some(Simplex::Face(u)) = *s {
             if let Some(p) = side_of(u, &[(k + 1) % 3, (k + 2) % 3]) {
                 return Some(p);
             }
