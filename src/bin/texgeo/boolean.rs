@@ -180,7 +180,7 @@ fn evaluation_json(a: &str, b: &str, ev: &Evaluation) -> serde_json::Value {
             "meeting_pairs": r.meeting_pairs,
             "coplanar_pairs": r.coplanar_pairs,
             "new_points": r.new_points,
-            "merged_points": r.merged_points,
+            "exact_signs": r.exact_signs,
             "cut_a": r.cut_a,
             "cut_b": r.cut_b,
             "refined_a": ev.refinement.a.triangles.len(),
@@ -194,6 +194,9 @@ fn evaluation_json(a: &str, b: &str, ev: &Evaluation) -> serde_json::Value {
             "point_tests": c.point_tests,
             "saved_share": c.saved_share(),
             "exact_fallbacks": c.exact_fallbacks,
+            "local_sides": c.local_sides,
+            "rounded_probes": c.rounded_probes,
+            "exact_signs": c.exact_signs,
         },
     })
 }
@@ -206,6 +209,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "flat_triangles": r.flat_triangles,
         "collapsed_edges": r.collapsed_edges,
         "removed_triangles": r.removed_triangles,
+        "flipped": r.flipped,
         "pockets": r.pockets,
         "pocket_triangles": r.pocket_triangles,
         "dropped_shells": r.dropped_shells,
