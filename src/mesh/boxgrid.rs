@@ -54,6 +54,15 @@ impl Grid {
 /// `(i, j)` with i in `a` and j in `b`, each once, in no particular order. Only the
 /// region where both sets' boxes meet is gridded.
 pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
+    box_pairs_within(a, b, u64::MAX).unwrap_or_default()
+}
+
+/// [`box_pairs`], unless the grid would compare more than `max_tests` pairs of boxes
+/// sharing a cell (counted from the cells' occupancy before any pair is compared): then
+/// `None`. Boxes that pile up in a few cells whatever their size — a fan of slivers
+/// around one vertex, long parallel slivers — make the grid quadratic, and this says so
+/// for the price of counting.
+pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Option<Vec<(u32, u32)>> {
     let hull = |boxes: &[Box3]| -> Box3 {
         boxes.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(x.0), hi.max(x.1)))
     };
@@ -65,7 +74,7 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
         }
     };
     if a.is_empty() || region.0.cmpgt(region.1).any() || !region.0.is_finite() || !region.1.is_finite() {
-        return Vec::new();
+        return Some(Vec::new());
     }
     // Entries: (cell key, id with the set in the top bit). Boxes outside the region are left out.
     let inside = |x: &Box3| overlaps(x, &region);
@@ -79,7 +88,7 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
         }))
         .collect();
     if all.is_empty() {
-        return Vec::new();
+        return Some(Vec::new());
     }
     let extent = region.1 - region.0;
     let mean = all.iter().map(|(_, x)| (x.1 - x.0).max_element()).sum::<f64>() / all.len() as f64;
@@ -113,6 +122,10 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
     let mut start = vec![0u32; cells + 1];
     for &r in &ranges {
         each_cell(r, &mut |c| start[c + 1] += 1);
+    }
+    let tests = start.iter().map(|&c| u64::from(c) * u64::from(c.saturating_sub(1)) / 2).sum::<u64>();
+    if tests > max_tests {
+        return None;
     }
     for c in 0..cells {
         start[c + 1] += start[c];
@@ -165,7 +178,7 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
             x.extend(y);
             x
         });
-    pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect()
+    Some(pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect())
 }
 
 trait ClampTo {
@@ -241,5 +254,24 @@ mod tests {
         assert_eq!(box_pairs(&c, None), vec![(0, 1)]);
         let far = vec![(DVec3::splat(50.0), DVec3::splat(51.0))];
         assert_eq!(box_pairs(&c, Some(&far)), vec![]);
+    }
+
+    #[test]
+    fn piled_up_boxes_are_refused_before_pairing() {
+        // Boxes of a fan's slivers around the origin: all share the cells at the centre.
+        let fan: Vec<Box3> = (0..400)
+            .map(|k| {
+                let a = std::f64::consts::TAU * f64::from(k) / 400.0;
+                let p = DVec3::new(a.cos(), a.sin(), 0.0);
+                (p.min(DVec3::ZERO), p.max(DVec3::ZERO))
+            })
+            .collect();
+        assert_eq!(box_pairs_within(&fan, None, 40 * 400), None);
+        assert_eq!(box_pairs_within(&fan, None, u64::MAX).map(|p| p.len()), Some(brute(&fan, None).len()));
+        // Spread boxes pass the same bound, with the same pairs as without it.
+        let spread = random_boxes(400, 3, 0.0);
+        let mut within = box_pairs_within(&spread, None, 40 * 400).expect("few pairs per cell");
+        within.sort_unstable();
+        assert_eq!(within, brute(&spread, None));
     }
 }

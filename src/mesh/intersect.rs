@@ -21,16 +21,19 @@
 //! that whole segment as an edge and those on the other side have its pieces. Those
 //! faces only touch; to tell that from crossing, the triangles with the whole segment
 //! are split at the middle corner before the pair tests ([`split_at_t_junctions`]).
-//! Candidate pairs come from an octree over the triangles and their edges that leaves
-//! out pairs which cannot count, so fans and long slivers stay cheap
-//! ([`super::crosstree`]); restricted to marked triangles, they are the marked
-//! triangles' boxes against all others in a uniform grid ([`super::boxgrid`]).
+//! Candidate pairs come from a uniform grid over the triangles' boxes
+//! ([`super::boxgrid`]) when its cells hold few boxes each, as on ordinary meshes, where
+//! it is the cheapest search; when boxes pile up in its cells (fans, long slivers,
+//! high-valence vertices: counted from the cells' occupancy before any pair is compared),
+//! from an octree over the triangles and their edges that leaves out pairs which cannot
+//! count ([`super::crosstree`]). Restricted to marked triangles, they are the marked
+//! triangles' boxes against all others in the grid.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Mesh;
-use super::boxgrid::box_pairs;
+use super::boxgrid::{box_pairs, box_pairs_within};
 use super::crosstree::candidate_pairs;
 use super::triangulate::{self, Projection, TriangulateError};
 use crate::exact::{Sign, orient2d, orient2d_approx, orient3d};
@@ -391,14 +394,30 @@ pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
 
 /// [`self_intersections`] of a mesh already tessellated (`soup.face_of` names the faces).
 pub fn soup_self_intersections(soup: &TriangleSoup, limit: usize) -> Vec<(usize, usize)> {
-    crossings(soup, None, limit)
+    crossings(soup, None, limit, Search::Auto)
 }
 
 /// [`soup_self_intersections`] restricted to the pairs with at least one triangle marked
 /// in `near` (one flag per triangle): when the unmarked triangles are known not to cross
 /// each other, the same answer for a fraction of the work.
 pub fn soup_self_intersections_near(soup: &TriangleSoup, near: &[bool], limit: usize) -> Vec<(usize, usize)> {
-    crossings(soup, Some(near), limit)
+    crossings(soup, Some(near), limit, Search::Auto)
+}
+
+/// Box pairs sharing a grid cell the grid may compare per triangle (plus a floor for
+/// small meshes) before the octree is used instead. Ordinary meshes compare 15–30.
+const GRID_TESTS_PER_TRIANGLE: u64 = 128;
+const GRID_TESTS_FLOOR: u64 = 1 << 16;
+
+/// Where the candidate pairs of a whole soup come from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Search {
+    /// The grid unless it would compare too many boxes, then the octree.
+    Auto,
+    #[cfg(test)]
+    Grid,
+    #[cfg(test)]
+    Tree,
 }
 
 /// Faces whose own triangulation failed because their edges cross or corners coincide,
@@ -411,7 +430,12 @@ fn self_crossing_faces(soup: &TriangleSoup) -> Vec<(usize, usize)> {
         .collect()
 }
 
-fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(usize, usize)> {
+fn crossings(
+    soup: &TriangleSoup,
+    near: Option<&[bool]>,
+    limit: usize,
+    search: Search,
+) -> Vec<(usize, usize)> {
     let mut found = self_crossing_faces(soup);
     if found.len() >= limit {
         found.truncate(limit);
@@ -435,7 +459,20 @@ fn crossings(soup: &TriangleSoup, near: Option<&[bool]>, limit: usize) -> Vec<(u
     let n = soup.triangles.len();
     let degenerate: Vec<bool> = (0..n).into_par_iter().map(|t| is_degenerate(soup.triangle(t))).collect();
     let candidates = match near {
-        None => candidate_pairs(&soup.positions, &soup.triangles, &soup.face_of, &degenerate),
+        None => {
+            let budget = match search {
+                Search::Auto => {
+                    GRID_TESTS_PER_TRIANGLE.saturating_mul(n as u64).saturating_add(GRID_TESTS_FLOOR)
+                }
+                #[cfg(test)]
+                Search::Grid => u64::MAX,
+                #[cfg(test)]
+                Search::Tree => 0,
+            };
+            box_pairs_within(&soup.boxes(), None, budget).unwrap_or_else(|| {
+                candidate_pairs(&soup.positions, &soup.triangles, &soup.face_of, &degenerate)
+            })
+        }
         Some(near) => {
             // Marked boxes against all: a pair of two marked triangles comes twice (keep
             // one), a triangle meets its own box (drop it).
@@ -611,7 +648,10 @@ mod tests {
         meshes.extend((0..6).map(|seed| grid_soup(seed, 60)));
         for (i, m) in meshes.iter().enumerate() {
             let expected = all_pairs(m);
-            assert_eq!(self_intersections(m, usize::MAX), expected, "mesh {i}");
+            let soup = TriangleSoup::new(m);
+            for search in [Search::Auto, Search::Grid, Search::Tree] {
+                assert_eq!(crossings(&soup, None, usize::MAX, search), expected, "mesh {i}, {search:?}");
+            }
             if i == 0 || i >= 5 {
                 assert!(!expected.is_empty(), "mesh {i} has no crossing to find");
             }
