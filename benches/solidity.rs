@@ -6,7 +6,9 @@
 //! Shapes (each about `faces` triangles): `bicone`, two fans of long slivers meeting at
 //! a ring; `needle`, a cone 100 times taller than wide over a base fanned from its centre
 //! (long slivers over a flat fan); `cone`, one apex of valence `faces / 2` over a base
-//! kept as one polygon. Seconds are the median and minimum of N runs (default 3), wall
+//! kept as one polygon; `sliver`, a cylinder 5 times taller than wide whose sides are
+//! long parallel slivers, its caps fanned; `valence`, one apex of valence `faces − 1`
+//! over a base kept as one polygon (about `2 · faces` triangles). Seconds are the median and minimum of N runs (default 3), wall
 //! clock and CPU (user + system, all threads: what a busy machine does not hide).
 
 use std::time::Instant;
@@ -29,6 +31,8 @@ fn shape(name: &str, faces: u32) -> Option<Mesh> {
         "bicone" => procedural::bicone(sides, 1.0, 1.0),
         "needle" => procedural::bicone(sides, 100.0, 0.0),
         "cone" => procedural::cone(sides),
+        "sliver" => procedural::sliver_cylinder((faces / 4).max(3), 10.0),
+        "valence" => procedural::cone(faces.saturating_sub(1).max(3)),
         _ => return None,
     })
 }
@@ -45,7 +49,7 @@ fn main() -> anyhow::Result<()> {
         .context("--faces")?;
     let shapes: Vec<&str> = match value("--shape") {
         Some(s) => vec![s.as_str()],
-        None => vec!["bicone", "needle", "cone"],
+        None => vec!["bicone", "needle", "cone", "sliver", "valence"],
     };
     println!("shape,faces,triangles,median_s,min_s,median_cpu_s,solid");
     for name in shapes {

@@ -255,6 +255,7 @@ fn fans_slivers_and_high_valence_vertices_are_clean() {
         ("flat lens", procedural::bicone(300, 0.01, 0.01)),
         ("cone", procedural::cone(300)),
         ("dented bicone", dented_bicone(300, 0.2)),
+        ("cylinder of long slivers", procedural::sliver_cylinder(300, 10.0)),
     ] {
         assert_eq!(self_intersections(&m, 10), vec![], "{name}");
         let check = texgeo::mesh::solidity::check(&m);

@@ -174,6 +174,32 @@ pub fn bicone(sides: u32, top: f64, bottom: f64) -> Mesh {
     mesh(positions, faces)
 }
 
+/// A cylinder of long slivers: a prism of height `height` over the regular `sides`-gon
+/// on the unit circle (≥ 3), each side quad split along a diagonal into two triangles
+/// that span the whole height, each cap fanned from its centre; `4 · sides` triangles.
+/// With many sides and a tall prism the side triangles are long parallel slivers whose
+/// boxes overlap along their whole length, and the cap centres have valence `sides`.
+/// `height` must be positive.
+pub fn sliver_cylinder(sides: u32, height: f64) -> Mesh {
+    let sides = sides.max(3);
+    let ring = |z: f64| {
+        (0..sides).map(move |i| {
+            let a = TAU * f64::from(i) / f64::from(sides);
+            DVec3::new(a.cos(), a.sin(), z)
+        })
+    };
+    let mut positions: Vec<DVec3> = ring(0.0).chain(ring(height)).collect();
+    positions.extend([DVec3::ZERO, DVec3::new(0.0, 0.0, height)]);
+    let (bottom, top) = (2 * sides, 2 * sides + 1);
+    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(4 * sides as usize);
+    for i in 0..sides {
+        let j = (i + 1) % sides;
+        faces.extend([vec![i, j, sides + j], vec![i, sides + j, sides + i], vec![j, i, bottom]]);
+        faces.push(vec![sides + i, sides + j, top]);
+    }
+    mesh(positions, faces)
+}
+
 /// A square pyramid: base [−1, 1]² at z = −1, apex (0, 0, 1); one quad and 4 triangles.
 pub fn pyramid() -> Mesh {
     let positions = vec![
