@@ -15,16 +15,19 @@
 //! it along the axes; tested with a margin for rounding, so nothing that crosses is left
 //! out). A cell stops splitting when it holds few entries, when all its entries share a
 //! vertex or all belong to one face (no pair there counts), or when it holds no edge or
-//! no triangle. Long slivers and high-valence fans therefore sit in few cells, unlike
-//! boxes in a uniform grid, whose overlaps grow with the square of the fan's size.
+//! no triangle. A cell is halved only along the axes that part its entries when some do
+//! (long slivers side by side are cut across, not along). Long slivers and high-valence
+//! fans therefore sit in few cells, unlike boxes in a uniform grid, whose overlaps grow
+//! with the square of the fan's size.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 /// A cell with at most this many entries pairs them instead of splitting.
 const LEAF: usize = 48;
-/// Deeper cells are not split (a point where many triangles truly cross).
-const MAX_DEPTH: u32 = 24;
+/// Deeper cells are not split (a point where many triangles truly cross); a level may
+/// halve fewer than three axes ([`Tree::parting_axes`]).
+const MAX_DEPTH: u32 = 32;
 /// Cells with more entries are split with their children in parallel.
 const PARALLEL: usize = 4096;
 /// Face of an edge whose triangles belong to different faces.
@@ -190,6 +193,27 @@ impl Tree<'_> {
         mask
     }
 
+    /// Of the axes in `split`, those that part the entries at `mid` (by their boxes: at
+    /// most half of them reach both sides, and at least an eighth lie wholly on each), or
+    /// all of `split` when none does. Long slivers side by side reach both halves along
+    /// their length: halving across them only, the cells become columns that each hold a
+    /// few of them, where cubes would cut every sliver many times.
+    fn parting_axes(&self, entries: &[u32], mid: DVec3, split: [bool; 3]) -> [bool; 3] {
+        let (mut below, mut above) = ([0usize; 3], [0usize; 3]);
+        for &x in entries {
+            let (lo, hi) = self.boxes[x as usize];
+            for k in 0..3 {
+                below[k] += usize::from(hi[k] < mid[k]);
+                above[k] += usize::from(lo[k] > mid[k]);
+            }
+        }
+        let m = entries.len();
+        let parting: [bool; 3] = std::array::from_fn(|k| {
+            split[k] && 2 * (m - below[k] - above[k]) <= m && 8 * below[k].min(above[k]) >= m
+        });
+        if parting.contains(&true) { parting } else { split }
+    }
+
     fn walk(&self, cell: Box3, entries: Vec<u32>, depth: u32, out: &mut Vec<u64>) {
         if self.nothing_to_pair(&entries) {
             return;
@@ -197,7 +221,10 @@ impl Tree<'_> {
         let (lo, hi) = cell;
         let mid = (lo + hi) * 0.5;
         // Axes the cell can still be halved along.
-        let split: [bool; 3] = std::array::from_fn(|k| lo[k] < mid[k] && mid[k] < hi[k]);
+        let mut split: [bool; 3] = std::array::from_fn(|k| lo[k] < mid[k] && mid[k] < hi[k]);
+        if entries.len() > LEAF {
+            split = self.parting_axes(&entries, mid, split);
+        }
         if entries.len() <= LEAF || depth >= MAX_DEPTH || !split.contains(&true) {
             self.pair(&entries, out);
             return;
