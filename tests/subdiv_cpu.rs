@@ -5,6 +5,7 @@ mod common;
 
 use common::shapes;
 use glam::DVec3;
+use texgeo::mesh::spec::MeshSpec;
 use texgeo::mesh::{Mesh, procedural};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::topology::Topology;
@@ -101,7 +102,9 @@ fn matches_committed_sharp_references() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reference/subdiv");
     for (name, level) in shapes::committed_sharp_references() {
         let shape = shapes::sharp().into_iter().find(|s| s.name == name).unwrap();
-        let input = texgeo::subdiv::tags::read(dir.join(format!("{name}.obj"))).unwrap();
+        let path = dir.join(format!("{name}.obj"));
+        let (mesh, tags) = MeshSpec::File(path.clone()).load_with_tags().unwrap();
+        let input = texgeo::subdiv::tags::interpret(mesh, &tags, &path).unwrap();
         let surface = input.surface(Default::default());
         assert_eq!(surface, shape.surface, "reference/subdiv/{name}.obj is not the test shape {name}");
         let path = dir.join(format!("{name}-level{level}.off"));

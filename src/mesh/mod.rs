@@ -14,6 +14,7 @@ pub mod frame;
 pub mod intersect;
 pub mod procedural;
 pub mod solidity;
+pub mod spec;
 pub mod stats;
 pub mod triangulate;
 pub mod validate;

@@ -1,5 +1,5 @@
 //! Catmull-Clark subdivision (2010 thesis, Ch. 3; SPEC §5): the sharp features
-//! and scheme options a control mesh carries ([`features`], read from OBJ tags by
+//! and scheme options a control mesh carries ([`features`], interpreted from OBJ tags by
 //! [`tags`]) and their sharpness arithmetic ([`crease`]), the CPU reference ([`cpu`]), the
 //! topology (OpenSubdiv's, non-manifold included) the fragment-mesh path builds on
 //! ([`topology`]), the fragment meshes ([`fragment`]), their GPU passes ([`gpu`]) and the

@@ -27,7 +27,8 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::mesh::error::Location;
-use crate::mesh::{Mesh, MeshError, formats};
+use crate::mesh::formats::{self, obj::Tags};
+use crate::mesh::{Mesh, MeshError};
 
 use super::features::{Boundary, Corner, Crease, CreaseMethod, Features, Options, Surface, Triangles};
 use super::{Result, SubdivError};
@@ -75,37 +76,12 @@ impl Tagged {
     }
 }
 
-/// Reads a mesh file; an OBJ file's tags come with it (other formats have none).
-pub fn read(path: impl AsRef<Path>) -> Result<Tagged> {
-    let path = path.as_ref();
-    if formats::Format::from_path(path)? != formats::Format::Obj {
-        let mesh = formats::read(path)?;
-        return Ok(Tagged {
-            mesh,
-            features: Features::default(),
-            options: TaggedOptions::default(),
-            ignored: Vec::new(),
-        });
-    }
-    let bytes = formats::read_file(path, formats::Format::Obj)?;
-    read_obj(&bytes, path)
-}
-
-/// Reads OBJ bytes with their tags; `path` only names the source in errors.
-pub fn read_obj(bytes: &[u8], path: &Path) -> Result<Tagged> {
-    if bytes.is_empty() {
-        return Err(MeshError::parse(path, Location::File, "the file is empty").into());
-    }
-    let (mesh, map) = formats::obj::read_mapped(bytes, path)?;
-    // The reader has checked the text is UTF-8.
-    let text = String::from_utf8_lossy(bytes);
-    let mut parser = Parser::new(path, &mesh, &map);
-    for (number, line) in text.lines().enumerate() {
-        let content = line.split('#').next().unwrap_or("");
-        let mut words = content.split_whitespace();
-        if words.next() == Some("t") {
-            parser.tag(number + 1, words.collect())?;
-        }
+/// Interprets the tags the OBJ reader kept ([`crate::mesh::spec::MeshSpec::load_with_tags`])
+/// on their mesh; `path` only names the file in errors.
+pub fn interpret(mesh: Mesh, tags: &Tags, path: &Path) -> Result<Tagged> {
+    let mut parser = Parser::new(path, &mesh, &tags.vertices);
+    for tag in &tags.tags {
+        parser.tag(tag.line, tag.words.iter().map(String::as_str).collect())?;
     }
     let Parser { features, options, ignored, .. } = parser;
     Ok(Tagged { mesh, features, options, ignored })
@@ -348,7 +324,9 @@ mod tests {
     use super::*;
 
     fn read(text: &str) -> Result<Tagged> {
-        read_obj(text.as_bytes(), Path::new("test.obj"))
+        let path = Path::new("test.obj");
+        let (mesh, tags) = formats::obj::read_with_tags(text.as_bytes(), path)?;
+        interpret(mesh, &tags, path)
     }
 
     const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 1 2 3 4\n";

@@ -17,6 +17,7 @@ use std::str::FromStr;
 use serde_json::{Map, Value};
 
 use super::{Result, SweepError};
+use crate::mesh::spec::MeshSpec;
 
 /// One mesh to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -130,11 +131,7 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
 }
 
 fn resolve(base: &Path, mesh: &str) -> String {
-    if mesh.starts_with("builtin:") || Path::new(mesh).is_absolute() {
-        mesh.to_string()
-    } else {
-        base.join(mesh).to_string_lossy().into_owned()
-    }
+    MeshSpec::parse(mesh).in_folder(base).to_string()
 }
 
 fn list_entries(base: &Path, text: &str) -> Vec<Entry> {

@@ -35,7 +35,8 @@ use serde_json::{Map, Value};
 use super::record::Record;
 use super::task::{Failure, Task, TaskKind, Visit, parse_options};
 use crate::gpu::{Context, ContextOptions, DeviceChoice};
-use crate::mesh::{Mesh, MeshError, formats, procedural, validate};
+use crate::mesh::spec::MeshSpec;
+use crate::mesh::{MeshError, validate};
 
 /// Environment variable of the test-only fault hook.
 pub const FAULT_VAR: &str = "TEXGEO_SWEEP_FAULT";
@@ -160,7 +161,7 @@ fn run_job<T: Task>(
             *ctx = Some(open(device).map_err(|e| Failure::failed("device", e))?);
         }
         let t = Instant::now();
-        let mesh = load(&job.path).map_err(unreadable)?;
+        let mesh = MeshSpec::parse(&job.path).load().map_err(unreadable)?;
         rec.time("read", t.elapsed());
         let t = Instant::now();
         let report = validate::report(&mesh);
@@ -181,19 +182,6 @@ fn run_job<T: Task>(
     // Without the reset (kernels before 4.0) this is the worker's peak so far.
     rec.peak_rss_kib = crate::host::peak_rss_kib();
     rec
-}
-
-/// A mesh file or `builtin:NAME`.
-fn load(path: &str) -> Result<Mesh, MeshError> {
-    match path.strip_prefix("builtin:") {
-        Some(name) => procedural::by_name(name).ok_or_else(|| {
-            MeshError::Unsuitable(format!(
-                "no built-in model '{name}' (built-ins: {})",
-                procedural::BUILTIN_NAMES.join(", ")
-            ))
-        }),
-        None => formats::read(path),
-    }
 }
 
 fn unreadable(e: MeshError) -> Failure {

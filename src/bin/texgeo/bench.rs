@@ -177,11 +177,7 @@ impl Models {
         }
         let mut out = Vec::new();
         for &(thesis, spec) in stand_ins {
-            let arg = if spec.starts_with("builtin:") {
-                MeshArg::from(spec)
-            } else {
-                MeshArg::from(self.models_dir.join(spec))
-            };
+            let arg = MeshArg::from(spec).in_folder(&self.models_dir);
             if arg.file().is_none_or(std::path::Path::exists) {
                 out.push((thesis, spec.to_string(), crate::mesh::load(&arg)?));
             } else {

@@ -1,16 +1,14 @@
 //! `texgeo mesh stats|convert|builtins`, and how every command reads its mesh.
 
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::frame::Frame;
 use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
 use texgeo::mesh::stats::Stats;
+use texgeo::mesh::spec::MeshSpec;
 use texgeo::mesh::{Mesh, formats, procedural};
-use texgeo::subdiv::Features;
-use texgeo::subdiv::tags::{self, Tagged, TaggedOptions};
+use texgeo::subdiv::tags::{self, Tagged};
 
 #[derive(clap::Subcommand)]
 pub enum Command {
@@ -34,80 +32,25 @@ pub enum Command {
     Builtins,
 }
 
-/// A mesh on the command line: a file path (any bytes, as the system allows: not only
-/// UTF-8) or `builtin:NAME`.
-#[derive(Clone, Debug)]
-pub struct MeshArg(PathBuf);
-
-impl From<OsString> for MeshArg {
-    fn from(s: OsString) -> MeshArg {
-        MeshArg(s.into())
-    }
-}
-
-impl From<PathBuf> for MeshArg {
-    fn from(p: PathBuf) -> MeshArg {
-        MeshArg(p)
-    }
-}
-
-impl From<&str> for MeshArg {
-    fn from(s: &str) -> MeshArg {
-        MeshArg(s.into())
-    }
-}
-
-impl std::fmt::Display for MeshArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.0.display().fmt(f)
-    }
-}
-
-impl MeshArg {
-    /// The NAME of `builtin:NAME`.
-    pub fn builtin(&self) -> Option<&str> {
-        self.0.to_str()?.strip_prefix("builtin:")
-    }
-
-    /// The file, unless it is a built-in model.
-    pub fn file(&self) -> Option<&Path> {
-        self.builtin().is_none().then_some(self.0.as_path())
-    }
-
-    /// The files among `args` (for "never overwrite an input").
-    pub fn files<'a>(args: impl IntoIterator<Item = &'a MeshArg>) -> Vec<&'a Path> {
-        args.into_iter().filter_map(MeshArg::file).collect()
-    }
-}
+/// A mesh on the command line: a file path or `builtin:NAME` ([`texgeo::mesh::spec`]).
+pub type MeshArg = MeshSpec;
 
 /// Reads a mesh file, or a built-in model given as `builtin:NAME`.
 pub fn load(spec: &MeshArg) -> anyhow::Result<Mesh> {
-    match (spec.builtin(), spec.file()) {
-        (Some(name), _) => procedural::by_name(name).with_context(|| {
-            format!("no built-in model '{name}' (built-ins: {})", procedural::BUILTIN_NAMES.join(", "))
-        }),
-        (None, Some(path)) => Ok(formats::read(path)?),
-        (None, None) => anyhow::bail!("{spec}: neither a file nor builtin:NAME"),
-    }
+    Ok(spec.load()?)
+}
+
+/// Reads a mesh with its sharp-feature tags (OpenSubdiv's `t crease`, … in an OBJ file;
+/// other formats and built-in models have none).
+pub fn load_tagged(spec: &MeshArg) -> anyhow::Result<Tagged> {
+    let (mesh, t) = spec.load_with_tags()?;
+    // Built-in models have no tags, hence no file to name.
+    Ok(tags::interpret(mesh, &t, spec.file().unwrap_or(Path::new("")))?)
 }
 
 /// Reads a mesh and lets it through only if it is a solid ([`solidity::require_solid`]),
 /// or what `policy` accepts; the error names the reason and, among `flags` (the command's
 /// own), the one that would accept it.
-/// Reads a mesh with its sharp-feature tags (OpenSubdiv's `t crease`, … in an OBJ file;
-/// other formats and built-in models have none).
-pub fn load_tagged(spec: &MeshArg) -> anyhow::Result<Tagged> {
-    let Some(path) = spec.file() else {
-        return Ok(Tagged {
-            mesh: load(spec)?,
-            features: Features::default(),
-            options: TaggedOptions::default(),
-            ignored: Vec::new(),
-        });
-    };
-    Ok(tags::read(path)?)
-}
-
 pub fn load_solid(spec: &MeshArg, policy: Policy, flags: &[&str]) -> anyhow::Result<Accepted> {
     let mesh = load(spec)?;
     solidity::require_solid(mesh, policy).map_err(|e| {

@@ -13,8 +13,10 @@
 //!    shared and a closed OBJ reads as a closed mesh.
 //!
 //! Vertices no face uses are dropped (`tobj` does not return them); the others keep their
-//! file order ([`read_mapped`] also returns the renumbering). Tags (`t` lines, the sharp
-//! features of subdivision surfaces) are skipped here; `subdiv::tags` reads them. Texture coordinates, normals and colours are checked but not kept. A face
+//! file order. Tags (`t` lines, the sharp features of subdivision surfaces) are kept as
+//! data ([`Tags`], from [`read_with_tags`]) with the renumbering their indices need;
+//! `subdiv::tags` interprets them. Texture coordinates, normals and colours are checked
+//! but not kept. A face
 //! may only use vertices defined before it (positive or relative indices), as written
 //! by every exporter; a forward reference is reported as out of range.
 
@@ -29,7 +31,7 @@ use crate::mesh::{Mesh, MeshError, Result, error::Location};
 /// Statements of the OBJ format that texgeo accepts but ignores.
 #[rustfmt::skip]
 const IGNORED: &[&str] = &[
-    "t", "l", "p", "s", "usemtl", "mtllib", "vp", "cstype", "deg", "bmat", "step", "curv", "curv2",
+    "l", "p", "s", "usemtl", "mtllib", "vp", "cstype", "deg", "bmat", "step", "curv", "curv2",
     "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg", "bevel", "c_interp",
     "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap", "call",
     "csh",
@@ -43,16 +45,38 @@ struct Checked {
     vertices: usize,
     /// The text to give `tobj` when it differs from the file.
     cleaned: Option<String>,
+    /// The `t` lines.
+    tags: Vec<Tag>,
+}
+
+/// One `t` line, uninterpreted.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Tag {
+    /// 1-based line number in the file.
+    pub line: usize,
+    /// The words after `t`.
+    pub words: Vec<String>,
+}
+
+/// An OBJ file's tags as read: the mesh does not interpret them (subdivision does).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Tags {
+    pub tags: Vec<Tag>,
+    /// File vertex (0-based, as tags count them) → mesh vertex, `u32::MAX` for a vertex no
+    /// face uses (dropped).
+    pub vertices: Vec<u32>,
 }
 
 /// Reads an OBJ file; `path` only names the source in errors.
 pub fn read(bytes: &[u8], path: &Path) -> Result<Mesh> {
-    Ok(read_mapped(bytes, path)?.0)
+    Ok(read_with_tags(bytes, path)?.0)
 }
 
-/// Reads an OBJ file and says where each of the file's vertices went: the mesh vertex,
-/// or `u32::MAX` for a vertex no face uses (dropped).
-pub fn read_mapped(bytes: &[u8], path: &Path) -> Result<(Mesh, Vec<u32>)> {
+/// Reads an OBJ file with its tags.
+pub fn read_with_tags(bytes: &[u8], path: &Path) -> Result<(Mesh, Tags)> {
+    if bytes.is_empty() {
+        return Err(MeshError::parse(path, Location::File, "the file is empty"));
+    }
     let text = utf8(bytes, path, 0, 0)?;
     let checked = check(text, path)?;
     let source = checked.cleaned.as_deref().unwrap_or(text);
@@ -65,7 +89,8 @@ pub fn read_mapped(bytes: &[u8], path: &Path) -> Result<(Mesh, Vec<u32>)> {
     let (models, _materials) =
         tobj::load_obj_buf(&mut source.as_bytes(), &options, |_| Err(tobj::LoadError::OpenFileFailed))
             .map_err(|e| MeshError::parse(path, Location::File, format!("tobj: {e}")))?;
-    assemble(&models, &checked, path)
+    let (mesh, vertices) = assemble(&models, &checked, path)?;
+    Ok((mesh, Tags { tags: checked.tags, vertices }))
 }
 
 /// Merges `tobj`'s models into one mesh, using the checked corner list for vertex identity;
@@ -147,6 +172,7 @@ fn check(text: &str, path: &Path) -> Result<Checked> {
     let mut corners = Vec::new();
     let (mut nv, mut nvt, mut nvn) = (0usize, 0usize, 0usize);
     let mut cleaned: Option<String> = None;
+    let mut tags = Vec::new();
     let mut start = 0usize;
     for (number, raw) in text.split_inclusive('\n').enumerate() {
         let line_no = number + 1;
@@ -224,6 +250,10 @@ fn check(text: &str, path: &Path) -> Result<Checked> {
                 }
             }
             "o" | "g" => {}
+            "t" => {
+                tags.push(Tag { line: line_no, words: words.map(str::to_string).collect() });
+                replace = Some(String::new());
+            }
             k if IGNORED.contains(&k) => replace = Some(String::new()),
             k => return Err(err(format!("unknown OBJ statement '{k}'"))),
         }
@@ -247,7 +277,7 @@ fn check(text: &str, path: &Path) -> Result<Checked> {
         }
         start += raw.len();
     }
-    Ok(Checked { corners, vertices: nv, cleaned })
+    Ok(Checked { corners, vertices: nv, cleaned, tags })
 }
 
 /// One `v`, `v/vt`, `v//vn` or `v/vt/vn` reference of a face, checked against the

@@ -11,6 +11,7 @@ use crate::boolean::{self, BooleanError, InputError, Names, Operation, Transform
 use crate::gpu::Context;
 use crate::inclusion::Method;
 use crate::mesh::covering::measures;
+use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, Report, procedural};
 use crate::report::bench::boolean::turned_copy;
 use crate::sweep::record::{Record, mesh_hash};
@@ -65,8 +66,8 @@ impl Options {
         if let Some(steps) = self.with.strip_prefix("transform:") {
             return Transform::parse(steps)?.apply(mesh).map_err(|e| e.to_string());
         }
-        if let Some(name) = self.with.strip_prefix("builtin:") {
-            return procedural::by_name(name).ok_or_else(|| format!("no built-in model '{name}'"));
+        if let spec @ MeshSpec::Builtin(_) = MeshSpec::parse(&self.with) {
+            return spec.load().map_err(|e| e.to_string());
         }
         Err(format!(
             "unknown second operand '{}' (expected turned, transform:STEPS or builtin:NAME)",
