@@ -9,6 +9,7 @@
 //! - [`host`]: the machine texgeo runs on (memory, CPU, load).
 //! - [`random`]: seeded random numbers.
 //! - [`terminal`]: every message for a person.
+//! - [`choice`]: `auto` or one method, the one way every algorithm's method is named.
 //! - [`exact`]: exact predicates and arithmetic on f64 inputs, one sign convention.
 //! - [`gpu`]: every Vulkan object: device, textures, render targets, passes, pipelines.
 //! - [`mesh`]: the polygon mesh, its names and file formats, validation and solidity.
@@ -29,6 +30,7 @@
 pub mod boolean;
 pub mod cache;
 pub mod check;
+pub mod choice;
 pub mod exact;
 pub mod gpu;
 pub mod host;

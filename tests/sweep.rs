@@ -65,7 +65,8 @@ fn summary(dir: &Path) -> String {
     text.split("## Slowest meshes").next().unwrap().to_string()
 }
 
-const VOXELIZE: [&str; 4] = ["--task", "voxelize", "--res", "16"];
+// A faithful GPU method, named (the task's default is `auto`, as for the command).
+const VOXELIZE: [&str; 6] = ["--task", "voxelize", "--method", "zoned", "--res", "16"];
 
 fn sweep(manifest: &Path, out: &Path, extra: &[&str], env: &[(&str, &str)]) -> Output {
     let mut args = vec!["sweep", manifest.to_str().unwrap(), "-o", out.to_str().unwrap()];
@@ -270,4 +271,33 @@ fn boolean_task_checks_against_cgal_and_shards_merge_alike() {
     }
     ok(&texgeo(&["sweep", "merge", sharded.to_str().unwrap()], &[]));
     assert_eq!(table(&sharded), reference);
+}
+
+/// Without `--method` a task uses the command's default, `auto`, and records which method
+/// it chose; a method that does not exist is refused with the command's message.
+#[test]
+fn tasks_default_to_auto_and_record_the_choice() {
+    let dir = temp("auto");
+    let m = dir.join("m.txt");
+    std::fs::write(&m, "builtin:cube\n").unwrap();
+    let run = |task: &str, extra: &[&str]| {
+        let out = dir.join(format!("{task}{}", extra.join("")));
+        let mut args = vec!["sweep", m.to_str().unwrap(), "-o", out.to_str().unwrap(), "--task", task];
+        args.extend(extra);
+        let o = texgeo(&args, &[]);
+        (o, out)
+    };
+    for (task, extra) in [("voxelize", ["--res", "8"]), ("inclusion", ["--points", "50"])] {
+        let (o, out) = run(task, &extra);
+        ok(&o);
+        let line = std::fs::read_to_string(out.join("results-0-of-1.jsonl")).unwrap();
+        let record: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+        assert_eq!(record["outcome"], "ok", "{task}: {line}");
+        assert!(record["checks"]["method"].as_str().is_some_and(|s| !s.is_empty()), "{task}: {line}");
+        assert_eq!(record["checks"]["differing"], 0, "{task}: {line}");
+    }
+    let (o, _) = run("voxelize", &["--method", "magic"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("task voxelize: no method 'magic' (auto, cpu, fgpu"), "{err}");
 }

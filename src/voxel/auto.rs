@@ -98,6 +98,17 @@ pub enum Device {
     Gpu,
 }
 
+impl Device {
+    /// The kind of `ctx`'s device (`None`: no device open).
+    pub fn of(ctx: Option<&crate::gpu::Context>) -> Device {
+        match ctx {
+            None => Device::None,
+            Some(c) if c.info().kind == "cpu" => Device::Cpu,
+            Some(_) => Device::Gpu,
+        }
+    }
+}
+
 /// The modelled time of `method` in seconds, on `threads` threads of rayon's pool.
 pub fn estimate(method: Method, c: &Counts, device: Device, threads: usize) -> Option<f64> {
     let par = 1.0 / (0.9 * threads.max(1) as f64).max(1.0);

@@ -24,7 +24,7 @@
 //! | `fang` | Fang & Chen: surface triangles sliced into slabs, XOR along y (§5.2.6) |
 //! | `scanline` | exact ray parity along x rows (§5.2.1) |
 //!
-//! `auto` ([`Choice::Auto`], the command's default) picks the fastest of them for the
+//! `auto` ([`crate::choice::Choice::Auto`], the command's default) picks the fastest of them for the
 //! device, solid and resolution from measured cost models ([`auto`]).
 
 pub mod aspect;
@@ -102,34 +102,7 @@ impl Method {
 }
 
 /// `--method`: one method, or `auto`, the fastest one by the cost models of [`auto`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Choice {
-    #[default]
-    Auto,
-    Method(Method),
-}
-
-impl std::str::FromStr for Choice {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Choice, String> {
-        if s == "auto" {
-            return Ok(Choice::Auto);
-        }
-        Method::parse(s).map(Choice::Method).ok_or_else(|| {
-            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            format!("no method '{s}' (auto, {})", names.join(", "))
-        })
-    }
-}
-
-impl std::fmt::Display for Choice {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Choice::Auto => f.write_str("auto"),
-            Choice::Method(m) => f.write_str(m.name()),
-        }
-    }
-}
+pub type Choice = crate::choice::Choice<Method>;
 
 /// The zone height of `zoned` (PGPU-MP, §5.4.2; `--zone`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

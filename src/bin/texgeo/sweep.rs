@@ -64,8 +64,8 @@ struct RunArgs {
     #[arg(long, conflicts_with = "resume")]
     restart: bool,
 
-    /// Task method (inclusion: gpu, cpu, …; voxelize: zoned, cpu, …; subdivide: gpu, cpu;
-    /// boolean: the inclusion method of its point tests).
+    /// Task method (inclusion: auto (default), cpu, gpu, …; voxelize: auto (default), zoned,
+    /// cpu, …; subdivide: gpu, cpu; boolean: the inclusion method of its point tests).
     #[arg(long, help_heading = "Task options")]
     method: Option<String>,
     /// inclusion: random points per mesh (default 1000).

@@ -102,7 +102,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mesh = solid.mesh;
     let grid = Grid::for_mesh(&mesh, args.res)?.in_frame(solid.frame);
     if let Some(defect) = &solid.non_solid {
-        if let Choice::Method(m) = args.method {
+        if let Choice::Fixed(m) = args.method {
             if m.uses_gpu() {
                 anyhow::bail!(
                     "{}: method {m} voxelizes solids only; under --allow-open a mesh that is not a solid is \
@@ -135,7 +135,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let solid = Solid::new(&mesh)?;
     let mut opened = None;
     let method = match args.method {
-        Choice::Method(m) => m,
+        Choice::Fixed(m) => m,
         Choice::Auto => {
             // Asked as if the GPU's draws were free: when a CPU method still wins, no
             // device is opened (the usual case on lavapipe and, by the models, elsewhere).
@@ -144,8 +144,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             let mut choice = Plan::choose(counts, plan::Device::Gpu, threads);
             if choice.method.uses_gpu() || args.aspect.is_some() {
                 let ctx = crate::open_context_for(device, "scanline")?;
-                let kind = if ctx.info().kind == "cpu" { plan::Device::Cpu } else { plan::Device::Gpu };
-                choice = Plan::choose(counts, kind, threads);
+                choice = Plan::choose(counts, plan::Device::of(Some(&ctx)), threads);
                 opened = Some(ctx);
             }
             note!("texgeo: --method auto: {}", choice.describe());

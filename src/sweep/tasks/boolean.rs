@@ -27,11 +27,13 @@ pub struct Options {
     /// steps), or `builtin:NAME`.
     pub with: String,
     /// Inclusion method for the point tests (`texgeo boolean --method`).
-    pub method: String,
+    #[serde(with = "crate::choice::by_name")]
+    pub method: Method,
     /// Regularized sets (the default) or the thesis' plain ones.
     pub regularized: bool,
     /// `cgal` (volume and area of the result against CGAL's, 1e-9 relative) or `none`.
-    pub reference: String,
+    #[serde(with = "crate::choice::by_name_or_none")]
+    pub reference: Option<Reference>,
 }
 
 impl Default for Options {
@@ -39,11 +41,18 @@ impl Default for Options {
         Options {
             op: "difference".into(),
             with: "turned".into(),
-            method: boolean::Options::default().method.to_string(),
+            method: boolean::Options::default().method,
             regularized: true,
-            reference: "none".into(),
+            reference: None,
         }
     }
+}
+
+/// What a Boolean's result is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Reference {
+    /// CGAL's Nef polyhedra: volume and area of the result.
+    Cgal,
 }
 
 /// Relative volume/area agreement asked of CGAL's result (as the tests ask).
@@ -52,10 +61,6 @@ const CGAL_TOLERANCE: f64 = 1e-9;
 impl Options {
     fn operation(&self) -> Result<Operation, String> {
         self.op.parse()
-    }
-
-    fn method(&self) -> Result<Method, String> {
-        self.method.parse::<Method>().map_err(|e| e.to_string())
     }
 
     /// The second operand for `mesh`.
@@ -86,16 +91,12 @@ impl Task for BooleanTask {
 
     fn validate(o: &Options) -> Result<(), String> {
         o.operation()?;
-        o.method()?;
         o.other(&procedural::cube())?;
-        match o.reference.as_str() {
-            "cgal" | "none" => Ok(()),
-            r => Err(format!("unknown reference '{r}' (expected cgal or none)")),
-        }
+        Ok(())
     }
 
     fn needs_device(o: &Options) -> bool {
-        o.method().is_ok_and(|m| !m.is_cpu())
+        !o.method.is_cpu()
     }
 
     fn run(
@@ -108,10 +109,7 @@ impl Task for BooleanTask {
     ) -> Result<(), Failure> {
         let op = o.operation().map_err(|e| Failure::failed("options", e))?;
         let other = o.other(mesh).map_err(|e| Failure::failed("options", e))?;
-        let options = boolean::Options {
-            method: o.method().map_err(|e| Failure::failed("options", e))?,
-            ..boolean::Options::default()
-        };
+        let options = boolean::Options { method: o.method, ..boolean::Options::default() };
         let names = Names { a: "the mesh", b: "the second operand" };
         let ev = boolean::evaluate(mesh, &other, names, &options, ctx).map_err(refusal)?;
         let t = &ev.timings;
@@ -161,7 +159,7 @@ impl Task for BooleanTask {
             }
         }
 
-        if o.reference == "cgal" {
+        if o.reference == Some(Reference::Cgal) {
             let start = Instant::now();
             // CGAL refusing an operand texgeo accepts (a non-manifold solid, say) is recorded,
             // not failed: it is the reference that cannot answer.

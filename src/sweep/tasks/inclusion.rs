@@ -17,8 +17,9 @@ use crate::sweep::task::{Failure, Task};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Options {
-    /// The method under test (`texgeo inclusion --method`).
-    pub method: String,
+    /// The method under test (`texgeo inclusion --method`; `auto` is recorded as `method`).
+    #[serde(with = "crate::choice::by_name")]
+    pub method: Method,
     /// Uniform random points in the bounding box.
     pub points: usize,
     pub seed: u64,
@@ -26,8 +27,9 @@ pub struct Options {
     pub grid: usize,
     /// GPU methods: tetrahedra per point-vertex.
     pub batch: Option<u32>,
-    /// A CPU method every answer is compared with, or `none`.
-    pub reference: String,
+    /// A CPU method every answer is compared with (`none`: no comparison).
+    #[serde(with = "crate::choice::by_name_or_none")]
+    pub reference: Option<Method>,
     /// Accept meshes that are not solids (open, self-intersecting, nested, inverted): their
     /// points are classified by the generalized winding number (inside iff w ≥ ½) on the
     /// CPU whatever the method, compared with the direct sum over every triangle, and the
@@ -38,12 +40,12 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            method: "gpu".into(),
+            method: Method::Auto,
             points: 1000,
             seed: 1,
             grid: inclusion::tetragrid::DEFAULT_RESOLUTION,
             batch: None,
-            reference: "cpu".into(),
+            reference: Some(Method::Cpu),
             allow_open: false,
         }
     }
@@ -53,26 +55,14 @@ impl Default for Options {
 #[derive(Default)]
 pub struct Inclusion;
 
-impl Options {
-    fn reference(&self) -> Result<Option<Method>, String> {
-        if self.reference == "none" {
-            return Ok(None);
-        }
-        let m: Method = self.reference.parse().map_err(|e: InclusionError| e.to_string())?;
-        if !m.is_cpu() {
-            return Err(format!("reference '{m}' must be a CPU method (or none)"));
-        }
-        Ok(Some(m))
-    }
-}
-
 impl Task for Inclusion {
     const NAME: &'static str = "inclusion";
     type Options = Options;
 
     fn validate(o: &Options) -> Result<(), String> {
-        o.method.parse::<Method>().map_err(|e| e.to_string())?;
-        o.reference()?;
+        if let Some(m) = o.reference.filter(|m| !m.is_cpu()) {
+            return Err(format!("reference '{m}' must be a CPU method (or none)"));
+        }
         if o.points == 0 || o.points > 100_000_000 {
             return Err(format!("points {} is outside 1..=100000000", o.points));
         }
@@ -80,7 +70,7 @@ impl Task for Inclusion {
     }
 
     fn needs_device(o: &Options) -> bool {
-        o.method.parse::<Method>().is_ok_and(|m| !m.is_cpu())
+        !o.method.is_cpu()
     }
 
     fn run(
@@ -91,7 +81,6 @@ impl Task for Inclusion {
         o: &Options,
         out: &mut Record,
     ) -> Result<(), Failure> {
-        let method: Method = o.method.parse().map_err(|e| Failure::failed("options", e))?;
         // The same gate as `texgeo inclusion`: what the command refuses, the sweep refuses.
         let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
         let accepted = require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?;
@@ -112,7 +101,10 @@ impl Task for Inclusion {
         }
 
         let t = Instant::now();
-        let mut solver = Solver::new(method, mesh, &options, ctx, o.batch).map_err(refusal)?;
+        let mut solver = Solver::new(o.method, mesh, &options, ctx, o.batch).map_err(refusal)?;
+        if o.method == Method::Auto {
+            out.check("method", solver.name());
+        }
         out.time("build", t.elapsed());
         let t = Instant::now();
         let classes = solver.classify_all(&points).map_err(refusal)?;
@@ -129,7 +121,7 @@ impl Task for Inclusion {
         h.bytes(&classes.iter().map(|&c| c as u8).collect::<Vec<_>>());
         out.hash("classes", &h);
 
-        let Some(reference) = o.reference().map_err(|e| Failure::failed("options", e))? else {
+        let Some(reference) = o.reference else {
             return Ok(());
         };
         let t = Instant::now();
@@ -177,7 +169,7 @@ fn winding_rule(
     let mut h = Fnv::default();
     h.bytes(&classes.iter().map(|&c| c as u8).collect::<Vec<_>>());
     out.hash("classes", &h);
-    if o.reference == "none" {
+    if o.reference.is_none() {
         return Ok(());
     }
     let t = Instant::now();

@@ -10,17 +10,20 @@ use crate::mesh::solidity::{Policy, require_solid};
 use crate::mesh::{Mesh, Report};
 use crate::sweep::record::{Fnv, Record};
 use crate::sweep::task::{Failure, Task};
-use crate::voxel::{Grid, Method, Solid, VoxelError, Voxelizer, Zone, grid};
+use crate::voxel::auto::{Counts, Device, Plan};
+use crate::voxel::{Choice, Grid, Method, Solid, VoxelError, Voxelizer, Zone, grid};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Options {
-    /// The method under test (`texgeo voxelize --method`).
-    pub method: String,
+    /// The method under test (`texgeo voxelize --method`; `auto` chooses among the
+    /// methods the worker's device runs, and is recorded as `method`).
+    pub method: Choice,
     /// Voxels per side.
     pub res: usize,
-    /// The method every voxel is compared with, or `none`.
-    pub reference: String,
+    /// The method every voxel is compared with (`none`: no comparison).
+    #[serde(with = "crate::choice::by_name_or_none")]
+    pub reference: Option<Method>,
     /// Zone height for `zoned` (default: chosen from the mesh and memory).
     pub zone: Option<usize>,
     /// Accept meshes that are not solids (`voxelize --allow-open`): their voxels are the
@@ -33,22 +36,13 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            method: "zoned".into(),
+            method: Choice::Auto,
             res: 64,
-            reference: "scanline".into(),
+            reference: Some(Method::Scanline),
             zone: None,
             allow_open: false,
         }
     }
-}
-
-fn method(name: &str) -> Result<Method, String> {
-    Method::parse(name).ok_or_else(|| {
-        format!(
-            "unknown voxelization method '{name}' (expected {})",
-            Method::ALL.map(|m| m.name()).join(", ")
-        )
-    })
 }
 
 /// Solid voxelization by slicing tetrahedra; keeps one [`Voxelizer`] (and its pipelines)
@@ -76,16 +70,11 @@ impl Task for Voxelize {
     type Options = Options;
 
     fn validate(o: &Options) -> Result<(), String> {
-        method(&o.method)?;
-        if o.reference != "none" {
-            method(&o.reference)?;
-        }
         grid::check_resolution(o.res).map_err(|e| e.to_string())
     }
 
     fn needs_device(o: &Options) -> bool {
-        let gpu = |name: &str| Method::parse(name).is_some_and(Method::uses_gpu);
-        gpu(&o.method) || gpu(&o.reference)
+        [o.method.fixed(), o.reference].into_iter().flatten().any(Method::uses_gpu)
     }
 
     fn run(
@@ -96,7 +85,6 @@ impl Task for Voxelize {
         o: &Options,
         out: &mut Record,
     ) -> Result<(), Failure> {
-        let m = method(&o.method).map_err(|e| Failure::failed("options", e))?;
         let refusal = |e: VoxelError| refusal(e, report);
         // The same gate as `texgeo voxelize`: what the command refuses, the sweep refuses.
         let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
@@ -111,6 +99,12 @@ impl Task for Voxelize {
         let solid = Solid::new(mesh).map_err(refusal)?;
         out.time("covering", t.elapsed());
         out.size("res", o.res);
+        let m = o.method.fixed().unwrap_or_else(|| {
+            let threads = rayon::current_num_threads();
+            let m = Plan::choose(Counts::new(&solid, &grid), Device::of(ctx), threads).method;
+            out.check("method", m.name());
+            m
+        });
 
         let result = self.voxelizer(ctx, o.zone).run(&solid, &grid, m).map_err(refusal)?;
         let t = result.timings;
@@ -137,10 +131,9 @@ impl Task for Voxelize {
         }
         out.hash("volume", &h);
 
-        if o.reference == "none" {
+        let Some(r) = o.reference else {
             return Ok(());
-        }
-        let r = method(&o.reference).map_err(|e| Failure::failed("options", e))?;
+        };
         let t = Instant::now();
         let expected = self.voxelizer(ctx, o.zone).run(&solid, &grid, r).map_err(refusal)?;
         out.time("reference", t.elapsed());
@@ -175,7 +168,7 @@ fn winding_rule(mesh: &Mesh, o: &Options, out: &mut Record) -> Result<(), Failur
         }
     }
     out.hash("volume", &h);
-    if o.reference == "none" {
+    if o.reference.is_none() {
         return Ok(());
     }
     let t = Instant::now();
