@@ -613,3 +613,25 @@ fn the_labels_do_not_depend_on_the_number_of_threads() {
         assert_eq!(runs[0], one_by_one, "{m}");
     }
 }
+
+/// The solver streams a point source block by block with the answers of one call on all
+/// the points, and says when the source is done.
+#[test]
+fn a_solver_streams_what_it_answers_at_once() {
+    use texgeo::inclusion::points::PointReader;
+    use texgeo::inclusion::solver::Solver;
+    let mesh = procedural::torus_knot();
+    let (lo, hi) = mesh.bounds();
+    let points = Rng::new(3).points_in_box(500, lo, hi);
+    for method in [Method::Cpu, Method::Octants] {
+        let mut solver = Solver::new(method, &mesh, &Options::default(), None, None).unwrap();
+        let whole = solver.classify_all(&points).unwrap();
+        let mut source = PointReader::from_points(points.clone(), "points");
+        let mut streamed = Vec::new();
+        while let Some(parts) = solver.classify_next(&mut source).unwrap() {
+            streamed.extend(parts.into_iter().flatten());
+        }
+        assert_eq!(streamed, whole, "{method}");
+        assert_eq!(solver.name(), method.name());
+    }
+}

@@ -27,6 +27,9 @@ pub enum InclusionError {
          by its generalized winding number on the CPU (--method auto, or any CPU method)"
     )]
     NotForNonSolids(&'static str),
+    /// Reading the points to classify.
+    #[error(transparent)]
+    Points(#[from] crate::mesh::MeshError),
 }
 
 impl From<crate::gpu::GpuError> for InclusionError {

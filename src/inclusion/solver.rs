@@ -21,6 +21,7 @@ use super::jordan::Jordan;
 use super::method::{Method, Options};
 use super::octants::Octants;
 use super::octree::JordanOctree;
+use super::points::PointReader;
 use super::tetragrid::GridClassifier;
 use super::voxel_space::VoxelSpace;
 use super::winding::WindingNumber;
@@ -86,8 +87,7 @@ pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Optio
         let choice = Choice { method: Method::Winding, resolution: None, predicted: f64::NAN };
         return (Method::Winding, *options, Some(choice));
     }
-    let triangles = mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum();
-    let choice = auto::choose(triangles, options.points);
+    let choice = auto::choose(triangles(mesh), options.points);
     let mut options = *options;
     if choice.resolution.is_some() && options.voxel_space_resolution.is_none() {
         options.voxel_space_resolution = choice.resolution;
@@ -132,6 +132,12 @@ pub fn classify_accepted(
     Ok((classes, solver.name().to_string()))
 }
 
+/// The triangles the cost models count: a triangle is one, a polygon of n sides n (its
+/// fan about the centroid).
+fn triangles(mesh: &Mesh) -> usize {
+    mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum()
+}
+
 /// Builds the CPU classifier `method` for `mesh` (GPU methods: [`Solver::new`]).
 pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
     let (method, options, _) = resolve(method, mesh, options);
@@ -154,10 +160,9 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
         }
         Method::Winding => Box::new(WindingNumber::with_policy(mesh, options.allow_open)?),
         Method::VoxelSpace => {
-            let triangles = mesh.faces().map(|f| if f.len() == 3 { 1 } else { f.len() }).sum();
             let n = options
                 .voxel_space_resolution
-                .unwrap_or_else(|| super::voxel_space::resolution_for(triangles, options.points));
+                .unwrap_or_else(|| super::voxel_space::resolution_for(triangles(mesh), options.points));
             // Without the closure check when the caller made it (the same unbalanced-edge test).
             Box::new(VoxelSpace::new(mesh, n, options.allow_open || options.known_closed)?)
         }
@@ -211,7 +216,7 @@ impl Solver {
         match self {
             Solver::Cpu(c) => c.name(),
             Solver::Gpu(g) => g.name(),
-            Solver::GpuGrid(_) => "gpu+tetragrid",
+            Solver::GpuGrid(_) => Method::GpuTetraGrid.name(),
         }
     }
 
@@ -221,6 +226,16 @@ impl Solver {
             Solver::Gpu(g) => g.classify_all(points),
             Solver::GpuGrid(g) => g.classify_all(points),
         }
+    }
+
+    /// Classifies the next block of `source` (`None` at its end), in the parts it was
+    /// read in: a CPU method classifies each part in the task that parsed it, a GPU
+    /// method the whole block in its draws.
+    pub fn classify_next(&mut self, source: &mut PointReader) -> Result<Option<Vec<Vec<Class>>>> {
+        if let Solver::Cpu(c) = self {
+            return Ok(source.next_block_with(|points| c.classify_all(&points))?);
+        }
+        source.next_block()?.map(|points| self.classify_all(&points).map(|c| vec![c])).transpose()
     }
 
     /// GPU time split of the last call (`None` for CPU methods).

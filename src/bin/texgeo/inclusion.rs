@@ -166,17 +166,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         let t = Instant::now();
         let parts: Vec<Vec<Class>> = match block.take() {
             Some(parts) => parts.iter().map(|pts| solver.classify_all(pts)).collect::<Result<_, _>>()?,
-            None => {
-                let parts = if let Solver::Cpu(c) = &solver {
-                    source.next_block_with(|pts| c.classify_all(&pts))?
-                } else {
-                    source.next_block()?.map(|pts| solver.classify_all(&pts).map(|c| vec![c])).transpose()?
-                };
-                match parts {
-                    Some(parts) => parts,
-                    None => break,
-                }
-            }
+            None => match solver.classify_next(&mut source)? {
+                Some(parts) => parts,
+                None => break,
+            },
         };
         run += t.elapsed();
         if let Some(g) = solver.gpu_stats() {

@@ -191,5 +191,6 @@ fn refusal(e: InclusionError) -> Failure {
         | InclusionError::NotForNonSolids(_) => Failure::refused("options", e),
         InclusionError::Gpu(_) => Failure::failed("gpu", e),
         InclusionError::NeedsGpu(_) => Failure::failed("device", e),
+        InclusionError::Points(_) => Failure::failed("points", e),
     }
 }
