@@ -7,8 +7,6 @@ pub enum InclusionError {
     /// The covering methods need a closed, consistently oriented boundary (SPEC §1).
     #[error("the mesh is not closed and consistently oriented: {0}")]
     NotClosed(UnbalancedEdge),
-    #[error("unknown inclusion method '{name}' (expected one of: {expected})")]
-    UnknownMethod { name: String, expected: String },
     #[error("tetragrid resolution {0} is outside 2..=64")]
     Resolution(usize),
     #[error("octree depth {0} is outside 1..=10")]

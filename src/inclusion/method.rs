@@ -1,11 +1,8 @@
 //! The inclusion methods and their options, as the command line names them.
 
 use std::fmt;
-use std::str::FromStr;
 
 use glam::DVec3;
-
-use super::error::InclusionError;
 
 /// The inclusion methods (`--method`). [`super::solver::Solver::new`] builds any of them;
 /// [`Method::is_cpu`] says which ones [`super::solver::build`] can make without a device.
@@ -79,10 +76,6 @@ impl Method {
         }
     }
 
-    pub fn names() -> Vec<&'static str> {
-        std::iter::once(Method::Auto).chain(Method::ALL).map(|m| m.name()).collect()
-    }
-
     /// True for methods that run on the CPU alone (`auto` only picks those).
     pub fn is_cpu(self) -> bool {
         !matches!(self, Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid)
@@ -92,15 +85,6 @@ impl Method {
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl FromStr for Method {
-    type Err = InclusionError;
-    fn from_str(s: &str) -> Result<Method, InclusionError> {
-        std::iter::once(Method::Auto).chain(Method::ALL).find(|m| m.name() == s).ok_or_else(|| {
-            InclusionError::UnknownMethod { name: s.to_string(), expected: Method::names().join(", ") }
-        })
     }
 }
 
@@ -157,14 +141,11 @@ mod tests {
     #[test]
     fn method_names_round_trip() {
         for m in Method::ALL {
-            assert_eq!(m.name().parse::<Method>().unwrap(), m);
             assert_eq!(m.to_possible_value().unwrap().get_name(), m.name());
         }
         assert_eq!(Method::value_variants()[0], Method::Auto);
         assert_eq!(Method::value_variants()[1..], Method::ALL);
-        assert_eq!("auto".parse::<Method>().unwrap(), Method::Auto);
-        let e = "gpu+magic".parse::<Method>().unwrap_err().to_string();
-        assert!(e.contains("gpu+magic") && e.contains("jordan-octree"), "{e}");
+        assert_eq!(crate::choice::parse::<Method>("auto"), Some(Method::Auto));
         assert_eq!(Class::OnBoundary as u8, 2);
     }
 }

@@ -52,8 +52,8 @@ pub enum Command {
         #[command(flatten)]
         models: Models,
         /// CPU inclusion method for the point tests.
-        #[arg(long, default_value = "octants")]
-        method: String,
+        #[arg(long, value_enum, default_value_t = texgeo::inclusion::Method::Octants)]
+        method: texgeo::inclusion::Method,
         /// Skip the plain classification (one point test per triangle; slow on big models).
         #[arg(long)]
         no_plain: bool,
@@ -364,9 +364,8 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             let cfg = Config { points, methods, sizes, voxel_methods, threads: thread_counts, runs, budget };
             finish(around.run(|| bench::scale::run(ctx, &inclusion, &voxel, &cfg))?, &Common { runs, out })
         }
-        Command::Boolean { models, method, no_plain, no_cgal, scaling, common } => {
+        Command::Boolean { models, method: cpu_method, no_plain, no_cgal, scaling, common } => {
             use bench::boolean::{Config, Pair, STAND_INS};
-            let cpu_method: texgeo::inclusion::Method = method.parse()?;
             anyhow::ensure!(
                 cpu_method.is_cpu(),
                 "--method takes a CPU inclusion method (the GPU one always runs)"

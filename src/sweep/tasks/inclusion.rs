@@ -187,7 +187,6 @@ fn refusal(e: InclusionError) -> Failure {
         InclusionError::Resolution(_)
         | InclusionError::OctreeDepth(_)
         | InclusionError::Options(_)
-        | InclusionError::UnknownMethod { .. }
         | InclusionError::NotForNonSolids(_) => Failure::refused("options", e),
         InclusionError::Gpu(_) => Failure::failed("gpu", e),
         InclusionError::NeedsGpu(_) => Failure::failed("device", e),
