@@ -15,6 +15,7 @@ use texgeo::boolean::{self, Names, Operation};
 use texgeo::gpu::{Context, ContextOptions, DeviceChoice, GpuError};
 use texgeo::inclusion::solver::classify_accepted;
 use texgeo::mesh::solidity::{self, Policy};
+use texgeo::mesh::spec::MeshSpec;
 use texgeo::mesh::stats::Stats;
 use texgeo::mesh::{Mesh, formats, procedural, triangulate};
 use texgeo::subdiv::tags::{self, TaggedOptions};
@@ -236,7 +237,7 @@ impl RawMesh {
         allow_open: bool,
         flip_inverted: bool,
     ) -> PyResult<(Bound<'py, PyByteArray>, String)> {
-        let method: texgeo::inclusion::Method = method.parse().map_err(err(Kind::Inclusion))?;
+        let method = inclusion_method(method, Kind::Inclusion)?;
         let points = points_of(points, "points")?;
         let policy = Policy { allow_open, flip_inverted, ..Policy::default() };
         let mesh = &self.mesh;
@@ -381,16 +382,28 @@ impl RawVoxels {
 /// Reads a mesh file (with its OBJ tags) or `builtin:NAME`.
 #[pyfunction]
 fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<RawMesh> {
-    if let Some(name) = path.to_str().and_then(|s| s.strip_prefix("builtin:")) {
-        return procedural::by_name(name).map(RawMesh::plain).ok_or_else(|| {
-            MeshError::new_err(format!(
-                "no built-in model '{name}' (built-ins: {})",
-                procedural::BUILTIN_NAMES.join(", ")
-            ))
-        });
-    }
-    let tagged = work(py, || tags::read(&path)).map_err(err(Kind::Mesh))?;
+    let spec = MeshSpec::parse(path.as_os_str());
+    let tagged = work(py, || -> PyResult<_> {
+        let (mesh, t) = spec.load_with_tags().map_err(err(Kind::Mesh))?;
+        // Built-in models have no tags, hence no file to name.
+        tags::interpret(mesh, &t, spec.file().unwrap_or(std::path::Path::new(""))).map_err(err(Kind::Mesh))
+    })?;
     Ok(RawMesh { mesh: tagged.mesh, features: tagged.features, options: tagged.options })
+}
+
+/// An inclusion method by its command-line name (`auto` included), as `--method` takes it.
+fn inclusion_method(name: &str, kind: Kind) -> PyResult<texgeo::inclusion::Method> {
+    texgeo::choice::parse::<texgeo::inclusion::Method>(name).ok_or_else(|| {
+        let expected: Vec<&str> = std::iter::once(texgeo::inclusion::Method::Auto)
+            .chain(texgeo::inclusion::Method::ALL)
+            .map(texgeo::inclusion::Method::name)
+            .collect();
+        let msg = format!("unknown inclusion method '{name}' (expected one of: {})", expected.join(", "));
+        match kind {
+            Kind::Boolean => BooleanError::new_err(msg),
+            _ => InclusionError::new_err(msg),
+        }
+    })
 }
 
 /// The names of the built-in models.
@@ -400,7 +413,7 @@ fn builtins() -> Vec<&'static str> {
 }
 
 fn boolean_options(method: &str, allow_self_intersections: bool) -> PyResult<boolean::Options> {
-    let method: texgeo::inclusion::Method = method.parse().map_err(err(Kind::Boolean))?;
+    let method = inclusion_method(method, Kind::Boolean)?;
     Ok(boolean::Options { method, allow_self_intersections, ..boolean::Options::default() })
 }
 

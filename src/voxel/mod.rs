@@ -246,7 +246,7 @@ pub fn voxelize_accepted(
 ) -> Result<(Grid, Volume, String)> {
     let grid = Grid::for_mesh(&accepted.mesh, n)?.in_frame(accepted.frame);
     if accepted.non_solid.is_some() {
-        if let Choice::Method(m) = choice {
+        if let Choice::Fixed(m) = choice {
             if m.uses_gpu() {
                 return Err(VoxelError::Usage(format!(
                     "method {m} voxelizes solids only; a mesh that is not a solid is voxelized by its \
@@ -263,7 +263,7 @@ pub fn voxelize_accepted(
     let mut open = || ctx.take().map_or_else(|| Err(VoxelError::Usage("no device".into())), |f| f());
     let mut opened = None;
     let method = match choice {
-        Choice::Method(m) => m,
+        Choice::Fixed(m) => m,
         Choice::Auto => {
             let counts = auto::Counts::new(&solid, &grid);
             let threads = rayon::current_num_threads();

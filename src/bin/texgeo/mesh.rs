@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::frame::Frame;
 use texgeo::mesh::solidity::{self, Accepted, Defect, Policy};
-use texgeo::mesh::stats::Stats;
 use texgeo::mesh::spec::MeshSpec;
+use texgeo::mesh::stats::Stats;
 use texgeo::mesh::{Mesh, formats, procedural};
 use texgeo::subdiv::tags::{self, Tagged};
 
