@@ -298,7 +298,10 @@ fn outputs_are_checked_against_what_the_command_writes_and_never_replace_an_inpu
     std::os::unix::fs::symlink(&knot, dir.join("link.off")).unwrap();
     std::fs::write(dir.join("p.txt"), "0 0 0\n").unwrap();
     for (args, needle) in [
-        (vec!["voxelize", &knot, "--res", "8", "-o", &knot], "written as binvox or NumPy; name it .binvox or .npy"),
+        (
+            vec!["voxelize", &knot, "--res", "8", "-o", &knot],
+            "written as binvox or NumPy; name it .binvox or .npy",
+        ),
         (vec!["voxelize", "builtin:knot", "--res", "8", "-o", &dir.arg("v.png")], "name it .binvox"),
         (vec!["mesh", "convert", &knot, &knot], "is an input of this run"),
         (vec!["mesh", "convert", &knot, &dir.arg("link.off")], "is an input of this run"),
