@@ -268,16 +268,7 @@ pub fn finish(
                 }
             }
             if gone.iter().any(|&g| g) {
-                let keep: Vec<bool> = gone.iter().map(|g| !g).collect();
-                retain_marked(&mut soup.triangles, &keep);
-                retain_marked(&mut origin, &keep);
-                retain_marked(&mut changed, &keep);
-                for (t, o) in added {
-                    soup.triangles.push(t);
-                    origin.push(o);
-                    changed.push(true);
-                }
-                soup.face_of = (0..soup.triangles.len() as u32).collect();
+                replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
                 continue;
             }
         }
@@ -303,16 +294,7 @@ pub fn finish(
                 added.extend(f.added);
             }
             if gone.iter().any(|&g| g) {
-                let keep: Vec<bool> = gone.iter().map(|g| !g).collect();
-                retain_marked(&mut soup.triangles, &keep);
-                retain_marked(&mut origin, &keep);
-                retain_marked(&mut changed, &keep);
-                for (t, o) in added {
-                    soup.triangles.push(t);
-                    origin.push(o);
-                    changed.push(true);
-                }
-                soup.face_of = (0..soup.triangles.len() as u32).collect();
+                replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
                 continue;
             }
         }
@@ -617,6 +599,27 @@ fn collapse(
     }
     soup.face_of = (0..soup.triangles.len() as u32).collect();
     repair.removed_triangles += before - soup.triangles.len();
+}
+
+/// Removes the triangles marked in `gone` and appends `added` (each with the input face it
+/// came from) as changed ones.
+fn replace_marked(
+    soup: &mut TriangleSoup,
+    origin: &mut Vec<u32>,
+    changed: &mut Vec<bool>,
+    gone: &[bool],
+    added: Vec<([u32; 3], u32)>,
+) {
+    let keep: Vec<bool> = gone.iter().map(|g| !g).collect();
+    retain_marked(&mut soup.triangles, &keep);
+    retain_marked(origin, &keep);
+    retain_marked(changed, &keep);
+    for (t, o) in added {
+        soup.triangles.push(t);
+        origin.push(o);
+        changed.push(true);
+    }
+    soup.face_of = (0..soup.triangles.len() as u32).collect();
 }
 
 /// Keeps the items of `v` whose flag in `keep` is set.
