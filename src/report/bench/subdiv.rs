@@ -150,11 +150,7 @@ pub fn measure(
                     last = Some(run);
                     Ok(total)
                 },
-                &mut || -> Result<Duration> {
-                    let start = Instant::now();
-                    cpu::refine(mesh, level)?;
-                    Ok(start.elapsed())
-                },
+                &mut || -> Result<Duration> { cpu_once(mesh, level) },
                 &mut || -> Result<Duration> { osd_once(mesh, level) },
             ],
         )?;
@@ -198,6 +194,13 @@ pub fn measure(
 
 /// One timed OpenSubdiv refine + interpolate, as the helper measured it (no output
 /// written; the helper's start is not counted).
+/// One timed run of the CPU reference.
+fn cpu_once(mesh: &Mesh, level: u32) -> Result<Duration> {
+    let start = Instant::now();
+    cpu::refine(mesh, level)?;
+    Ok(start.elapsed())
+}
+
 fn osd_once(mesh: &Mesh, level: u32) -> Result<Duration> {
     let options = osd::Options { repeat: Some(1), no_output: true, ..Default::default() };
     let timed = osd::run(&crate::subdiv::Surface::smooth(mesh.clone()), level, &options)?;
@@ -245,11 +248,7 @@ pub fn per_level(
                     gpu_levels = run.gpu_levels;
                     Ok(run.times.total)
                 },
-                &mut || -> Result<Duration> {
-                    let start = Instant::now();
-                    cpu::refine(mesh, level)?;
-                    Ok(start.elapsed())
-                },
+                &mut || -> Result<Duration> { cpu_once(mesh, level) },
                 &mut || -> Result<Duration> { osd_once(mesh, level) },
             ],
         )?;
