@@ -23,6 +23,7 @@ alone (construction from arrays, the Boolean, extraction), as its own benchmarks
 """
 import argparse
 import csv
+import json
 import importlib.util
 import math
 import os
@@ -128,17 +129,12 @@ def run(cmd, timeout):
 
 
 def stats_of(texgeo, path, timeout):
-    """(is a solid texgeo accepts, volume) of a mesh file, by `texgeo mesh stats`."""
-    p, rc, _ = run([texgeo, "mesh", "stats", path], timeout)
+    """(is a solid texgeo accepts, volume) of a mesh file, by `texgeo mesh stats --json`."""
+    p, rc, _ = run([texgeo, "mesh", "stats", "--json", path], timeout)
     if p == "timeout" or rc != 0:
         return False, None
-    solid, volume = False, None
-    for line in p.stdout.splitlines():
-        if line.startswith("solid:") or line.startswith("solid "):
-            solid = "yes" in line.split(":", 1)[-1] or line.split()[1] == "yes"
-        if line.startswith("volume"):
-            volume = float(line.split()[1])
-    return solid, volume
+    stats = json.loads(p.stdout)
+    return bool(stats.get("solid")), stats.get("volume")
 
 
 def texgeo_op(texgeo, a, b, op, out, timeout):
