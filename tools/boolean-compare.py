@@ -202,6 +202,8 @@ def main():
     ap.add_argument("--texgeo", required=True)
     ap.add_argument("--cgal", default="")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--resume", action="store_true",
+                    help="keep the models OUT/results.csv already holds and run only the others")
     args = ap.parse_args()
     transforms = [t for t in args.transforms.split(",") if t]
     for t in transforms:
@@ -215,14 +217,22 @@ def main():
         f for f in os.listdir(args.corpus) if f.endswith(".off"))
     work = os.path.join(args.out, "work")
     os.makedirs(work, exist_ok=True)
-    rows = []
+    rows = read_rows(args.out) if args.resume else []
+    done = {r["model"] for r in rows}
     for name in names:
         src = os.path.join(args.corpus, name)
+        if name[:-4] in done:
+            continue
         solid, _ = stats_of(args.texgeo, src, args.timeout)
         if not solid:
             print(f"{name}: not a solid texgeo accepts, skipped", file=sys.stderr)
             continue
-        pos, tris = read_off(src)
+        # texgeo's own reader normalises the corpus' OFF dialects (COFF colours, comments) first
+        plain = os.path.join(work, f"{name[:-4]}.in.off")
+        if run([args.texgeo, "mesh", "convert", src, plain], args.timeout)[1] != 0:
+            print(f"{name}: texgeo could not convert it, skipped", file=sys.stderr)
+            continue
+        pos, tris = read_off(plain)
         if args.max_faces and len(tris) > args.max_faces:
             continue
         stem = name[:-4]
@@ -260,12 +270,32 @@ def main():
                         os.remove(out)
                 line = " ".join(f"{r['tool']}={r['outcome']}" for r in rows[-(2 if args.no_cgal else 3):])
                 print(f"{stem} {tname} {op}: {line}", file=sys.stderr)
+        write_tables(args.out, rows, quiet=True)  # a long run keeps what it measured so far
     write_tables(args.out, rows)
 
 
-def write_tables(out, rows):
-    fields = ["model", "triangles", "transform", "op", "tool", "outcome", "seconds", "volume",
-              "rel_volume_diff", "valid", "message"]
+FIELDS = ["model", "triangles", "transform", "op", "tool", "outcome", "seconds", "volume",
+          "rel_volume_diff", "valid", "message"]
+
+
+def read_rows(out):
+    """The rows of an earlier run's results.csv, numbers as numbers (empty when there is none)."""
+    path = os.path.join(out, "results.csv")
+    if not os.path.exists(path):
+        return []
+    rows = []
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            r["triangles"] = int(r["triangles"])
+            for k in ("seconds", "volume"):
+                r[k] = float(r[k]) if r[k] != "" else None
+            r["rel_volume_diff"] = float(r["rel_volume_diff"]) if r["rel_volume_diff"] != "" else ""
+            rows.append(r)
+    return rows
+
+
+def write_tables(out, rows, quiet=False):
+    fields = FIELDS
     tmp = os.path.join(out, "results.csv.tmp")
     with open(tmp, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
@@ -293,7 +323,8 @@ def write_tables(out, rows):
     with open(os.path.join(out, "table.md.tmp"), "w") as f:
         f.write("\n".join(lines) + "\n")
     os.replace(os.path.join(out, "table.md.tmp"), os.path.join(out, "table.md"))
-    print(os.path.join(out, "table.md"), file=sys.stderr)
+    if not quiet:
+        print(os.path.join(out, "table.md"), file=sys.stderr)
 
 
 if __name__ == "__main__":
