@@ -248,3 +248,63 @@ fn stacked_boxes_with_coplanar_tops() {
     let (_, [vu, vi, vd, _]) = check_exact("box on a box", &base, &top, true);
     assert_eq!((vu, vi, vd), (5.0, 0.0, 4.0));
 }
+
+/// A cube with a pyramid on each face (the corpus' star: 14 vertices, 24 triangles).
+fn spiked_cube() -> Mesh {
+    let h = 0.125;
+    let mut positions: Vec<DVec3> = [(-h, -h), (-h, h), (h, h), (h, -h)]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, -h))
+        .chain([(-h, -h), (-h, h), (h, h), (h, -h)].iter().map(|&(x, y)| DVec3::new(x, y, h)))
+        .collect();
+    positions
+        .extend([DVec3::X, DVec3::Y, DVec3::NEG_X, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z].map(|p| 0.5 * p));
+    let faces = [
+        [0, 1, 13],
+        [1, 2, 13],
+        [2, 3, 13],
+        [3, 0, 13],
+        [3, 2, 8],
+        [7, 3, 8],
+        [6, 7, 8],
+        [2, 6, 8],
+        [7, 6, 12],
+        [4, 7, 12],
+        [5, 4, 12],
+        [6, 5, 12],
+        [4, 5, 10],
+        [5, 1, 10],
+        [1, 0, 10],
+        [0, 4, 10],
+        [5, 6, 9],
+        [6, 2, 9],
+        [2, 1, 9],
+        [1, 5, 9],
+        [7, 4, 11],
+        [3, 7, 11],
+        [0, 3, 11],
+        [4, 0, 11],
+    ];
+    Mesh::new(positions, faces.iter().map(|f| f.to_vec()).collect()).unwrap()
+}
+
+/// Mirrored in x and turned 30° about z in floating point: the copy's spikes along ±z
+/// keep the apexes, and an edge of one spike passes within an ulp of the other's, so
+/// exactly distinct intersection points on the two faces at that edge round to one point
+/// and their sub-ulp slivers to one triangle twice, oppositely oriented.
+#[test]
+fn spiked_cube_against_its_mirror_image_turned_30_degrees() {
+    let a = spiked_cube();
+    let (s, c) = 30f64.to_radians().sin_cos();
+    let positions = a
+        .positions()
+        .iter()
+        .map(|p| {
+            let x = 0.0 - p.x;
+            DVec3::new(x * c + p.y * -s, x * s + p.y * c, p.z)
+        })
+        .collect();
+    let faces = (0..a.num_faces()).map(|f| a.face(f).iter().rev().copied().collect()).collect();
+    let b = Mesh::new(positions, faces).unwrap();
+    check_exact("spiked cube, mirrored and turned 30°", &a, &b, true);
+}

@@ -18,7 +18,10 @@
 //! Closedness is checked by the caller. Nesting and orientation of shells are those of
 //! the exact result: rounding could change them only by making faces cross.
 //!
-//! **Repair.** For every crossing pair or flat triangle, its shortest edge with an
+//! **Repair.** Points that round to one position are one point (as when the file is read
+//! back): triangles left without three distinct corners go, and so do pairs that come to
+//! coincide with opposite orientations (exactly distinct slivers thinner than an ulp).
+//! Then, for every crossing pair or flat triangle, its shortest edge with an
 //! intersection point at one end is collapsed if it is shorter than [`COLLAPSE`] × the
 //! operands' diagonal: the intersection point moves onto the other end (an input vertex
 //! never moves). A flat triangle with no such edge (a corner on its opposite edge) is
@@ -69,7 +72,8 @@ pub struct Repair {
     pub flat_triangles: usize,
     /// Edges collapsed.
     pub collapsed_edges: usize,
-    /// Triangles removed by the collapses (those on a collapsed edge, cancelling pairs).
+    /// Triangles removed by the collapses (those left without area, pairs that coincide
+    /// with opposite orientations).
     pub removed_triangles: usize,
     /// Flat regions rebuilt without their sliver (between two nearly coincident faces, too
     /// thin for f64 and too wide to collapse an edge of).
@@ -90,6 +94,7 @@ impl Repair {
     pub fn is_clean(&self) -> bool {
         self.crossings == 0
             && self.flat_triangles == 0
+            && self.removed_triangles == 0
             && self.pockets == 0
             && self.flipped == 0
             && self.dropped_shells == 0
@@ -187,6 +192,8 @@ pub fn finish(
     let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let thickness = flat_thickness(max_abs, diagonal);
     let is_new = |v: u32| v >= first_new;
+    // Welding is a collapse of edges of length zero: the same clean-up.
+    collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), &mut repair);
     for round in 0..=ROUNDS {
         let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
         let flat: Vec<usize> = (0..soup.triangles.len())
