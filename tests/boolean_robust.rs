@@ -308,3 +308,15 @@ fn spiked_cube_against_its_mirror_image_turned_30_degrees() {
     let b = Mesh::new(positions, faces).unwrap();
     check_exact("spiked cube, mirrored and turned 30°", &a, &b, true);
 }
+
+/// A sphere against its copy turned by an exact quarter about z: the turned vertices are
+/// those of the sphere up to an ulp (cos and sin rounded), so the difference is slivers
+/// thinner than f64 between faces a few ulps apart; snapped together they cancel.
+#[test]
+fn sphere_against_its_exact_quarter_turn() {
+    let a = procedural::sphere(16, 32);
+    let (_, [vu, vi, vd, vs]) = check_exact("sphere 16×32", &a, &quarter_turn(&a), false);
+    let v = volume(&a);
+    assert!((vu - v).abs() <= REL * v && (vi - v).abs() <= REL * v, "{vu} {vi}");
+    assert!(vd <= REL * v && vs <= REL * v, "{vd} {vs}");
+}

@@ -21,10 +21,14 @@
 //! **Repair.** Points that round to one position are one point (as when the file is read
 //! back): triangles left without three distinct corners go, and so do pairs that come to
 //! coincide with opposite orientations (exactly distinct slivers thinner than an ulp).
+//! The corners of crossing or flat triangles are snapped onto any point within a few
+//! ulps ([`snap_distance`]; the lowest id stays: A's vertices, then B's, then
+//! intersection points), with the same clean-up: nearly coincident points of the two
+//! operands (a copy turned a quarter in floating point) then meet instead of crossing.
 //! Then, for every crossing pair or flat triangle, its shortest edge with an
 //! intersection point at one end is collapsed if it is shorter than [`COLLAPSE`] × the
 //! operands' diagonal: the intersection point moves onto the other end (an input vertex
-//! never moves). A flat triangle with no such edge (a corner on its opposite edge) is
+//! moves only by a snap). A flat triangle with no such edge (a corner on its opposite edge) is
 //! removed by splitting its neighbour across that edge at the corner. A collapse keeps every directed edge balanced — the triangles on the
 //! edge vanish and their other edges pair up — so the result stays closed and oriented;
 //! two triangles that come to coincide with opposite orientations cancel. The moved
@@ -61,6 +65,13 @@ fn flat_thickness(max_abs: f64, diagonal: f64) -> f64 {
     (1e-12 * diagonal).max(64.0 * f64::EPSILON * max_abs)
 }
 
+/// How close (per coordinate) a point must be to a corner of a crossing or flat triangle
+/// to be snapped onto it, for points with coordinates up to `max_abs`: a few ulps, the
+/// distance rounding alone puts between exactly distinct points of a sub-ulp sliver.
+fn snap_distance(max_abs: f64) -> f64 {
+    64.0 * f64::EPSILON * max_abs
+}
+
 /// What the check found and the repair did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Repair {
@@ -70,10 +81,13 @@ pub struct Repair {
     pub crossings: usize,
     /// Triangles without area after rounding, before any repair.
     pub flat_triangles: usize,
+    /// Points snapped onto a point a few ulps away (the corners of crossing or flat
+    /// triangles: nearly coincident points of the two operands and the cut).
+    pub snapped: usize,
     /// Edges collapsed.
     pub collapsed_edges: usize,
-    /// Triangles removed by the collapses (those left without area, pairs that coincide
-    /// with opposite orientations).
+    /// Triangles removed by the snaps and collapses (those left without area, pairs that
+    /// coincide with opposite orientations).
     pub removed_triangles: usize,
     /// Flat regions rebuilt without their sliver (between two nearly coincident faces, too
     /// thin for f64 and too wide to collapse an edge of).
@@ -105,12 +119,13 @@ impl std::fmt::Display for Repair {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} edges collapsed \
-             ({} triangles removed, points moved at most {:e}), {} flat slivers removed ({} triangles rebuilt), \
-             {} long flat triangles split away, {} flat shells dropped",
+            "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
+             {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
+             ({} triangles rebuilt), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
+            self.snapped,
             self.collapsed_edges,
             self.removed_triangles,
             self.moved,
@@ -192,6 +207,7 @@ pub fn finish(
     let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let thickness = flat_thickness(max_abs, diagonal);
     let is_new = |v: u32| v >= first_new;
+    let snap = snap_distance(max_abs);
     // Welding is a collapse of edges of length zero: the same clean-up.
     collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), &mut repair);
     for round in 0..=ROUNDS {
@@ -206,6 +222,19 @@ pub fn finish(
         }
         if crossings.is_empty() && flat.is_empty() {
             break;
+        }
+        if round < ROUNDS {
+            let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
+            let map = snap_map(&soup, corners, snap);
+            if !map.is_empty() {
+                for (&gone, &keep) in &map {
+                    let d = soup.positions[gone as usize].distance(soup.positions[keep as usize]);
+                    repair.moved = repair.moved.max(d);
+                }
+                repair.snapped += map.len();
+                collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
+                continue;
+            }
         }
         // Per defect, the shortest collapsible edge of its triangles: (length, keep, gone).
         let shortest = |faces: &[usize]| -> Option<(f64, u32, u32)> {
@@ -355,6 +384,53 @@ pub fn finish(
     }
     drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
     Ok(Finished { triangles: soup.triangles, origin, repair })
+}
+
+/// The snaps for the corners of `faces`: every point of the soup within `snap` (per
+/// coordinate) of such a corner joins its cluster, and each cluster goes onto its lowest
+/// id. Points already at one position are one point (welded), so every snap moves one.
+fn snap_map(soup: &TriangleSoup, faces: impl Iterator<Item = usize>, snap: f64) -> HashMap<u32, u32> {
+    let cell = |p: DVec3| (p / snap).floor().as_i64vec3().to_array();
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut used = vec![false; soup.positions.len()];
+    for t in &soup.triangles {
+        for &v in t {
+            if !std::mem::replace(&mut used[v as usize], true) {
+                grid.entry(cell(soup.positions[v as usize])).or_default().push(v);
+            }
+        }
+    }
+    let mut sets = UnionFind::new(soup.positions.len());
+    let mut members = std::collections::BTreeSet::new();
+    for f in faces {
+        for v in soup.triangles[f] {
+            let p = soup.positions[v as usize];
+            let [x, y, z] = cell(p);
+            for key in (-1..=1)
+                .flat_map(|i| (-1..=1).flat_map(move |j| (-1..=1).map(move |k| [x + i, y + j, z + k])))
+            {
+                for &w in grid.get(&key).into_iter().flatten() {
+                    if w != v && (soup.positions[w as usize] - p).abs().max_element() <= snap {
+                        sets.union(v, w);
+                        members.insert(v);
+                        members.insert(w);
+                    }
+                }
+            }
+        }
+    }
+    let mut lowest: HashMap<u32, u32> = HashMap::new();
+    for &v in &members {
+        let root = sets.find(v);
+        lowest.entry(root).or_insert(v); // members ascend: the first is the lowest
+    }
+    members
+        .into_iter()
+        .filter_map(|v| {
+            let keep = lowest[&sets.find(v)];
+            (keep != v).then_some((v, keep))
+        })
+        .collect()
 }
 
 /// For a flat triangle f (a, b, m) whose corner m lies strictly inside its edge ab once

@@ -207,6 +207,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "tested": r.tested,
         "crossings": r.crossings,
         "flat_triangles": r.flat_triangles,
+        "snapped": r.snapped,
         "collapsed_edges": r.collapsed_edges,
         "removed_triangles": r.removed_triangles,
         "flipped": r.flipped,
