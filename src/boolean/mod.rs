@@ -33,7 +33,6 @@
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::gpu::Context;
 use crate::inclusion::{self, Method, solver::Solver};
@@ -235,10 +234,7 @@ pub fn evaluate(
             Side::A => &mut solver_a,
             Side::B => &mut solver_b,
         };
-        match solver {
-            Solver::Cpu(c) => Ok(points.par_iter().with_min_len(64).map(|&p| c.classify(p)).collect()),
-            other => other.classify_all(points),
-        }
+        solver.classify_fine(points, 64)
     };
     let classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
     timings.classify = start.elapsed();

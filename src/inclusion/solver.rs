@@ -7,6 +7,8 @@
 //! number (inside iff w ≥ ½), whichever CPU method is asked for, by
 //! [`FastWinding`]; the GPU methods refuse it.
 
+use std::time::{Duration, Instant};
+
 use glam::DVec3;
 
 use super::auto::{self, Choice};
@@ -28,6 +30,7 @@ use super::winding::WindingNumber;
 use crate::gpu::Context;
 use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
+use crate::mesh::solidity::{Accepted, Defect};
 
 /// Defaults for the GPU methods: tetrahedra per point-vertex.
 pub const GPU_BATCH: u32 = super::gpu::DEFAULT_BATCH;
@@ -95,28 +98,43 @@ pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Optio
     (choice.method, options, Some(choice))
 }
 
+/// Refuses a GPU method for a mesh that [`require_solid`](crate::mesh::solidity::require_solid)
+/// accepted without being a solid (under allow-open): only the CPU methods evaluate its
+/// generalized winding number.
+pub fn check_method(solid: &Accepted, method: Method) -> Result<()> {
+    if solid.non_solid.is_some() && !method.is_cpu() {
+        return Err(InclusionError::NotForNonSolids(method.name()));
+    }
+    Ok(())
+}
+
+/// The options for `points` query points against a mesh that
+/// [`require_solid`](crate::mesh::solidity::require_solid) accepted: its verdict says
+/// whether the winding-number rule applies and spares the closure check.
+pub fn options_for(solid: &Accepted, points: usize, allow_open: bool) -> Options {
+    Options {
+        points,
+        allow_open,
+        non_solid: solid.non_solid.is_some(),
+        known_closed: !matches!(solid.non_solid, Some(Defect::Open(_))),
+        ..Options::default()
+    }
+}
+
 /// Classifies `points`, given in the input's units, against a mesh that
 /// [`require_solid`](crate::mesh::solidity::require_solid) accepted, as `texgeo inclusion`
 /// does: the options from the verdict, `auto` resolved for the number of points, the
 /// points moved into the mesh's frame. `ctx` is called only for a GPU method. Returns
 /// the classes and the name of the method that ran (Python's `Mesh.contains`).
 pub fn classify_accepted(
-    solid: &crate::mesh::solidity::Accepted,
+    solid: &Accepted,
     points: &[DVec3],
     method: Method,
     allow_open: bool,
     ctx: impl FnOnce() -> std::result::Result<Context, crate::gpu::GpuError>,
 ) -> Result<(Vec<Class>, String)> {
-    if solid.non_solid.is_some() && !method.is_cpu() {
-        return Err(InclusionError::NotForNonSolids(method.name()));
-    }
-    let options = Options {
-        points: points.len(),
-        allow_open,
-        non_solid: solid.non_solid.is_some(),
-        known_closed: !matches!(solid.non_solid, Some(crate::mesh::solidity::Defect::Open(_))),
-        ..Options::default()
-    };
+    check_method(solid, method)?;
+    let options = options_for(solid, points.len(), allow_open);
     let (method, options, _) = resolve(method, &solid.mesh, &options);
     let ctx = if method.is_cpu() { None } else { Some(ctx()?) };
     let mut solver = Solver::new(method, &solid.mesh, &options, ctx.as_ref(), None)?;
@@ -130,6 +148,27 @@ pub fn classify_accepted(
     };
     let classes = solver.classify_all(points)?;
     Ok((classes, solver.name().to_string()))
+}
+
+/// What [`Solver::classify_stream`] counted.
+#[derive(Clone, Debug, Default)]
+pub struct Streamed {
+    /// Points per [`Class`], indexed by its value.
+    pub counts: [usize; 3],
+    /// Reading and classifying the points (not the sink's time).
+    pub classify: Duration,
+    /// The GPU's counts and times summed over the blocks (GPU methods).
+    pub gpu: Option<GpuStats>,
+}
+
+impl Streamed {
+    pub fn total(&self) -> usize {
+        self.counts.iter().sum()
+    }
+
+    pub fn count(&self, class: Class) -> usize {
+        self.counts[class as usize]
+    }
 }
 
 /// The triangles the cost models count: a triangle is one, a polygon of n sides n (its
@@ -236,6 +275,52 @@ impl Solver {
             return Ok(source.next_block_with(|points| c.classify_all(&points))?);
         }
         source.next_block()?.map(|points| self.classify_all(&points).map(|c| vec![c])).transpose()
+    }
+
+    /// Classifies `first` (a block already read: its size sized the method), then the rest
+    /// of `source` block by block, handing the classes to `sink` in the order of the
+    /// points, a part at a time, as `texgeo inclusion` writes them.
+    pub fn classify_stream<E: From<InclusionError>>(
+        &mut self,
+        first: Option<Vec<DVec3>>,
+        source: &mut PointReader,
+        mut sink: impl FnMut(&[Class]) -> std::result::Result<(), E>,
+    ) -> std::result::Result<Streamed, E> {
+        let gpu = self.gpu_stats().map(|_| GpuStats::default());
+        let mut streamed = Streamed { gpu, ..Streamed::default() };
+        let mut block = first.map(|points| vec![points]);
+        loop {
+            let t = Instant::now();
+            let parts = match block.take() {
+                Some(parts) => parts.iter().map(|points| self.classify_all(points)).collect::<Result<_>>()?,
+                None => match self.classify_next(source)? {
+                    Some(parts) => parts,
+                    None => break,
+                },
+            };
+            streamed.classify += t.elapsed();
+            if let (Some(sum), Some(g)) = (&mut streamed.gpu, self.gpu_stats()) {
+                sum.add(g);
+            }
+            for classes in &parts {
+                for &c in classes {
+                    streamed.counts[c as usize] += 1;
+                }
+                sink(classes)?;
+            }
+        }
+        Ok(streamed)
+    }
+
+    /// Classifies a few points (the Booleans' groups of points): a CPU method one point
+    /// per task in tasks of at least `grain` points, finer than [`Solver::classify_all`]'s
+    /// blocks; a GPU method in its draws.
+    pub fn classify_fine(&mut self, points: &[DVec3], grain: usize) -> Result<Vec<Class>> {
+        use rayon::prelude::*;
+        match self {
+            Solver::Cpu(c) => Ok(points.par_iter().with_min_len(grain).map(|&p| c.classify(p)).collect()),
+            other => other.classify_all(points),
+        }
     }
 
     /// GPU time split of the last call (`None` for CPU methods).

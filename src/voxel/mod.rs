@@ -234,10 +234,9 @@ pub struct Voxelization {
 
 /// Voxelizes `n`³ voxels of a mesh that
 /// [`require_solid`](crate::mesh::solidity::require_solid) accepted, as `texgeo voxelize`
-/// does: a mesh taken under allow-open by its generalized winding number on the CPU, a
-/// solid by `choice` (`auto`: the fastest by the cost models, opening the device with
-/// `ctx` only when a GPU method might win). Returns the grid, the volume and the name of
-/// the method that ran (Python's `Mesh.voxelize`).
+/// does: a mesh taken under allow-open by its generalized winding number on the CPU
+/// ([`voxelize_non_solid`]), a solid by `choice` ([`choose_method`]). Returns the grid, the
+/// volume and the name of the method that ran (Python's `Mesh.voxelize`).
 pub fn voxelize_accepted(
     accepted: &crate::mesh::solidity::Accepted,
     n: usize,
@@ -246,44 +245,75 @@ pub fn voxelize_accepted(
 ) -> Result<(Grid, Volume, String)> {
     let grid = Grid::for_mesh(&accepted.mesh, n)?.in_frame(accepted.frame);
     if accepted.non_solid.is_some() {
-        if let Choice::Fixed(m) = choice {
-            if m.uses_gpu() {
-                return Err(VoxelError::Usage(format!(
-                    "method {m} voxelizes solids only; a mesh that is not a solid is voxelized by its \
-                     generalized winding number on the CPU (auto, cpu or scanline)"
-                )));
-            }
-        }
-        let winding = crate::inclusion::fast_winding::FastWinding::for_voxels(&accepted.mesh)
-            .map_err(|e| VoxelError::Mesh(e.to_string()))?;
-        return Ok((grid, winding.voxelize(&grid)?, "fast-winding".to_string()));
+        check_non_solid(choice)?;
+        return Ok((grid, voxelize_non_solid(&accepted.mesh, &grid)?, "fast-winding".to_string()));
     }
     let solid = Solid::new(&accepted.mesh)?;
-    let mut ctx = Some(ctx);
-    let mut open = || ctx.take().map_or_else(|| Err(VoxelError::Usage("no device".into())), |f| f());
-    let mut opened = None;
-    let method = match choice {
-        Choice::Fixed(m) => m,
+    let chosen = choose_method(choice, &solid, &grid, false, |_| ctx())?;
+    let result = Voxelizer::new(chosen.ctx).run(&solid, &grid, chosen.method)?;
+    Ok((grid, result.volume, chosen.method.name().to_string()))
+}
+
+/// Refuses a GPU method for a mesh accepted under allow-open without being a solid: only
+/// its generalized winding number on the CPU voxelizes it.
+pub fn check_non_solid(choice: Choice) -> Result<()> {
+    match choice.fixed() {
+        Some(m) if m.uses_gpu() => Err(VoxelError::Usage(format!(
+            "method {m} voxelizes solids only; under --allow-open a mesh that is not a solid is voxelized \
+             by its generalized winding number on the CPU (--method auto, cpu or scanline)"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The voxels of a mesh accepted under allow-open without being a solid: occupied iff the
+/// generalized winding number at the centre is at least ½ (centres on the surface empty).
+pub fn voxelize_non_solid(mesh: &Mesh, grid: &Grid) -> Result<Volume> {
+    let winding = crate::inclusion::fast_winding::FastWinding::for_voxels(mesh)
+        .map_err(|e| VoxelError::Mesh(e.to_string()))?;
+    winding.voxelize(grid)
+}
+
+/// The method [`choose_method`] settled on, and the device it opened.
+pub struct Chosen {
+    pub method: Method,
+    /// What `auto` weighed (`None` for a fixed method).
+    pub plan: Option<auto::Plan>,
+    /// The device, when the method needs one or the caller asked for it.
+    pub ctx: Option<Context>,
+}
+
+/// The method `choice` stands for on `solid` at `grid`, and the device it runs with.
+/// `auto` asks the cost models as if the GPU's draws were free, so that no device is
+/// opened while a CPU method still wins (the usual case on lavapipe and, by the models,
+/// elsewhere); when a GPU method wins, or `with_device` (the caller needs the device
+/// anyway), it opens the device and asks again for its kind. `open` is called at most
+/// once, with the fixed method (`None` under `auto`).
+pub fn choose_method<E>(
+    choice: Choice,
+    solid: &Solid,
+    grid: &Grid,
+    with_device: bool,
+    open: impl FnOnce(Option<Method>) -> std::result::Result<Context, E>,
+) -> std::result::Result<Chosen, E> {
+    match choice {
+        Choice::Fixed(method) => {
+            let ctx = if method.uses_gpu() || with_device { Some(open(Some(method))?) } else { None };
+            Ok(Chosen { method, plan: None, ctx })
+        }
         Choice::Auto => {
-            let counts = auto::Counts::new(&solid, &grid);
+            let counts = auto::Counts::new(solid, grid);
             let threads = rayon::current_num_threads();
             let mut plan = auto::Plan::choose(counts, auto::Device::Gpu, threads);
-            if plan.method.uses_gpu() {
-                let c = open()?;
-                let kind = if c.info().kind == "cpu" { auto::Device::Cpu } else { auto::Device::Gpu };
-                plan = auto::Plan::choose(counts, kind, threads);
-                opened = Some(c);
+            let mut ctx = None;
+            if plan.method.uses_gpu() || with_device {
+                let c = open(None)?;
+                plan = auto::Plan::choose(counts, auto::Device::of(Some(&c)), threads);
+                ctx = Some(c);
             }
-            plan.method
+            Ok(Chosen { method: plan.method, plan: Some(plan), ctx })
         }
-    };
-    let ctx = match opened {
-        Some(c) => Some(c),
-        None if method.uses_gpu() => Some(open()?),
-        None => None,
-    };
-    let result = Voxelizer::new(ctx).run(&solid, &grid, method)?;
-    Ok((grid, result.volume, method.name().to_string()))
+    }
 }
 
 /// Runs methods, keeping GPU pipelines alive between runs (a benchmark runs many).

@@ -4,8 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use texgeo::inclusion::gpu::GpuStats;
-use texgeo::inclusion::solver::{Solver, resolve};
+use texgeo::inclusion::solver::{self, Solver, resolve};
 use texgeo::inclusion::{Class, Method, Options, points};
 use texgeo::mesh::solidity::Policy;
 use texgeo::random::Rng;
@@ -88,18 +87,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let policy =
         Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
-    let mesh = solid.mesh;
+    let mesh = &solid.mesh;
     if solid.flipped {
         note!("texgeo: note: {} was inverted; its faces were reversed (--flip-inverted)", args.mesh);
     }
     if let Some(defect) = &solid.non_solid {
-        if !args.method.is_cpu() {
-            anyhow::bail!(
-                "{}: {}",
-                args.mesh,
-                texgeo::inclusion::InclusionError::NotForNonSolids(args.method.name())
-            );
-        }
+        solver::check_method(&solid, args.method).map_err(|e| anyhow::anyhow!("{}: {e}", args.mesh))?;
         crate::mesh::warn_non_solid(&args.mesh, defect);
     }
     // Points are given in the mesh's units and classified in its frame.
@@ -119,14 +112,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let options = Options {
         tetragrid_resolution: args.grid.unwrap_or(texgeo::inclusion::tetragrid::DEFAULT_RESOLUTION),
         voxel_space_resolution: args.grid,
-        points: source.estimated_total(),
-        allow_open: args.allow_open,
-        non_solid: solid.non_solid.is_some(),
-        known_closed: !matches!(solid.non_solid, Some(texgeo::mesh::solidity::Defect::Open(_))),
-        ..Options::default()
+        ..solver::options_for(&solid, source.estimated_total(), args.allow_open)
     };
     let t = Instant::now();
-    let (method, options, choice) = resolve(args.method, &mesh, &options);
+    let (method, options, choice) = resolve(args.method, mesh, &options);
     let auto = choice
         .as_ref()
         .map(|c| if solid.non_solid.is_some() { "fast-winding".to_string() } else { c.to_string() });
@@ -145,7 +134,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         }
         None => {}
     }
-    let mut solver = Solver::new(method, &mesh, &options, ctx.as_ref(), args.batch)
+    let mut solver = Solver::new(method, mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
     let build = t.elapsed();
     // Block by block: classify, count, write (a text output as it goes; a `.npy` output
@@ -156,36 +145,14 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     };
     let npy_out = args.output.as_deref().is_some_and(points::is_npy);
     let mut all = Vec::new();
-    let mut counts = [0usize; 3];
-    let mut run = std::time::Duration::ZERO;
-    let mut gpu = GpuStats::default();
-    // The first block was read whole (its size sized the method); then a CPU method
-    // classifies each part of a block in the task that parsed it.
-    let mut block = first.map(|pts| vec![pts]);
-    loop {
-        let t = Instant::now();
-        let parts: Vec<Vec<Class>> = match block.take() {
-            Some(parts) => parts.iter().map(|pts| solver.classify_all(pts)).collect::<Result<_, _>>()?,
-            None => match solver.classify_next(&mut source)? {
-                Some(parts) => parts,
-                None => break,
-            },
-        };
-        run += t.elapsed();
-        if let Some(g) = solver.gpu_stats() {
-            gpu.add(g);
+    let streamed = solver.classify_stream(first, &mut source, |classes| -> anyhow::Result<()> {
+        match &mut out {
+            Some(_) if npy_out => all.extend_from_slice(classes),
+            Some(file) => points::write_classes(file, classes).map_err(|e| file.error(e))?,
+            None => {}
         }
-        for &c in parts.iter().flatten() {
-            counts[c as usize] += 1;
-        }
-        for classes in &parts {
-            match &mut out {
-                Some(_) if npy_out => all.extend_from_slice(classes),
-                Some(file) => points::write_classes(file, classes).map_err(|e| file.error(e))?,
-                None => {}
-            }
-        }
-    }
+        Ok(())
+    })?;
     if let Some(mut file) = out {
         if npy_out {
             points::write_classes_npy(&mut file, &all).map_err(|e| file.error(e))?;
@@ -195,19 +162,18 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             return Ok(());
         }
     }
-    let total: usize = counts.iter().sum();
     if args.json {
-        texgeo::json::print(&texgeo::inclusion::solver::Summary {
-            points: total,
-            inside: counts[Class::Inside as usize],
-            outside: counts[Class::Outside as usize],
-            boundary: counts[Class::OnBoundary as usize],
+        texgeo::json::print(&solver::Summary {
+            points: streamed.total(),
+            inside: streamed.count(Class::Inside),
+            outside: streamed.count(Class::Outside),
+            boundary: streamed.count(Class::OnBoundary),
             method: solver.name().to_string(),
             auto,
             build,
             structure_bytes: solver.build_stats().bytes,
-            classify: run,
-            gpu: solver.gpu_stats().map(|_| gpu.clone()),
+            classify: streamed.classify,
+            gpu: streamed.gpu.clone(),
             device: ctx.as_ref().filter(|_| solver.gpu_stats().is_some()).map(|c| c.info().label()),
         });
         return Ok(());
@@ -215,10 +181,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     say!(
         "{}: {} points, {} inside, {} outside, {} on the boundary",
         args.mesh,
-        total,
-        counts[Class::Inside as usize],
-        counts[Class::Outside as usize],
-        counts[Class::OnBoundary as usize]
+        streamed.total(),
+        streamed.count(Class::Inside),
+        streamed.count(Class::Outside),
+        streamed.count(Class::OnBoundary)
     );
     let stats = solver.build_stats();
     say!(
@@ -226,9 +192,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         solver.name(),
         build.as_secs_f64() * 1e3,
         stats.bytes as f64 / 1024.0,
-        run.as_secs_f64() * 1e3
+        streamed.classify.as_secs_f64() * 1e3
     );
-    if solver.gpu_stats().is_some() {
+    if let Some(gpu) = &streamed.gpu {
         say!(
             "GPU: {} points drawn in {} draw(s), {:.3} ms; {} flagged and answered exactly on the CPU in {:.3} ms",
             gpu.gpu_points,

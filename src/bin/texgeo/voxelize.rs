@@ -5,8 +5,9 @@ use std::path::PathBuf;
 
 use texgeo::mesh::solidity::Policy;
 use texgeo::voxel::aspect::{self, Aspect, Material};
-use texgeo::voxel::auto::{self as plan, Counts, Plan};
-use texgeo::voxel::{Choice, Grid, Method, Solid, Summary, Timings, Voxelizer, Zone, binvox, npy, pictures};
+use texgeo::voxel::{
+    Choice, Grid, Method, Solid, Summary, Timings, Voxelizer, Zone, binvox, choose_method, npy, pictures,
+};
 
 /// Aspect functions (Fig. 5-9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -102,18 +103,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mesh = solid.mesh;
     let grid = Grid::for_mesh(&mesh, args.res)?.in_frame(solid.frame);
     if let Some(defect) = &solid.non_solid {
-        if let Choice::Fixed(m) = args.method {
-            if m.uses_gpu() {
-                anyhow::bail!(
-                    "{}: method {m} voxelizes solids only; under --allow-open a mesh that is not a solid is \
-                     voxelized by its generalized winding number on the CPU (--method auto, cpu or scanline)",
-                    args.mesh
-                );
-            }
-        }
+        texgeo::voxel::check_non_solid(args.method).map_err(|e| anyhow::anyhow!("{}: {e}", args.mesh))?;
         crate::mesh::warn_non_solid(&args.mesh, defect);
         let t = std::time::Instant::now();
-        let volume = texgeo::inclusion::fast_winding::FastWinding::for_voxels(&mesh)?.voxelize(&grid)?;
+        let volume = texgeo::voxel::voxelize_non_solid(&mesh, &grid)?;
         say!(
             "{}: {}³ voxels, {} occupied, generalized winding number ≥ ½ (fast-winding) in {:.1} ms",
             args.mesh,
@@ -133,33 +126,18 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let solid = Solid::new(&mesh)?;
-    let mut opened = None;
-    let method = match args.method {
-        Choice::Fixed(m) => m,
-        Choice::Auto => {
-            // Asked as if the GPU's draws were free: when a CPU method still wins, no
-            // device is opened (the usual case on lavapipe and, by the models, elsewhere).
-            let counts = Counts::new(&solid, &grid);
-            let threads = rayon::current_num_threads();
-            let mut choice = Plan::choose(counts, plan::Device::Gpu, threads);
-            if choice.method.uses_gpu() || args.aspect.is_some() {
-                let ctx = crate::open_context_for(device, "scanline")?;
-                choice = Plan::choose(counts, plan::Device::of(Some(&ctx)), threads);
-                opened = Some(ctx);
-            }
-            note!("texgeo: --method auto: {}", choice.describe());
-            choice.method
-        }
-    };
-    let needs_gpu = method.uses_gpu() || args.aspect.is_some();
-    let ctx = if opened.is_some() {
-        opened
-    } else if needs_gpu {
-        let hint = if method.uses_gpu() { "cpu or scanline" } else { "cpu, without --aspect" };
-        Some(crate::open_context_for(device, hint)?)
-    } else {
-        None
-    };
+    let chosen = choose_method(args.method, &solid, &grid, args.aspect.is_some(), |fixed| {
+        let hint = match fixed {
+            None => "scanline",
+            Some(m) if m.uses_gpu() => "cpu or scanline",
+            Some(_) => "cpu, without --aspect",
+        };
+        crate::open_context_for(device, hint)
+    })?;
+    if let Some(plan) = &chosen.plan {
+        note!("texgeo: --method auto: {}", plan.describe());
+    }
+    let (method, ctx) = (chosen.method, chosen.ctx);
     if let Some(ctx) = &ctx {
         say!("device: {}", ctx.info().label());
     }
