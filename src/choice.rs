@@ -44,6 +44,24 @@ fn names<M: ValueEnum>() -> String {
     M::value_variants().iter().map(name).collect::<Vec<_>>().join(", ")
 }
 
+impl<M> From<M> for Choice<M> {
+    fn from(m: M) -> Choice<M> {
+        Choice::Fixed(m)
+    }
+}
+
+/// The clap parser of a `--method` that takes a [`Choice`]: its possible values are `auto`
+/// (described by `auto`) and every method of `M` with its doc line, so that `--help` and
+/// usage errors list them as for a plain `clap::ValueEnum`.
+pub fn value_parser<M: ValueEnum + Send + Sync + 'static>(
+    auto: &'static str,
+) -> impl clap::builder::TypedValueParser<Value = Choice<M>> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = std::iter::once(PossibleValue::new("auto").help(auto))
+        .chain(M::value_variants().iter().filter_map(ValueEnum::to_possible_value));
+    PossibleValuesParser::new(values).try_map(|s| s.parse::<Choice<M>>())
+}
+
 impl<M: ValueEnum> FromStr for Choice<M> {
     type Err = String;
     fn from_str(s: &str) -> Result<Choice<M>, String> {

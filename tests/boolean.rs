@@ -44,7 +44,7 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 }
 
 fn evaluate(a: &Mesh, b: &Mesh, method: Method, ctx: Option<&Context>) -> Evaluation {
-    let options = Options { method, ..Options::default() };
+    let options = Options { method: method.into(), ..Options::default() };
     boolean::evaluate(a, b, Names::default(), &options, ctx).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -259,7 +259,7 @@ fn gpu_and_cpu_classification_give_identical_outputs() {
         &knot,
         &turned,
         Names::default(),
-        &Options { method: Method::Cpu, grouping: boolean::Grouping::Plain, ..Options::default() },
+        &Options { method: Method::Cpu.into(), grouping: boolean::Grouping::Plain, ..Options::default() },
         None,
     )
     .unwrap();
@@ -286,7 +286,7 @@ fn bad_operands_are_refused_with_the_reason() {
             &cube,
             bad,
             names,
-            &Options { method: Method::Bvh, ..Options::default() },
+            &Options { method: Method::Bvh.into(), ..Options::default() },
             None,
         )
         .err()

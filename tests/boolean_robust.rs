@@ -27,7 +27,7 @@ fn moved(m: &Mesh, t: DAffine3) -> Mesh {
 /// All four operations closed and oriented, the volume identities; returns the evaluation
 /// and the volumes of ∪, ∩, −, ⊖.
 fn check(name: &str, a: &Mesh, b: &Mesh) -> (Evaluation, [f64; 4]) {
-    let options = Options { method: Method::Bvh, ..Options::default() };
+    let options = Options { method: Method::Bvh.into(), ..Options::default() };
     let ev =
         boolean::evaluate(a, b, Names::default(), &options, None).unwrap_or_else(|e| panic!("{name}: {e}"));
     let mut v = [0.0; 4];

@@ -588,7 +588,7 @@ fn voxel_space_at_any_resolution_and_auto_label_as_cpu() {
             }
             for points in [0, 1_000, 1_000_000] {
                 let options = Options { points, ..Options::default() };
-                let got = build(Method::Auto, &mesh, &options).unwrap().classify_all(&pts);
+                let got = build(texgeo::inclusion::Choice::Auto, &mesh, &options).unwrap().classify_all(&pts);
                 assert_eq!(got, want, "{name} + {shift}: auto for {points} points");
             }
         }

@@ -10,7 +10,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use texgeo::inclusion::fast_winding::{FastWinding, TOLERANCES};
 use texgeo::inclusion::winding::WindingNumber;
-use texgeo::inclusion::{Class, Classifier, InclusionError, Method, Options, Solver, build};
+use texgeo::inclusion::{Choice, Class, Classifier, InclusionError, Method, Options, Solver, build};
 use texgeo::mesh::procedural::{box_between, cube};
 use texgeo::mesh::solidity::{self, flipped};
 use texgeo::mesh::{Mesh, formats};
@@ -144,7 +144,8 @@ fn every_cpu_method_answers_by_the_winding_number_and_gpu_methods_refuse() {
         }
         // With enough points for the cell grid, and whatever method is asked for.
         let options = Options { allow_open: true, non_solid: true, points: 50_000, ..Options::default() };
-        for method in std::iter::once(Method::Auto).chain(Method::ALL.into_iter().filter(|m| m.is_cpu())) {
+        let cpu = Method::ALL.into_iter().filter(|m| m.is_cpu()).map(Choice::Fixed);
+        for method in std::iter::once(Choice::Auto).chain(cpu) {
             let c = build(method, &mesh, &options).unwrap();
             assert_eq!(c.classify_all(&pts), got, "{name}: {method}");
         }

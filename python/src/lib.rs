@@ -392,11 +392,10 @@ fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<RawMesh> {
 }
 
 /// An inclusion method by its command-line name (`auto` included), as `--method` takes it.
-fn inclusion_method(name: &str, kind: Kind) -> PyResult<texgeo::inclusion::Method> {
-    texgeo::choice::parse::<texgeo::inclusion::Method>(name).ok_or_else(|| {
-        let expected: Vec<&str> = std::iter::once(texgeo::inclusion::Method::Auto)
-            .chain(texgeo::inclusion::Method::ALL)
-            .map(texgeo::inclusion::Method::name)
+fn inclusion_method(name: &str, kind: Kind) -> PyResult<texgeo::inclusion::Choice> {
+    name.parse::<texgeo::inclusion::Choice>().map_err(|_| {
+        let expected: Vec<&str> = std::iter::once("auto")
+            .chain(texgeo::inclusion::Method::ALL.map(texgeo::inclusion::Method::name))
             .collect();
         let msg = format!("unknown inclusion method '{name}' (expected one of: {})", expected.join(", "));
         match kind {

@@ -35,7 +35,7 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 
 use crate::gpu::Context;
-use crate::inclusion::{self, Method, solver::Solver};
+use crate::inclusion::{self, Choice, Method, solver::Solver};
 use crate::mesh::Mesh;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
@@ -62,7 +62,7 @@ pub use transform::Transform;
 #[derive(Clone, Debug)]
 pub struct Options {
     /// The inclusion method for the point tests.
-    pub method: Method,
+    pub method: Choice,
     /// One point test per group (default) or per triangle.
     pub grouping: Grouping,
     /// Go on with operands whose faces cross each other (results are then those of the
@@ -78,7 +78,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            method: Method::Octants,
+            method: Choice::Fixed(Method::Octants),
             grouping: Grouping::Grouped,
             allow_self_intersections: false,
             inclusion: inclusion::Options::default(),

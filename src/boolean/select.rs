@@ -22,8 +22,9 @@ use glam::DVec3;
 use super::classify::Class;
 use crate::mesh::Mesh;
 
-/// A Boolean operation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// A Boolean operation (`--op`), named as [`Operation::name`] says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Operation {
     Union,
     Intersection,
@@ -87,7 +88,7 @@ impl fmt::Display for Operation {
 impl FromStr for Operation {
     type Err = String;
     fn from_str(s: &str) -> Result<Operation, String> {
-        Operation::ALL.into_iter().find(|o| o.name() == s).ok_or_else(|| {
+        crate::choice::parse(s).ok_or_else(|| {
             format!(
                 "unknown operation '{s}' (expected one of: {})",
                 Operation::ALL.map(|o| o.name()).join(", ")
@@ -149,7 +150,10 @@ mod tests {
     fn names_round_trip_and_symmetric_difference_flips_inside_parts() {
         for op in Operation::ALL {
             assert_eq!(op.name().parse::<Operation>().unwrap(), op);
+            assert_eq!(crate::choice::name(&op), op.name());
+            assert_eq!(serde_json::to_string(&op).unwrap(), format!("\"{}\"", op.name()));
         }
+        assert_eq!(<Operation as clap::ValueEnum>::value_variants(), Operation::ALL);
         assert!("xor".parse::<Operation>().unwrap_err().contains("symmetric-difference"));
         assert_eq!(Operation::SymmetricDifference.keeps(true, Class::In, true), Some(true));
         assert_eq!(Operation::SymmetricDifference.keeps(false, Class::OnSame, false), None);

@@ -17,7 +17,7 @@ use super::method::Method;
 
 /// What `auto` picked and why (printed on stderr by the command).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Choice {
+pub struct Pick {
     pub method: Method,
     /// The voxel-space grid size, when that is the method.
     pub resolution: Option<usize>,
@@ -25,7 +25,7 @@ pub struct Choice {
     pub predicted: f64,
 }
 
-impl std::fmt::Display for Choice {
+impl std::fmt::Display for Pick {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.method)?;
         if let Some(n) = self.resolution {
@@ -73,9 +73,9 @@ pub fn voxel_space_resolution(triangles: usize, points: usize) -> usize {
 
 /// Picks the method for a mesh of `triangles` covering triangles and `points` query
 /// points (0 = unknown: a few).
-pub fn choose(triangles: usize, points: usize) -> Choice {
+pub fn choose(triangles: usize, points: usize) -> Pick {
     let points = if points == 0 { 64 } else { points };
     let n = voxel_space_resolution(triangles, points);
     let predicted = voxel_space_cost(triangles as f64, points as f64, n as f64);
-    Choice { method: Method::VoxelSpace, resolution: Some(n), predicted }
+    Pick { method: Method::VoxelSpace, resolution: Some(n), predicted }
 }

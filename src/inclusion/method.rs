@@ -4,15 +4,11 @@ use std::fmt;
 
 use glam::DVec3;
 
-/// The inclusion methods (`--method`). [`super::solver::Solver::new`] builds any of them;
-/// [`Method::is_cpu`] says which ones [`super::solver::build`] can make without a device.
-/// A new method is one variant here and one arm in the factory. [`Method::Auto`] is not a
-/// method of its own: the factory replaces it by the one [`super::auto`] picks.
+/// The inclusion methods (`--method`, with `auto`: [`Choice`]). [`super::solver::Solver::new`]
+/// builds any of them; [`Method::is_cpu`] says which ones [`super::solver::build`] can make
+/// without a device. A new method is one variant here and one arm in the factory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Method {
-    /// The fastest exact method for the mesh, the number of points and the device, from
-    /// measured cost models (says which on stderr).
-    Auto,
     /// Alg. 4-1 with basic preprocessing, every tetra tested.
     Cpu,
     /// Alg. 4-1 over a bounding-box hierarchy of the tetras (§4.3.2.2).
@@ -43,8 +39,16 @@ pub enum Method {
     VoxelSpace,
 }
 
+/// `--method`: one method, or `auto`, which the factory replaces by the one [`super::auto`]
+/// picks.
+pub type Choice = crate::choice::Choice<Method>;
+
+/// What `--help` says of `auto`.
+pub const AUTO: &str = "The fastest exact method for the mesh, the number of points and the device, from \
+                        measured cost models (says which on stderr)";
+
 impl Method {
-    /// Every method (not [`Method::Auto`], which picks one of them).
+    /// Every method.
     pub const ALL: [Method; 11] = [
         Method::Cpu,
         Method::Bvh,
@@ -72,13 +76,19 @@ impl Method {
             Method::CpuGpu => "cpu+gpu",
             Method::GpuTetraGrid => "gpu+tetragrid",
             Method::VoxelSpace => "voxel-space",
-            Method::Auto => "auto",
         }
     }
 
     /// True for methods that run on the CPU alone (`auto` only picks those).
     pub fn is_cpu(self) -> bool {
         !matches!(self, Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid)
+    }
+}
+
+impl Choice {
+    /// True unless a GPU method is asked for (`auto` picks CPU methods only).
+    pub fn is_cpu(self) -> bool {
+        self.fixed().is_none_or(Method::is_cpu)
     }
 }
 
@@ -143,9 +153,10 @@ mod tests {
         for m in Method::ALL {
             assert_eq!(m.to_possible_value().unwrap().get_name(), m.name());
         }
-        assert_eq!(Method::value_variants()[0], Method::Auto);
-        assert_eq!(Method::value_variants()[1..], Method::ALL);
-        assert_eq!(crate::choice::parse::<Method>("auto"), Some(Method::Auto));
+        assert_eq!(Method::value_variants(), Method::ALL);
+        assert_eq!(crate::choice::parse::<Method>("auto"), None);
+        assert_eq!("auto".parse::<Choice>(), Ok(Choice::Auto));
+        assert_eq!("cpu+gpu".parse::<Choice>(), Ok(Choice::Fixed(Method::CpuGpu)));
         assert_eq!(Class::OnBoundary as u8, 2);
     }
 }

@@ -76,6 +76,6 @@ pub mod winding;
 pub use classifier::{BuildStats, Class, Classifier};
 pub use cpu::{EdgeRule, FeitoTorres, Trace};
 pub use error::{InclusionError, Result};
-pub use method::{Method, Options};
+pub use method::{Choice, Method, Options};
 pub use solver::{Solver, build};
 pub use surface::Surface;

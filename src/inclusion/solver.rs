@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
-use super::auto::{self, Choice};
+use super::auto::{self, Pick};
 use super::bvh::Bvh;
 use super::classifier::{BuildStats, Class, Classifier};
 use super::cpu::{EdgeRule, FeitoTorres};
@@ -20,7 +20,7 @@ use super::fast_winding::FastWinding;
 use super::gpu::{GpuInclusion, GpuOptions, GpuStats, Phase2};
 use super::gpu_grid::GpuGridInclusion;
 use super::jordan::Jordan;
-use super::method::{Method, Options};
+use super::method::{Choice, Method, Options};
 use super::octants::Octants;
 use super::octree::JordanOctree;
 use super::points::PointReader;
@@ -82,12 +82,12 @@ pub fn winding_rule(mesh: &Mesh, options: &Options) -> bool {
 /// The method `auto` stands for on `mesh` with `options` (other methods: themselves).
 /// Under the winding-number rule ([`winding_rule`]) it is `winding`, evaluated by
 /// [`FastWinding`].
-pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Options, Option<Choice>) {
-    if method != Method::Auto {
+pub fn resolve(method: impl Into<Choice>, mesh: &Mesh, options: &Options) -> (Method, Options, Option<Pick>) {
+    if let Choice::Fixed(method) = method.into() {
         return (method, *options, None);
     }
     if winding_rule(mesh, options) {
-        let choice = Choice { method: Method::Winding, resolution: None, predicted: f64::NAN };
+        let choice = Pick { method: Method::Winding, resolution: None, predicted: f64::NAN };
         return (Method::Winding, *options, Some(choice));
     }
     let choice = auto::choose(triangles(mesh), options.points);
@@ -101,11 +101,11 @@ pub fn resolve(method: Method, mesh: &Mesh, options: &Options) -> (Method, Optio
 /// Refuses a GPU method for a mesh that [`require_solid`](crate::mesh::solidity::require_solid)
 /// accepted without being a solid (under allow-open): only the CPU methods evaluate its
 /// generalized winding number.
-pub fn check_method(solid: &Accepted, method: Method) -> Result<()> {
-    if solid.non_solid.is_some() && !method.is_cpu() {
-        return Err(InclusionError::NotForNonSolids(method.name()));
+pub fn check_method(solid: &Accepted, method: Choice) -> Result<()> {
+    match method.fixed() {
+        Some(m) if solid.non_solid.is_some() && !m.is_cpu() => Err(InclusionError::NotForNonSolids(m.name())),
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// The options for `points` query points against a mesh that
@@ -129,7 +129,7 @@ pub fn options_for(solid: &Accepted, points: usize, allow_open: bool) -> Options
 pub fn classify_accepted(
     solid: &Accepted,
     points: &[DVec3],
-    method: Method,
+    method: Choice,
     allow_open: bool,
     ctx: impl FnOnce() -> std::result::Result<Context, crate::gpu::GpuError>,
 ) -> Result<(Vec<Class>, String)> {
@@ -178,7 +178,7 @@ fn triangles(mesh: &Mesh) -> usize {
 }
 
 /// Builds the CPU classifier `method` for `mesh` (GPU methods: [`Solver::new`]).
-pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
+pub fn build(method: impl Into<Choice>, mesh: &Mesh, options: &Options) -> Result<Box<dyn Classifier>> {
     let (method, options, _) = resolve(method, mesh, options);
     let options = &options;
     if winding_rule(mesh, options) {
@@ -205,7 +205,6 @@ pub fn build(method: Method, mesh: &Mesh, options: &Options) -> Result<Box<dyn C
             // Without the closure check when the caller made it (the same unbalanced-edge test).
             Box::new(VoxelSpace::new(mesh, n, options.allow_open || options.known_closed)?)
         }
-        Method::Auto => return Err(InclusionError::Options("auto picks a method before building".into())),
         Method::Gpu | Method::CpuGpu | Method::GpuTetraGrid => {
             return Err(InclusionError::NeedsGpu(method.name()));
         }
@@ -216,7 +215,7 @@ impl Solver {
     /// Builds `method` for `mesh`. GPU methods need `ctx`; `batch` overrides their
     /// tetrahedra per point-vertex.
     pub fn new(
-        method: Method,
+        method: impl Into<Choice>,
         mesh: &Mesh,
         options: &Options,
         ctx: Option<&Context>,

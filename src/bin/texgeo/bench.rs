@@ -52,8 +52,12 @@ pub enum Command {
         #[command(flatten)]
         models: Models,
         /// CPU inclusion method for the point tests.
-        #[arg(long, value_enum, default_value_t = texgeo::inclusion::Method::Octants)]
-        method: texgeo::inclusion::Method,
+        #[arg(
+            long,
+            value_parser = texgeo::choice::value_parser::<texgeo::inclusion::Method>(texgeo::inclusion::method::AUTO),
+            default_value_t = texgeo::inclusion::Choice::Fixed(texgeo::inclusion::Method::Octants)
+        )]
+        method: texgeo::inclusion::Choice,
         /// Skip the plain classification (one point test per triangle; slow on big models).
         #[arg(long)]
         no_plain: bool,
@@ -83,8 +87,12 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = bench::scale::DEFAULT_POINTS.to_vec())]
         points: Vec<usize>,
         /// Inclusion methods (default: all, `auto` first).
-        #[arg(long, value_delimiter = ',', value_enum)]
-        methods: Vec<texgeo::inclusion::Method>,
+        #[arg(
+            long,
+            value_delimiter = ',',
+            value_parser = texgeo::choice::value_parser::<texgeo::inclusion::Method>(texgeo::inclusion::method::AUTO)
+        )]
+        methods: Vec<texgeo::inclusion::Choice>,
         /// Voxel grid sizes N (N³; empty: no voxelization).
         #[arg(long, value_delimiter = ',', default_values_t = bench::scale::DEFAULT_SIZES.to_vec())]
         sizes: Vec<usize>,
@@ -337,7 +345,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             out,
         } => {
             use bench::scale::{Config, Model};
-            use texgeo::inclusion::Method;
+            use texgeo::inclusion::{Choice, Method};
             let mesh = mesh.unwrap_or_else(|| {
                 let armadillo = models_dir.join("armadillo.off");
                 if armadillo.exists() { armadillo.into() } else { "builtin:knot".into() }
@@ -352,7 +360,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
                 texgeo::voxel::grid::check_resolution(n)?;
             }
             let methods = if methods.is_empty() {
-                std::iter::once(Method::Auto).chain(Method::ALL).collect()
+                std::iter::once(Choice::Auto).chain(Method::ALL.map(Choice::Fixed)).collect()
             } else {
                 methods
             };

@@ -9,7 +9,8 @@ use rayon::prelude::*;
 use texgeo::boolean::expr::{self, Expr};
 use texgeo::boolean::{self, Evaluation, Grouping, Names, Operation, Options, Transform};
 use texgeo::gpu::Context;
-use texgeo::inclusion::Method;
+use texgeo::inclusion::method::AUTO;
+use texgeo::inclusion::{Choice, Method};
 use texgeo::mesh::formats::{self, Format};
 use texgeo::mesh::frame::Frame;
 use texgeo::mesh::{Mesh, covering, covering::Covering, solidity};
@@ -63,8 +64,8 @@ pub struct Evaluate {
     /// bvh, tetragrid, jordan, jordan-octree, winding. The default is the fastest exact one
     /// for the few points grouped classification tests (measured: `texgeo bench boolean`);
     /// `gpu` is the thesis' GPU test, with its exact fallback.
-    #[arg(long, value_enum, default_value_t = Method::Octants)]
-    method: Method,
+    #[arg(long, value_parser = texgeo::choice::value_parser::<Method>(AUTO), default_value_t = Choice::Fixed(Method::Octants))]
+    method: Choice,
     /// One point test per triangle instead of one per group (the thesis' plain version).
     #[arg(long)]
     plain: bool,

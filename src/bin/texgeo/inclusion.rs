@@ -4,8 +4,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
+use texgeo::inclusion::method::AUTO;
 use texgeo::inclusion::solver::{self, Solver, resolve};
-use texgeo::inclusion::{Class, Method, Options, points};
+use texgeo::inclusion::{Choice, Class, Method, Options, points};
 use texgeo::mesh::solidity::Policy;
 use texgeo::random::Rng;
 
@@ -25,8 +26,8 @@ pub struct Args {
     seed: u64,
     /// `auto` picks the fastest exact method for the mesh and the number of points (and says
     /// which on stderr); every method gives the same answers.
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    method: Method,
+    #[arg(long, value_parser = texgeo::choice::value_parser::<Method>(AUTO), default_value_t = Choice::Auto)]
+    method: Choice,
     /// Grid resolution n (n³ cells): for tetragrid and gpu+tetragrid 2..=64 (default 32), for
     /// voxel-space 2..=512 (default: from the mesh and the number of points).
     #[arg(long)]

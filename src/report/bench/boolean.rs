@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use crate::boolean::{self, Evaluation, Grouping, Names, Operation, Options, Transform, cgal};
 use crate::gpu::Context;
-use crate::inclusion::Method;
+use crate::inclusion::{Choice, Method};
 use crate::mesh::{Mesh, procedural};
 use crate::report::{Environment, Report, Samples, Table};
 
@@ -58,7 +58,7 @@ pub struct Config {
     /// Timed runs per measurement (after one warm-up); medians reported.
     pub runs: usize,
     /// CPU inclusion method.
-    pub cpu_method: Method,
+    pub cpu_method: Choice,
     /// Also classify one point per triangle (slow on big models).
     pub plain: bool,
     /// Time CGAL's corefinement (needs the helper from tools/setup).
@@ -124,8 +124,8 @@ pub fn measure_interleaved(
 
 /// The options of a timed evaluation: phases one after the other (no overlap of the
 /// classifiers' build with the refinement), so each phase's time is its own.
-pub fn sequential(method: Method, grouping: Grouping) -> Options {
-    Options { method, grouping, overlap: false, ..Options::default() }
+pub fn sequential(method: impl Into<Choice>, grouping: Grouping) -> Options {
+    Options { method: method.into(), grouping, overlap: false, ..Options::default() }
 }
 
 /// The columns of Table 6-1 between the pair and the totals, shared with `texgeo

@@ -14,7 +14,7 @@ use glam::DVec3;
 
 use crate::gpu::Context;
 use crate::inclusion::solver::{Solver, resolve};
-use crate::inclusion::{Class, InclusionError, Method, Options, points};
+use crate::inclusion::{Choice, Class, InclusionError, Options, points};
 use crate::mesh::{Mesh, MeshError};
 use crate::random::Rng;
 use crate::report::{Environment, Report, Samples, Table};
@@ -40,7 +40,7 @@ pub struct Config {
     /// Query-point counts (uniform in the mesh's bounding box grown by 5 % per side).
     pub points: Vec<usize>,
     /// Inclusion methods (`auto` included).
-    pub methods: Vec<Method>,
+    pub methods: Vec<Choice>,
     /// Voxel grid sizes N (N³).
     pub sizes: Vec<usize>,
     pub voxel_methods: Vec<crate::voxel::Method>,
@@ -140,7 +140,7 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
     let mut skipped = Vec::new();
     // Last (points, total, build) per (method, threads), to predict the next point count:
     // the build again plus the classification scaled by the points.
-    let mut last: std::collections::HashMap<(Method, usize), (usize, Duration, Duration)> =
+    let mut last: std::collections::HashMap<(Choice, usize), (usize, Duration, Duration)> =
         Default::default();
     for &n in &cfg.points {
         let pts = query_points(mesh, n);
@@ -185,7 +185,7 @@ fn inclusion_table(ctx: &Context, model: &Model, cfg: &Config) -> Result<Table, 
                     }
                     None => "–",
                 };
-                if method == Method::Auto && reference.is_none() {
+                if method == Choice::Auto && reference.is_none() {
                     reference = Some(classes);
                 }
                 crate::note!(

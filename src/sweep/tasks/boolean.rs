@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::boolean::{self, BooleanError, InputError, Names, Operation, Transform, cgal};
 use crate::gpu::Context;
-use crate::inclusion::Method;
+use crate::inclusion::Choice;
 use crate::mesh::covering::measures;
 use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, Report, procedural};
@@ -21,14 +21,13 @@ use crate::sweep::task::{Failure, Task, relative};
 #[serde(default, deny_unknown_fields)]
 pub struct Options {
     /// union, intersection, difference or symmetric-difference.
-    pub op: String,
+    pub op: Operation,
     /// The second operand: `turned` (the mesh turned 10° about y and moved 1 % of its
     /// diagonal), `transform:STEPS` (the mesh moved by `texgeo boolean --transform-b`
     /// steps), or `builtin:NAME`.
     pub with: String,
     /// Inclusion method for the point tests (`texgeo boolean --method`).
-    #[serde(with = "crate::choice::by_name")]
-    pub method: Method,
+    pub method: Choice,
     /// Regularized sets (the default) or the thesis' plain ones.
     pub regularized: bool,
     /// `cgal` (volume and area of the result against CGAL's, 1e-9 relative) or `none`.
@@ -39,7 +38,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            op: "difference".into(),
+            op: Operation::Difference,
             with: "turned".into(),
             method: boolean::Options::default().method,
             regularized: true,
@@ -59,10 +58,6 @@ pub enum Reference {
 const CGAL_TOLERANCE: f64 = 1e-9;
 
 impl Options {
-    fn operation(&self) -> Result<Operation, String> {
-        self.op.parse()
-    }
-
     /// The second operand for `mesh`.
     fn other(&self, mesh: &Mesh) -> Result<Mesh, String> {
         if self.with == "turned" {
@@ -90,7 +85,6 @@ impl Task for BooleanTask {
     type Options = Options;
 
     fn validate(o: &Options) -> Result<(), String> {
-        o.operation()?;
         o.other(&procedural::cube())?;
         Ok(())
     }
@@ -107,7 +101,7 @@ impl Task for BooleanTask {
         o: &Options,
         out: &mut Record,
     ) -> Result<(), Failure> {
-        let op = o.operation().map_err(|e| Failure::failed("options", e))?;
+        let op = o.op;
         let other = o.other(mesh).map_err(|e| Failure::failed("options", e))?;
         let options = boolean::Options { method: o.method, ..boolean::Options::default() };
         let names = Names { a: "the mesh", b: "the second operand" };

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::gpu::Context;
 use crate::inclusion::solver::Solver;
-use crate::inclusion::{self, Class, InclusionError, Method};
+use crate::inclusion::{self, Choice, Class, InclusionError, Method};
 use crate::mesh::solidity::{Policy, require_solid};
 use crate::mesh::{Mesh, Report};
 use crate::random::Rng;
@@ -18,8 +18,7 @@ use crate::sweep::task::{Failure, Task};
 #[serde(default, deny_unknown_fields)]
 pub struct Options {
     /// The method under test (`texgeo inclusion --method`; `auto` is recorded as `method`).
-    #[serde(with = "crate::choice::by_name")]
-    pub method: Method,
+    pub method: Choice,
     /// Uniform random points in the bounding box.
     pub points: usize,
     pub seed: u64,
@@ -40,7 +39,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Options {
         Options {
-            method: Method::Auto,
+            method: Choice::Auto,
             points: 1000,
             seed: 1,
             grid: inclusion::tetragrid::DEFAULT_RESOLUTION,
@@ -102,7 +101,7 @@ impl Task for Inclusion {
 
         let t = Instant::now();
         let mut solver = Solver::new(o.method, mesh, &options, ctx, o.batch).map_err(refusal)?;
-        if o.method == Method::Auto {
+        if o.method == Choice::Auto {
             out.check("method", solver.name());
         }
         out.time("build", t.elapsed());
