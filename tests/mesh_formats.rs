@@ -9,6 +9,8 @@ use glam::DVec3;
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::formats::{self, Format, obj, off, ply, stl};
 use texgeo::mesh::procedural::{self, BUILTIN_NAMES};
+use texgeo::mesh::spec::{MeshSpec, Placed};
+use texgeo::mesh::transform::Transform;
 use texgeo::mesh::triangulate;
 use texgeo::mesh::{Mesh, Result};
 
@@ -471,4 +473,29 @@ fn empty_meshes_are_written_and_read_back_in_every_format() {
         stl::write_ascii(&mut ascii, mesh).unwrap();
         assert_eq!(stl::read(&ascii, &path("a.stl")).unwrap().num_faces(), 0, "{name} through ascii STL");
     }
+}
+
+#[test]
+fn steps_after_the_last_at_place_the_mesh() {
+    let p = Placed::parse("builtin:cube@scale 2; translate 1 0 0").unwrap();
+    assert_eq!(p.spec, MeshSpec::parse("builtin:cube"));
+    assert_eq!(p.transform, Some(Transform::parse("scale 2; translate 1 0 0").unwrap()));
+    let cube = procedural::cube();
+    let placed = p.load().unwrap();
+    for (q, c) in placed.positions().iter().zip(cube.positions()) {
+        assert_eq!(*q, *c * 2.0 + DVec3::X);
+    }
+    let p = Placed::parse("a@b/x.off@rotate z 90").unwrap();
+    assert_eq!(p.spec, MeshSpec::parse("a@b/x.off"));
+    assert_eq!(Placed::parse("x.off").unwrap(), Placed { spec: MeshSpec::parse("x.off"), transform: None });
+    // A file whose name has an `@` is read whole.
+    let dir = std::env::temp_dir().join(format!("texgeo-placed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let at = dir.join("at@sign.off");
+    formats::write(&at, &cube).unwrap();
+    let whole = Placed::parse(&at);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(whole.unwrap(), Placed { spec: MeshSpec::parse(&at), transform: None });
+    let e = Placed::parse("x.off@twist 3").unwrap_err();
+    assert!(e.starts_with("unknown transform step 'twist 3'"), "{e}");
 }

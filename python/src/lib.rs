@@ -15,7 +15,7 @@ use texgeo::boolean::{self, Names, Operation};
 use texgeo::gpu::{Context, ContextOptions, DeviceChoice, GpuError};
 use texgeo::inclusion::solver::classify_accepted;
 use texgeo::mesh::solidity::{self, Policy};
-use texgeo::mesh::spec::MeshSpec;
+use texgeo::mesh::spec::Placed;
 use texgeo::mesh::stats::Stats;
 use texgeo::mesh::{Mesh, formats, procedural, triangulate};
 use texgeo::subdiv::tags::{self, TaggedOptions};
@@ -379,12 +379,19 @@ impl RawVoxels {
     }
 }
 
-/// Reads a mesh file (with its OBJ tags) or `builtin:NAME`.
+/// Reads a mesh file (with its OBJ tags) or `builtin:NAME`, placed by the steps after
+/// `@` if any (`PATH@STEPS`).
 #[pyfunction]
 fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<RawMesh> {
-    let spec = MeshSpec::parse(path.as_os_str());
+    let placed = Placed::parse(path.as_os_str())
+        .map_err(|e| MeshError::new_err(format!("{}: {e}", path.display())))?;
+    let spec = &placed.spec;
     let tagged = work(py, || -> PyResult<_> {
         let (mesh, t) = spec.load_with_tags().map_err(err(Kind::Mesh))?;
+        let mesh = match &placed.transform {
+            Some(steps) => steps.apply(&mesh).map_err(err(Kind::Mesh))?,
+            None => mesh,
+        };
         // Built-in models have no tags, hence no file to name.
         tags::interpret(mesh, &t, spec.file().unwrap_or(std::path::Path::new(""))).map_err(err(Kind::Mesh))
     })?;

@@ -136,6 +136,14 @@ def test_stats_are_the_cli_json(tmp_path):
         assert ("reason" in got) == (not got["solid"])
 
 
+def test_load_places_the_mesh_by_the_steps_after_at():
+    cube = texgeo.load("builtin:cube")
+    placed = texgeo.load("builtin:cube@scale 2; translate 1 0 0")
+    assert np.allclose(placed.vertices, cube.vertices * 2 + [1, 0, 0])
+    with pytest.raises(texgeo.MeshError, match="unknown transform step 'twist 3'"):
+        texgeo.load("builtin:cube@twist 3")
+
+
 def test_arrays_round_trip(tmp_path):
     m = texgeo.load("builtin:cube")
     assert m.vertices.shape == (8, 3) and m.vertices.dtype == np.float64

@@ -244,7 +244,9 @@ class Voxels:
 
 def load(path) -> Mesh:
     """Reads a mesh (.obj .off .ply .stl; an OBJ's sharp-feature tags are kept for
-    :meth:`Mesh.subdivide`) or a built-in model ``"builtin:NAME"`` (see :func:`builtins`)."""
+    :meth:`Mesh.subdivide`) or a built-in model ``"builtin:NAME"`` (see :func:`builtins`),
+    placed by the transform steps after ``@`` if any, as ``texgeo csg`` takes them:
+    ``load("part.off@rotate z 90; translate 1 0 0")``."""
     return Mesh._wrap(_texgeo.load(_os.fspath(path)))
 
 

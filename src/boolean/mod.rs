@@ -4,7 +4,8 @@
 //!
 //! 0. [`input`]: both operands must be closed, consistently oriented solids of positive
 //!    volume whose faces do not cross (non-manifold ones and polygon faces included);
-//!    [`transform`] places B (the thesis applies a full transform to each mesh).
+//!    [`Transform`] ([`crate::mesh::transform`]) places B (the thesis applies a full transform
+//!    to each mesh).
 //! 1. **Refinement** (§6.4) — [`index`] finds candidate triangle pairs in one spatial
 //!    index over both meshes, [`intersect`] decides each pair with exact predicates and
 //!    names every intersection point symbolically, [`refine`] keeps each one implicit
@@ -49,14 +50,13 @@ pub mod intersect;
 pub mod output;
 pub mod refine;
 pub mod select;
-pub mod transform;
 
+pub use crate::mesh::transform::Transform;
 pub use classify::{Class, Classification, ClassifyStats, Grouping};
 pub use input::InputError;
 pub use output::{InvalidResult, Repair};
 pub use refine::{RefineStats, Refinement, Side};
 pub use select::Operation;
-pub use transform::Transform;
 
 /// How to evaluate.
 #[derive(Clone, Debug)]

@@ -16,6 +16,7 @@ pub mod procedural;
 pub mod solidity;
 pub mod spec;
 pub mod stats;
+pub mod transform;
 pub mod triangulate;
 pub mod validate;
 

@@ -1,14 +1,17 @@
 //! How a mesh is named — on the command line, in a sweep manifest, in a task's options —
 //! and read: a file path (any bytes the system allows, not only UTF-8) or `builtin:NAME`
-//! (one of [`procedural::BUILTIN_NAMES`]). Every command and the sweep parse names here
-//! and load through [`MeshSpec::load`]; an OBJ file's tags come back as data
+//! (one of [`procedural::BUILTIN_NAMES`]), placed by transform steps after `@` where a
+//! command takes them ([`Placed`]). Every command and the sweep parse names here and load
+//! through [`MeshSpec::load`]; an OBJ file's tags come back as data
 //! ([`MeshSpec::load_with_tags`]) for subdivision to interpret.
 
 use std::ffi::{OsStr, OsString};
 use std::fmt;
+use std::os::unix::ffi::OsStrExt as _;
 use std::path::{Path, PathBuf};
 
 use super::formats::{self, Format, obj::Tags};
+use super::transform::Transform;
 use super::{Mesh, MeshError, Result, procedural};
 
 const BUILTIN: &str = "builtin:";
@@ -77,6 +80,47 @@ impl MeshSpec {
                 formats::obj::read_with_tags(&bytes, path)
             }
             _ => Ok((self.load()?, Tags::default())),
+        }
+    }
+}
+
+/// A mesh and the steps that place it ([`Transform`]): `MESH` or `MESH@STEPS`, e.g.
+/// `part.off@"rotate z 90; translate 1 0 0"` or `builtin:cube@scale 2`, as `texgeo csg`'s
+/// operands, the sweep's second operands and Python's `load` name them. MESH is split at
+/// the last `@` unless the whole text names an existing file (a file name with `@` in it
+/// and no steps).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placed {
+    pub spec: MeshSpec,
+    /// The steps after `@` (`None`: none given).
+    pub transform: Option<Transform>,
+}
+
+impl Placed {
+    /// `MESH` or `MESH@STEPS`; the error says what is wrong with the steps.
+    pub fn parse(s: impl AsRef<OsStr>) -> std::result::Result<Placed, String> {
+        let s = s.as_ref();
+        let bytes = s.as_bytes();
+        match bytes.iter().rposition(|&c| c == b'@') {
+            Some(at) if !Path::new(s).is_file() => {
+                let steps = std::str::from_utf8(&bytes[at + 1..])
+                    .map_err(|_| "the transform after '@' is not text".to_string())?;
+                let transform = Transform::parse(steps)?;
+                Ok(Placed {
+                    spec: MeshSpec::parse(OsStr::from_bytes(&bytes[..at])),
+                    transform: Some(transform),
+                })
+            }
+            _ => Ok(Placed { spec: MeshSpec::parse(s), transform: None }),
+        }
+    }
+
+    /// Reads the mesh and places it.
+    pub fn load(&self) -> Result<Mesh> {
+        let mesh = self.spec.load()?;
+        match &self.transform {
+            Some(t) => t.apply(&mesh),
+            None => Ok(mesh),
         }
     }
 }

@@ -3,13 +3,12 @@
 
 use std::ffi::OsString;
 use std::os::unix::ffi::OsStrExt as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use texgeo::boolean::Transform;
 use texgeo::boolean::expr::{Expr, is_name};
+use texgeo::mesh::spec::Placed;
 
 use crate::boolean::{Evaluate, Operand, check_mesh_output, run_expression};
-use crate::mesh::MeshArg;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -54,8 +53,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     run_expression(device, &expr, &operands, &args.output, &args.evaluate, &args.expr)
 }
 
-/// NAME=MESH or NAME=MESH@STEPS. The MESH part is split at its last `@` unless the whole
-/// of it is an existing file (a file name with `@` in it and no transform).
+/// NAME=MESH or NAME=MESH@STEPS (MESH@STEPS read by [`Placed`]).
 fn parse_operand(text: &OsString) -> anyhow::Result<Operand> {
     let bytes = text.as_bytes();
     let shown = text.to_string_lossy();
@@ -68,20 +66,16 @@ fn parse_operand(text: &OsString) -> anyhow::Result<Operand> {
             String::from_utf8_lossy(&bytes[..eq])
         )
     })?;
-    let rest = &bytes[eq + 1..];
-    let whole = Path::new(std::ffi::OsStr::from_bytes(rest));
-    let (mesh, transform) = match rest.iter().rposition(|&c| c == b'@') {
-        Some(at) if !whole.is_file() => {
-            let steps = std::str::from_utf8(&rest[at + 1..])
-                .map_err(|_| anyhow::anyhow!("operand {name}: the transform after '@' is not text"))?;
-            let t = Transform::parse(steps).map_err(|e| anyhow::anyhow!("operand {name}: {e}"))?;
-            (&rest[..at], Some(t))
-        }
-        _ => (rest, None),
-    };
-    if mesh.is_empty() {
+    let placed = Placed::parse(std::ffi::OsStr::from_bytes(&bytes[eq + 1..]))
+        .map_err(|e| anyhow::anyhow!("operand {name}: {e}"))?;
+    if placed.spec.file().is_some_and(|f| f.as_os_str().is_empty()) {
         anyhow::bail!("operand '{shown}': expected a mesh file or builtin:NAME after '='");
     }
-    let mesh = MeshArg::from(PathBuf::from(std::ffi::OsStr::from_bytes(mesh)));
-    Ok(Operand { name: name.to_string(), label: format!("{name} ({mesh})"), mesh, transform })
+    let mesh = placed.spec;
+    Ok(Operand {
+        name: name.to_string(),
+        label: format!("{name} ({mesh})"),
+        mesh,
+        transform: placed.transform,
+    })
 }

@@ -11,7 +11,7 @@ use crate::boolean::{self, BooleanError, InputError, Names, Operation, Transform
 use crate::gpu::Context;
 use crate::inclusion::Choice;
 use crate::mesh::covering::measures;
-use crate::mesh::spec::MeshSpec;
+use crate::mesh::spec::Placed;
 use crate::mesh::{Mesh, Report, procedural};
 use crate::report::bench::boolean::turned_copy;
 use crate::sweep::record::{Record, mesh_hash};
@@ -24,7 +24,7 @@ pub struct Options {
     pub op: Operation,
     /// The second operand: `turned` (the mesh turned 10° about y and moved 1 % of its
     /// diagonal), `transform:STEPS` (the mesh moved by `texgeo boolean --transform-b`
-    /// steps), or `builtin:NAME`.
+    /// steps), or `builtin:NAME`, placed by `@STEPS` if given ([`Placed`]).
     pub with: String,
     /// Inclusion method for the point tests (`texgeo boolean --method`).
     pub method: Choice,
@@ -66,8 +66,8 @@ impl Options {
         if let Some(steps) = self.with.strip_prefix("transform:") {
             return Transform::parse(steps)?.apply(mesh).map_err(|e| e.to_string());
         }
-        if let spec @ MeshSpec::Builtin(_) = MeshSpec::parse(&self.with) {
-            return spec.load().map_err(|e| e.to_string());
+        if self.with.starts_with("builtin:") {
+            return Placed::parse(&self.with)?.load().map_err(|e| e.to_string());
         }
         Err(format!(
             "unknown second operand '{}' (expected turned, transform:STEPS or builtin:NAME)",

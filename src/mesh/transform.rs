@@ -1,6 +1,6 @@
-//! The transform applied to an operand before the operation (§6.6: "a full
-//! transformation matrix for each mesh"), written on the command line as steps applied
-//! in the order given, separated by `;`:
+//! The transform that places a mesh (§6.6: "a full transformation matrix for each mesh",
+//! before a Boolean operation), written as steps applied in the order given, separated by
+//! `;` — after `@` in a mesh name ([`super::spec::Placed`]) or in `--transform-b`:
 //!
 //! - `translate X Y Z`
 //! - `rotate x|y|z DEGREES` or `rotate AX AY AZ DEGREES` (about an axis through the origin)
@@ -12,7 +12,7 @@
 
 use glam::{DAffine3, DMat3, DVec3};
 
-use crate::mesh::Mesh;
+use super::Mesh;
 
 /// A parsed transform.
 #[derive(Clone, Copy, Debug, PartialEq)]
