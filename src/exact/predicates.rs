@@ -127,8 +127,18 @@ fn orient3d_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Stack<192> {
 pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     match orient3d_filter(a, b, c, d) {
         Some(det) => sign_of(det),
+        None if in_axis_plane(a, b, c, d) => 0,
         None => -orient3d_exact(a, b, c, d).sign(),
     }
+}
+
+/// The four points have one coordinate in common, so they lie in a plane normal to an axis
+/// and the determinant has a zero column: exactly zero, which the filter cannot vouch for
+/// (its bound is never zero). Flat faces of CAD models and flat caps lie in such planes;
+/// the check saves the exact expansion there.
+#[inline]
+fn in_axis_plane(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+    (0..3).any(|k| a[k] == d[k] && b[k] == d[k] && c[k] == d[k])
 }
 
 /// The value of [`orient3d`]'s determinant (six times the signed volume of abcd): its
@@ -238,6 +248,18 @@ mod tests {
         assert_eq!(orient2d(DVec2::ZERO, DVec2::Y, DVec2::X), -1);
         assert_eq!(orient2d_approx([0.0, 0.0], [2.0, 0.0], [0.0, 1.0]), 2.0);
         assert_eq!(normal_signs(DVec3::ZERO, DVec3::X, DVec3::Y), [0, 0, 1]);
+    }
+
+    #[test]
+    fn points_in_an_axis_plane_are_coplanar_and_the_next_float_is_not() {
+        let (a, b, c) = (DVec3::new(1e15, 0.1, 0.3), DVec3::new(-3.7, 1e-9, 0.3), DVec3::new(0.2, -5e7, 0.3));
+        let d = DVec3::new(7.0, 11.0, 0.3);
+        assert!(in_axis_plane(a, b, c, d));
+        assert_eq!(orient3d(a, b, c, d), 0);
+        let above = DVec3::new(d.x, d.y, f64::from_bits(d.z.to_bits() + 1));
+        assert!(!in_axis_plane(a, b, c, above));
+        assert_eq!(orient3d(a, b, c, above), -orient3d_exact(a, b, c, above).sign());
+        assert_ne!(orient3d(a, b, c, above), 0);
     }
 
     #[test]

@@ -30,6 +30,10 @@ const LEAF: usize = 48;
 const MAX_DEPTH: u32 = 32;
 /// Cells with more entries are split with their children in parallel.
 const PARALLEL: usize = 4096;
+/// Where a cell is halved along an axis, as a fraction of its extent: off the middle,
+/// because symmetric meshes put apexes, rings and axes on their box's middle planes, and
+/// every entry touching a split plane goes to both halves.
+const SPLIT_AT: f64 = 0.4567;
 /// Face of an edge whose triangles belong to different faces.
 const MIXED: u32 = u32::MAX;
 
@@ -185,7 +189,7 @@ impl Tree<'_> {
             3
         };
         for &(axis, size, a, reach, span) in &axes[..count] {
-            mask &= !apart_children(axis, size, a, reach, span, cell, mid, split);
+            mask &= !apart_children(axis, size, a, reach, span, cell, mid, split, mask);
             if mask == 0 {
                 break;
             }
@@ -219,7 +223,7 @@ impl Tree<'_> {
             return;
         }
         let (lo, hi) = cell;
-        let mid = (lo + hi) * 0.5;
+        let mid = lo + (hi - lo) * SPLIT_AT;
         // Axes the cell can still be halved along.
         let mut split: [bool; 3] = std::array::from_fn(|k| lo[k] < mid[k] && mid[k] < hi[k]);
         if entries.len() > LEAF {
@@ -242,8 +246,7 @@ impl Tree<'_> {
             }
             b
         };
-        let mut children: Vec<Vec<u32>> = vec![Vec::new(); 8];
-        for &x in &entries {
+        let classify = |x: u32| -> u8 {
             let (blo, bhi) = self.boxes[x as usize];
             // The halves of each axis the entry's box reaches.
             let sides = |k: usize| -> (usize, usize) {
@@ -261,10 +264,27 @@ impl Tree<'_> {
             if mask.count_ones() > 1 {
                 mask = self.children_crossed(x, cell, mid, split, mask);
             }
-            for (c, child) in children.iter_mut().enumerate() {
-                if mask >> c & 1 == 1 {
-                    child.push(x);
-                }
+            mask
+        };
+        // The children each entry enters (bit c for child c), in parallel for big cells:
+        // the top cells hold nearly every entry and would otherwise run on one core.
+        let masks: Vec<u8> = if entries.len() > PARALLEL {
+            entries.par_iter().with_min_len(1024).map(|&x| classify(x)).collect()
+        } else {
+            entries.iter().map(|&x| classify(x)).collect()
+        };
+        let mut counts = [0usize; 8];
+        for &m in &masks {
+            for (c, n) in counts.iter_mut().enumerate() {
+                *n += usize::from(m >> c & 1);
+            }
+        }
+        let mut children: Vec<Vec<u32>> = counts.iter().map(|&n| Vec::with_capacity(n)).collect();
+        for (&x, &m) in entries.iter().zip(&masks) {
+            let mut m = m;
+            while m != 0 {
+                children[m.trailing_zeros() as usize].push(x);
+                m &= m - 1;
             }
         }
         drop(entries);
@@ -295,23 +315,37 @@ impl Tree<'_> {
     /// the pairs of the edge's triangles with that triangle.
     fn pair(&self, entries: &[u32], out: &mut Vec<u64>) {
         let overlaps = |a: Box3, b: Box3| a.0.cmple(b.1).all() && b.0.cmple(a.1).all();
-        for &e in entries.iter().filter(|&&x| x >= self.n) {
-            let ends = self.vertices(e);
+        let (edges, triangles): (Vec<u32>, Vec<u32>) = entries.iter().partition(|&&x| x >= self.n);
+        let first = out.len();
+        for &e in &edges {
             let k = (e - self.n) as usize;
-            for &u in entries.iter().filter(|&&x| x < self.n) {
-                if self.triangles[u as usize].iter().any(|v| ends.contains(v))
-                    || !overlaps(self.boxes[e as usize], self.boxes[u as usize])
-                {
+            let [a, b] = self.edges[k];
+            let edge_box = self.boxes[e as usize];
+            let around = &self.adjacent[self.start[k] as usize..self.start[k + 1] as usize];
+            for &u in &triangles {
+                let tu = self.triangles[u as usize];
+                if tu.contains(&a) || tu.contains(&b) || !overlaps(edge_box, self.boxes[u as usize]) {
                     continue;
                 }
                 let fu = self.face_of[u as usize];
-                for &t in &self.adjacent[self.start[k] as usize..self.start[k + 1] as usize] {
+                for &t in around {
                     if self.face_of[t as usize] != fu {
                         out.push((t.min(u) as u64) << 32 | t.max(u) as u64);
                     }
                 }
             }
         }
+        // A pair comes once per edge of either triangle that reaches the other: drop the
+        // repeats here, where they are few and close, before the global sort.
+        out[first..].sort_unstable();
+        let mut kept = first;
+        for r in first..out.len() {
+            if kept == first || out[kept - 1] != out[r] {
+                out[kept] = out[r];
+                kept += 1;
+            }
+        }
+        out.truncate(kept);
     }
 }
 
@@ -321,7 +355,7 @@ fn edge_axes(d: DVec3) -> [DVec3; 3] {
 }
 
 /// Along `axis`, which children of `cell` (halved at `mid` along the axes of `split`, as
-/// in [`Tree::children_crossed`]; bit c for child c) and an object that projects
+/// in [`Tree::children_crossed`]; bit c for child c, among those of `mask`) and an object that projects
 /// (relative to its point `a`) onto the interval between 0 and `reach` (`reach` =
 /// axis · (r − a) for the object's point r with |r − a| = `span`) are apart by more than
 /// the rounding can explain, given that each component of `axis` is within a few ulps of
@@ -338,6 +372,7 @@ fn apart_children(
     (lo, hi): Box3,
     mid: DVec3,
     split: [bool; 3],
+    mask: u8,
 ) -> u8 {
     let (u, m, v) = (lo - a, mid - a, hi - a);
     let (pu, pm, pv) = (axis * u, axis * m, axis * v);
@@ -350,7 +385,10 @@ fn apart_children(
     let tol = 1e-12 * (size * w).element_sum() + 1e-300 * (w.element_sum() + 1.0);
     let (below, above) = (reach.min(0.0) - tol, reach.max(0.0) + tol);
     let mut apart = 0u8;
-    for c in 0..8 {
+    let mut left = mask;
+    while left != 0 {
+        let c = left.trailing_zeros() as usize;
+        left &= left - 1;
         let [x, y, z] = std::array::from_fn(|k| half[k][c >> k & 1]);
         if x.0 + y.0 + z.0 > above || x.1 + y.1 + z.1 < below {
             apart |= 1 << c;
@@ -368,7 +406,7 @@ mod tests {
         let cell = (DVec3::ZERO, DVec3::ONE);
         let whole = [false; 3];
         let apart = |a: DVec3, reach: f64, span: DVec3| {
-            apart_children(DVec3::ONE, DVec3::ONE, a, reach, span, cell, DVec3::splat(0.5), whole) & 1 == 1
+            apart_children(DVec3::ONE, DVec3::ONE, a, reach, span, cell, DVec3::splat(0.5), whole, 1) & 1 == 1
         };
         let none = DVec3::ZERO;
         // The plane x + y + z = 3 touches the corner (1, 1, 1): not apart.
@@ -390,11 +428,12 @@ mod tests {
             cell,
             DVec3::splat(0.5),
             [true; 3],
+            0xff,
         );
         assert_eq!(halves, 1 << 7);
         // Far beyond f64's range the products overflow: no decision.
         let big = DVec3::splat(1e300);
-        assert_eq!(apart_children(big, big, big, 0.0, none, cell, DVec3::splat(0.5), [true; 3]), 0);
+        assert_eq!(apart_children(big, big, big, 0.0, none, cell, DVec3::splat(0.5), [true; 3], 0xff), 0);
     }
 
     #[test]
