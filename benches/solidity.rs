@@ -8,8 +8,10 @@
 //! (long slivers over a flat fan); `cone`, one apex of valence `faces / 2` over a base
 //! kept as one polygon; `sliver`, a cylinder 5 times taller than wide whose sides are
 //! long parallel slivers, its caps fanned; `valence`, one apex of valence `faces − 1`
-//! over a base kept as one polygon (about `2 · faces` triangles). Seconds are the median and minimum of N runs (default 3), wall
-//! clock and CPU (user + system, all threads: what a busy machine does not hide).
+//! over a base kept as one polygon (about `2 · faces` triangles). Seconds are the median and
+//! minimum of N runs (default 3), wall clock and CPU (user + system, all threads: what a
+//! busy machine does not hide); `load` is the one-minute load average when the row's runs
+//! ended (on a shared machine, wall seconds mean little without it).
 
 use std::time::Instant;
 
@@ -23,6 +25,14 @@ fn cpu_seconds() -> f64 {
     unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
     let secs = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
     secs(usage.ru_utime) + secs(usage.ru_stime)
+}
+
+/// The one-minute load average (Linux), or NaN where it cannot be read.
+fn load_average() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse().ok()))
+        .unwrap_or(f64::NAN)
 }
 
 fn shape(name: &str, faces: u32) -> Option<Mesh> {
@@ -51,7 +61,7 @@ fn main() -> anyhow::Result<()> {
         Some(s) => vec![s.as_str()],
         None => vec!["bicone", "needle", "cone", "sliver", "valence"],
     };
-    println!("shape,faces,triangles,median_s,min_s,median_cpu_s,solid");
+    println!("shape,faces,triangles,median_s,min_s,median_cpu_s,solid,load");
     for name in shapes {
         for &n in &faces {
             let Some(mesh) = shape(name, n) else { bail!("unknown shape {name}") };
@@ -69,9 +79,10 @@ fn main() -> anyhow::Result<()> {
             cpu.sort_by(f64::total_cmp);
             let (median, median_cpu) = (seconds[seconds.len() / 2], cpu[cpu.len() / 2]);
             println!(
-                "{name},{},{triangles},{median:.3},{:.3},{median_cpu:.3},{solid}",
+                "{name},{},{triangles},{median:.3},{:.3},{median_cpu:.3},{solid},{:.1}",
                 mesh.num_faces(),
-                seconds[0]
+                seconds[0],
+                load_average()
             );
         }
     }
