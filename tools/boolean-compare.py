@@ -227,9 +227,13 @@ def main():
         if not solid:
             print(f"{name}: not a solid texgeo accepts, skipped", file=sys.stderr)
             continue
-        # texgeo's own reader normalises the corpus' OFF dialects (COFF colours, comments) first
+        # texgeo's own reader normalises the corpus' OFF dialects (COFF colours, comments), and
+        # its STL writer triangulates polygons as every command does (a fan of a non-convex
+        # polygon would cross itself)
         plain = os.path.join(work, f"{name[:-4]}.in.off")
-        if run([args.texgeo, "mesh", "convert", src, plain], args.timeout)[1] != 0:
+        tri = os.path.join(work, f"{name[:-4]}.in.stl")
+        if any(run([args.texgeo, "mesh", "convert", i, o], args.timeout)[1] != 0
+               for i, o in ((src, tri), (tri, plain))):
             print(f"{name}: texgeo could not convert it, skipped", file=sys.stderr)
             continue
         pos, tris = read_off(plain)
