@@ -24,6 +24,9 @@ pub struct Table {
     pub notes: Vec<String>,
     /// File stem of the table's CSV (`REPORT-STEM.csv`); empty = numbered.
     pub stem: String,
+    /// The unit of each column's numbers where the title rather than the column's name
+    /// says it (empty: none); the CSV's header names it.
+    pub units: Vec<String>,
 }
 
 impl Table {
@@ -38,6 +41,17 @@ impl Table {
     /// Names the table's CSV file.
     pub fn named(mut self, stem: &str) -> Table {
         self.stem = stem.to_string();
+        self
+    }
+
+    /// Names `unit` as the unit of `columns` (the CSV header says it: "phase 1 (ms)").
+    pub fn unit(mut self, unit: &str, columns: impl IntoIterator<Item = usize>) -> Table {
+        self.units.resize(self.columns.len(), String::new());
+        for c in columns {
+            if let Some(u) = self.units.get_mut(c) {
+                *u = unit.to_string();
+            }
+        }
         self
     }
 
@@ -64,21 +78,80 @@ impl Table {
         s
     }
 
+    /// The table as CSV for a program to read: numbers only, units in the header. A
+    /// ratio "2.31×" or share "12.5 %" is written 2.31 or 12.5 with "(×)" or "(%)" in its
+    /// column's name, a missing value ("–") is an empty cell, ∞ is `inf`, and Markdown
+    /// markup (`code`, [links](…)) is dropped.
     pub fn to_csv(&self) -> String {
-        let esc = |c: &str| {
-            if c.contains([',', '"', '\n']) {
-                format!("\"{}\"", c.replace('"', "\"\""))
-            } else {
-                c.to_string()
-            }
-        };
-        let mut s = String::new();
-        let _ = writeln!(s, "{}", self.columns.iter().map(|c| esc(c)).collect::<Vec<_>>().join(","));
-        for r in &self.rows {
-            let _ = writeln!(s, "{}", r.iter().map(|c| esc(c)).collect::<Vec<_>>().join(","));
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let cells: Vec<Vec<(String, Option<&str>)>> =
+            self.rows.iter().map(|r| r.iter().map(|c| csv_cell(c)).collect()).collect();
+        let header: Vec<String> = self
+            .columns
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let name = plain(name);
+                let suffix = cells.iter().find_map(|r| r.get(i).and_then(|c| c.1));
+                let unit = self.units.get(i).filter(|u| !u.is_empty()).map(String::as_str).or(suffix);
+                match unit {
+                    Some(u) if !name.contains(u) => format!("{name} ({u})"),
+                    _ => name,
+                }
+            })
+            .collect();
+        let _ = w.write_record(&header);
+        for r in cells {
+            let _ = w.write_record(r.iter().map(|c| c.0.as_str()));
         }
-        s
+        String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
     }
+}
+
+/// Text without Markdown's inline markup: `code` → code, [label](target) → label.
+fn plain(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(c) = rest.chars().next() {
+        if let Some(after) = rest.strip_prefix('[')
+            && let Some(mid) = after.find("](")
+            && let Some(end) = after[mid + 2..].find(')')
+        {
+            out.push_str(&after[..mid]);
+            rest = &after[mid + 3 + end..];
+        } else {
+            if c != '`' {
+                out.push(c);
+            }
+            rest = &rest[c.len_utf8()..];
+        }
+    }
+    out
+}
+
+/// A Markdown cell as a CSV cell, and the unit sign taken off it (× or %) when it was a
+/// number followed by one.
+fn csv_cell(cell: &str) -> (String, Option<&'static str>) {
+    let c = cell.trim();
+    if c == "–" || c == "-" {
+        return (String::new(), None);
+    }
+    if c == "∞" {
+        return ("inf".into(), None);
+    }
+    let number = |s: &str| {
+        let s: String = s.trim().chars().filter(|c| !matches!(c, '\u{202f}' | '\u{2009}')).collect();
+        s.parse::<f64>().is_ok().then_some(s)
+    };
+    for unit in ["×", "%"] {
+        if let Some(n) = c.strip_suffix(unit).and_then(number) {
+            return (n, Some(unit));
+        }
+    }
+    if let Some(n) = number(c) {
+        return (n, None);
+    }
+    (plain(c), None)
 }
 
 /// A set of tables from one run, with the environment that produced them.
@@ -139,5 +212,21 @@ mod tests {
         assert_eq!(super::sig(123456.0, 4), "123456");
         assert_eq!(super::sig(-2.5, 2), "-2.5");
         assert_eq!(super::sig(0.0, 3), "0");
+    }
+
+    #[test]
+    fn csv_cells_are_numbers_with_their_units_in_the_header() {
+        let mut t = super::Table::new("T (ms)", &["[model](#m)", "speed-up", "saved", "time", "note"])
+            .unit("ms", [3]);
+        t.row(vec!["`a`".into(), "2.31×".into(), "99.4 %".into(), "1\u{202f}234.5".into(), "x, y".into()]);
+        t.row(vec!["b".into(), "–".into(), "∞".into(), "0.5".into(), "–".into()]);
+        assert_eq!(
+            t.to_csv(),
+            "model,speed-up (×),saved (%),time (ms),note\na,2.31,99.4,1234.5,\"x, y\"\nb,,inf,0.5,\n"
+        );
+        // A unit the column's name already says is not said twice.
+        let mut t = super::Table::new("T", &["today / thesis (×)", "spread (± %)"]);
+        t.row(vec!["0.5×".into(), "12 %".into()]);
+        assert_eq!(t.to_csv(), "today / thesis (×),spread (± %)\n0.5,12\n");
     }
 }

@@ -129,13 +129,15 @@ pub fn sequential(method: impl Into<Choice>, grouping: Grouping) -> Options {
 }
 
 /// The columns of Table 6-1 between the pair and the totals, shared with `texgeo
-/// reproduce`'s table: the thesis' pair, the operation and the measured phases (ms).
-pub const PHASE_COLUMNS: [&str; 10] = [
+/// reproduce`'s table: the thesis' pair, the operation and the measured phases (ms, the
+/// columns [`PHASE_MS`]).
+pub const PHASE_COLUMNS: [&str; 11] = [
     "thesis pair",
     "op",
     "triangles",
     "cut A+B",
-    "point tests grouped / plain",
+    "point tests grouped",
+    "point tests plain",
     "saved",
     "phase 1",
     "phase 2 grouped CPU",
@@ -143,15 +145,23 @@ pub const PHASE_COLUMNS: [&str; 10] = [
     "phase 2 plain CPU",
 ];
 
+/// The columns of a table that starts with the pair's name and [`PHASE_COLUMNS`] that
+/// hold milliseconds.
+pub const PHASE_MS: std::ops::RangeInclusive<usize> = 8..=11;
+
 /// Runs the benchmark.
 pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Report> {
     let columns = [
         &["pair (stand-in)"][..],
         &PHASE_COLUMNS,
-        &["total grouped CPU", "CGAL corefinement", "thesis plain / grouped total (s)"],
+        &["total grouped CPU", "CGAL corefinement", "thesis plain total", "thesis grouped total"],
     ]
     .concat();
-    let mut table = Table::new("Table 6-1: Boolean operations (ms; thesis in s)", &columns).named("table6-1");
+    let mut table = Table::new("Table 6-1: Boolean operations (ms; thesis in s)", &columns)
+        .named("table6-1")
+        .unit("ms", PHASE_MS)
+        .unit("ms", 12..=13)
+        .unit("s", 14..=15);
     let mut refused = Vec::new();
     for pair in pairs {
         let triangles = pair.a.num_faces() + pair.b.num_faces();
@@ -191,18 +201,15 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         let s = ev.classification.stats;
         for (k, &op) in OPERATIONS.iter().enumerate() {
             let total = p1.median() + p2.median() + asm[k].median();
-            let thesis = thesis_seconds(pair.thesis, op).map_or("–".into(), |(p, g)| format!("{p} / {g}"));
+            let thesis = thesis_seconds(pair.thesis, op);
             table.row(vec![
                 pair.name.clone(),
                 pair.thesis.to_string(),
                 op.symbol().to_string(),
                 triangles.to_string(),
                 (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
-                format!(
-                    "{} / {}",
-                    s.point_tests,
-                    plain.as_ref().map_or("–".into(), |p| p.3.classification.stats.point_tests.to_string())
-                ),
+                s.point_tests.to_string(),
+                plain.as_ref().map_or("–".into(), |p| p.3.classification.stats.point_tests.to_string()),
                 format!("{:.1} %", 100.0 * s.saved_share()),
                 ms(p1.median()),
                 ms(p2.median() + asm[k].median()),
@@ -213,7 +220,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                     .as_ref()
                     .and_then(|r| r.median_seconds(op))
                     .map_or("–".into(), |t| format!("{:.1}", t * 1e3)),
-                thesis,
+                thesis.map_or("–".into(), |t| t.0.to_string()),
+                thesis.map_or("–".into(), |t| t.1.to_string()),
             ]);
         }
         crate::note!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
@@ -250,7 +258,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                 "phase 2 µs/tri",
             ],
         )
-        .named("scaling");
+        .named("scaling")
+        .unit("ms", 2..=4);
         // (triangles, phase 1 s, phase 2 s) per size, for the growth exponents.
         let mut growth: Vec<(f64, f64, f64)> = Vec::new();
         for &n in &cfg.scaling {

@@ -121,6 +121,10 @@ fn thesis_table(id: &str) -> Table {
         &columns,
     )
     .named(&format!("table{id}-thesis"));
+    // Tables 4-5, 4-6 and 4-9 give seconds per set without saying so in their columns.
+    if matches!(id, "4-5" | "4-6" | "4-9") {
+        t = t.unit("s", 2..columns.len());
+    }
     for l in lines.filter(|l| !l.trim().is_empty()) {
         t.row(l.split(',').map(str::to_string).collect());
     }
@@ -477,6 +481,8 @@ fn table_4_5(measured: &[Measured], cfg: &Config) -> Table {
         columns: cols,
         ..Default::default()
     };
+    let columns = t45.columns.len();
+    t45 = t45.unit("s", 2..columns);
     for m in measured {
         let mut row = vec![label(m), m.faces.to_string(), m.time("cpu")];
         row.extend(m.grid_times.iter().map(|t| secs(t.mean())));
@@ -500,7 +506,8 @@ fn table_4_6(measured: &[Measured], cfg: &Config) -> Table {
             "TetraGrid 32",
             "GPU+TetraGrid 32",
         ],
-    );
+    )
+    .unit("s", 2..9);
     for m in measured {
         t46.row(vec![
             label(m),
@@ -530,7 +537,8 @@ fn index_tables(measured: &[Measured]) -> (Table, Table) {
             "Feito (BVH)",
             "Jordan (octree 6)",
         ],
-    );
+    )
+    .unit("KiB", 2..6);
     let mut t48 = Table::new(
         "Table 4-8: time to build each method's index (s)",
         &[
@@ -541,7 +549,8 @@ fn index_tables(measured: &[Measured]) -> (Table, Table) {
             "Feito (BVH)",
             "Jordan (octree 6)",
         ],
-    );
+    )
+    .unit("s", 2..6);
     for m in measured {
         let mut mem = vec![label(m), m.triangles.to_string()];
         let mut time = mem.clone();
@@ -570,7 +579,8 @@ fn table_4_9(measured: &[Measured], cfg: &Config) -> Table {
             "Jordan",
             "Jordan octree 6",
         ],
-    );
+    )
+    .unit("s", 2..8);
     for m in measured {
         t49.row(vec![
             label(m),
@@ -600,7 +610,8 @@ fn speed_ups(measured: &[Measured], cfg: &Config) -> Table {
             "gpu+tetragrid",
             "jordan-octree",
         ],
-    );
+    )
+    .unit("×", 1..8);
     for m in measured {
         speed.row(vec![
             label(m),

@@ -107,8 +107,11 @@ pub struct Measured {
     pub osd: (f64, f64),
     /// OpenSubdiv's every run, interleaved with `gpu_totals` and `cpu`.
     pub osd_runs: Samples,
-    /// "match, …", "MISMATCH" or "not checked".
+    /// "match", "MISMATCH" or "not checked".
     pub verdict: String,
+    /// The largest distance from OpenSubdiv's vertices over the bounding box's diagonal,
+    /// when they match.
+    pub max_error: Option<f64>,
 }
 
 /// Steps [`measure`] reports.
@@ -161,15 +164,15 @@ pub fn measure(
         let run = last.unwrap_or(first);
         progress.step(&format!("{}: compared with OpenSubdiv", model.name));
         let osd_times = (osd_runs.min().as_secs_f64(), osd_runs.median().as_secs_f64());
-        let verdict = if settings.validate {
+        let (verdict, max_error) = if settings.validate {
             let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
             if c.is_match() {
-                format!("match, max {:.1e} × diag", c.max_error / c.diagonal.max(f64::MIN_POSITIVE))
+                ("match", Some(c.max_error / c.diagonal.max(f64::MIN_POSITIVE)))
             } else {
-                "MISMATCH".to_string()
+                ("MISMATCH", None)
             }
         } else {
-            "not checked".to_string()
+            ("not checked", None)
         };
         out.push(Measured {
             name: model.name.clone(),
@@ -186,7 +189,8 @@ pub fn measure(
             cpu,
             osd: osd_times,
             osd_runs,
-            verdict,
+            verdict: verdict.to_string(),
+            max_error,
         });
     }
     Ok(out)
@@ -284,8 +288,10 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             "OpenSubdiv",
             "GPU path / OpenSubdiv",
             "vs OpenSubdiv",
+            "largest distance / diagonal",
         ],
-    );
+    )
+    .unit("ms", 5..=9);
     let mut split = Table::new(
         format!("Where the GPU path's time goes: level {level}, medians (ms)"),
         &[
@@ -299,9 +305,13 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             "assembly",
             "GPU path",
             "first run (cold)",
-            "targets",
+            "each pass",
+            "target width",
+            "target height",
         ],
-    );
+    )
+    .unit("ms", 1..=10)
+    .unit("texels", 11..=12);
     let mut targets = Vec::new();
     for m in measured {
         let gpu = &m.gpu;
@@ -329,6 +339,7 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             ms(osd_time),
             format!("{ratio:.2}"),
             m.verdict.clone(),
+            m.max_error.map_or("–".into(), |e| format!("{e:.1e}")),
         ]);
         let passes: Vec<String> = gpu.passes.iter().map(|&p| ms(p)).collect();
         split.row(vec![
@@ -336,13 +347,15 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             ms(gpu.base),
             ms(gpu.fragments),
             ms(gpu.upload),
-            format!("{} = {}", ms(gpu.passes_total()), passes.join(" + ")),
+            ms(gpu.passes_total()),
             ms(gpu.readback),
             ms(gpu.submit),
             ms(gpu.assembly),
             ms(gpu.total),
             ms(m.cold),
-            format!("2 × {}×{}", m.texture[0], m.texture[1]),
+            passes.join(" + "),
+            m.texture[0].to_string(),
+            m.texture[1].to_string(),
         ]);
     }
     table5.note(format!(
@@ -362,7 +375,8 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
         "Upload, passes and readback are GPU timestamps inside the one submission; the submission's wall \
          time also holds staging writes and waiting. Fragment build: cutting the base level into fragments, \
          writing their texel stream and the pass tables. Assembly: dropping the support rings and welding \
-         by coarse element into a Mesh (two threads).",
+         by coarse element into a Mesh (two threads). Each pass: the passes' times in order. Targets: two \
+         render targets of the width and height given (texels).",
     );
     Report { name: "subdivide".into(), environment, tables: vec![table5, split, thesis_table5()] }
 }
@@ -435,6 +449,7 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             "creased edges",
             "sharpness",
             "fragments with data",
+            "fragments",
             "GPU path, no creases",
             "GPU path, creased",
             "ratio (median of pairs)",
@@ -443,7 +458,8 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             "passes ratio",
             "target ≤ 1.2",
         ],
-    );
+    )
+    .unit("ms", [6, 7, 9, 10]);
     let mut subdivider = Subdivider::new(ctx)?;
     for model in models {
         let smooth = Surface::smooth(model.mesh.clone());
@@ -485,12 +501,8 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
                 } else {
                     format!("{sharpness}")
                 },
-                format!(
-                    "{} of {} ({:.0} %)",
-                    fragments.0,
-                    fragments.1,
-                    100.0 * fragments.0 as f64 / fragments.1.max(1) as f64
-                ),
+                fragments.0.to_string(),
+                fragments.1.to_string(),
                 ms(p.total),
                 ms(s.total),
                 format!("{ratio:.2}"),

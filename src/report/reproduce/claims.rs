@@ -114,9 +114,45 @@ fn within(lo: f64, hi: f64, a: f64, b: f64) -> Decision {
     }
 }
 
-/// What a claim's function finds: the value shown (with its interval) and where the
-/// rule puts it.
-pub type Measure = Result<(String, Decision), String>;
+/// The number a rule decided on and its interval, for programs (`claims.csv`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Value {
+    pub value: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// "ratio", "slope", "rank correlation", "share" or "s".
+    pub unit: &'static str,
+}
+
+impl Value {
+    fn ratio(r: &Ratio) -> Value {
+        Value { value: r.value, lo: r.lo, hi: r.hi, unit: "ratio" }
+    }
+}
+
+/// What a claim's function finds: the value shown (with its interval), where the rule
+/// puts it, and the deciding number when the rule has one (not for counts of models).
+#[derive(Clone, Debug)]
+pub struct Found {
+    pub shown: String,
+    pub decision: Decision,
+    pub value: Option<Value>,
+}
+
+impl From<(String, Decision)> for Found {
+    fn from((shown, decision): (String, Decision)) -> Found {
+        Found { shown, decision, value: None }
+    }
+}
+
+impl Found {
+    fn with(mut self, value: Value) -> Found {
+        self.value = Some(value);
+        self
+    }
+}
+
+pub type Measure = Result<Found, String>;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Verdict {
@@ -129,9 +165,9 @@ pub enum Verdict {
 impl Verdict {
     pub fn of(m: &Measure) -> Verdict {
         match m {
-            Ok((_, Decision::Holds)) => Verdict::Holds,
-            Ok((_, Decision::DoesNotHold)) => Verdict::DoesNotHold,
-            Ok((_, Decision::Inconclusive)) => Verdict::Inconclusive,
+            Ok(Found { decision: Decision::Holds, .. }) => Verdict::Holds,
+            Ok(Found { decision: Decision::DoesNotHold, .. }) => Verdict::DoesNotHold,
+            Ok(Found { decision: Decision::Inconclusive, .. }) => Verdict::Inconclusive,
             Err(why) => Verdict::NotMeasurable(why.clone()),
         }
     }
@@ -203,7 +239,7 @@ fn min_ratio(f: &Facts, exp: &str, a: &str, b: &str, t: f64, strict: bool) -> Me
     } else {
         format!("lowest {} ({}), highest {} over {} models", xr(&low.2), low.0, x(high), r.len())
     };
-    Ok((shown, decision))
+    Ok(Found::from((shown, decision)).with(Value::ratio(&low.2)))
 }
 
 /// The log–log slope of `points` (size, value) and its interval: the range of the slopes
@@ -240,10 +276,11 @@ fn slope(f: &Facts, exp: &str, key: &str, range: (f64, f64)) -> Measure {
     let (k, lo, hi, reps) = slope_interval(&pts).ok_or_else(|| {
         format!("needs models whose sizes span a factor of 2 or more ({} model(s) here)", s.len())
     })?;
-    Ok((
+    Ok(Found::from((
         format!("slope {} {}", fr(k, lo, hi, false), fitted(s.len(), reps)),
         within(lo, hi, range.0, range.1),
     ))
+    .with(Value { value: k, lo, hi, unit: "slope" }))
 }
 
 /// Rank correlation of model size and `a / b`, which must be positive, with `a / b`
@@ -268,7 +305,7 @@ fn advantage_grows(f: &Facts, exp: &str, a: &str, b: &str) -> Measure {
     }
     let largest = &r[r.len() - 1];
     let decision = Decision::all([above(lo, hi, 0.0), above(largest.2.lo, largest.2.hi, 1.0)]);
-    Ok((
+    Ok(Found::from((
         format!(
             "rank correlation {} over {} models; {} on the smallest, {} on the largest",
             fr(rho, lo, hi, true),
@@ -278,13 +315,14 @@ fn advantage_grows(f: &Facts, exp: &str, a: &str, b: &str) -> Measure {
         ),
         decision,
     ))
+    .with(Value { value: rho, lo, hi, unit: "rank correlation" }))
 }
 
 /// The ratio on the largest model, which must reach `t`.
 fn on_largest(f: &Facts, exp: &str, a: &str, b: &str, t: f64) -> Measure {
     let r = ratios(f, exp, a, b)?;
     let (model, _, q) = r.last().ok_or("no model")?;
-    Ok((format!("{} ({model})", xr(q)), at_least(q.lo, q.hi, t)))
+    Ok(Found::from((format!("{} ({model})", xr(q)), at_least(q.lo, q.hi, t))).with(Value::ratio(q)))
 }
 
 // ---------------------------------------------------------------- point in solid (Ch. 4)
@@ -307,10 +345,11 @@ fn tetragrid_discards(f: &Facts) -> Measure {
         }
     })?;
     let worst = s.iter().map(|p| p.2.value).fold(0f64, f64::max);
-    Ok((
+    Ok(Found::from((
         format!("at least {} discarded (worst of {} models; counted, no noise)", pct(1.0 - worst), s.len()),
         (1.0 - worst >= 0.9).into(),
     ))
+    .with(Value { value: 1.0 - worst, lo: 1.0 - worst, hi: 1.0 - worst, unit: "share" }))
 }
 
 fn tetragrid_memory_grows(f: &Facts) -> Measure {
@@ -330,7 +369,8 @@ fn tetragrid_memory_grows(f: &Facts) -> Measure {
     if total == 0 {
         return Err(f.why_not_run("inclusion").unwrap_or("no TetraGrid memory measured").to_string());
     }
-    Ok((format!("grows on {grows} of {total} models (counted bytes, no noise)"), (grows == total).into()))
+    Ok((format!("grows on {grows} of {total} models (counted bytes, no noise)"), (grows == total).into())
+        .into())
 }
 
 fn tetragrid_build_order(f: &Facts) -> Measure {
@@ -356,7 +396,11 @@ fn tetragrid_build_order(f: &Facts) -> Measure {
         f.why_not_run("inclusion").unwrap_or("no TetraGrid build times at 16³–64³").to_string()
     })?;
     let how = if reps > 0 { format!("; interval: each of {reps} builds fitted") } else { String::new() };
-    Ok((format!("steepest slope {} in n ({m}{how})", fr(k, lo, hi, false)), Decision::all(decisions)))
+    Ok(Found::from((
+        format!("steepest slope {} in n ({m}{how})", fr(k, lo, hi, false)),
+        Decision::all(decisions),
+    ))
+    .with(Value { value: k, lo, hi, unit: "slope" }))
 }
 
 fn gpu_faster(f: &Facts) -> Measure {
@@ -371,13 +415,13 @@ fn gpu_factor_10(f: &Facts) -> Measure {
     let r = ratios(f, "inclusion", "time:cpu", "time:gpu")?;
     let best = r.iter().max_by(|a, b| a.2.value.total_cmp(&b.2.value)).ok_or("no model")?;
     let decision = Decision::any(r.iter().map(|p| at_least(p.2.lo, p.2.hi, 10.0)));
-    Ok((format!("best {} ({})", xr(&best.2), best.0), decision))
+    Ok(Found::from((format!("best {} ({})", xr(&best.2), best.0), decision)).with(Value::ratio(&best.2)))
 }
 
 fn cpu_wins_small(f: &Facts) -> Measure {
     let r = ratios(f, "inclusion", "time:gpu", "time:cpu")?;
     let (m, _, q) = r.first().ok_or("no model")?;
-    Ok((format!("gpu / cpu {} ({m})", xr(q)), above(q.lo, q.hi, 1.0)))
+    Ok(Found::from((format!("gpu / cpu {} ({m})", xr(q)), above(q.lo, q.hi, 1.0))).with(Value::ratio(q)))
 }
 
 fn feito_beats_jordan(f: &Facts) -> Measure {
@@ -438,7 +482,8 @@ fn cheapest(f: &Facts, index: &str, others: &[&str]) -> Measure {
     Ok((
         format!("{shown} (build times: medians of their runs, compared beyond their range)"),
         Decision::all(decisions),
-    ))
+    )
+        .into())
 }
 
 fn octants_cheapest(f: &Facts) -> Measure {
@@ -462,7 +507,7 @@ fn bsp_costliest(f: &Facts) -> Measure {
         }
     }
     let shown = if fails.is_empty() { format!("costliest on {} models", s.len()) } else { fails.join(", ") };
-    Ok((shown, fails.is_empty().into()))
+    Ok((shown, fails.is_empty().into()).into())
 }
 
 fn octree_helps_jordan(f: &Facts) -> Measure {
@@ -694,7 +739,7 @@ fn voxel_grows_with_n(f: &Facts) -> Measure {
              within it or shrinking"
         ),
         Decision::all(decisions),
-    ))
+    ).into())
 }
 
 fn voxel_grows_with_size(f: &Facts) -> Measure {
@@ -724,7 +769,7 @@ fn voxel_grows_with_size(f: &Facts) -> Measure {
              rest within it or shrinking"
         ),
         Decision::all(decisions),
-    ))
+    ).into())
 }
 
 /// "Equal or better": zoned is slower only where the whole interval of pgpu / zoned lies
@@ -755,7 +800,7 @@ fn mp_never_slower(f: &Facts) -> Measure {
         ratios.len(),
         if slower.is_empty() { String::new() } else { format!("; zoned slower at {}", slower.join(", ")) }
     );
-    Ok((shown, slower.is_empty().into()))
+    Ok(Found::from((shown, slower.is_empty().into())).with(Value::ratio(low)))
 }
 
 /// Geometric mean of a / b over the cells where both were measured, with the geometric
@@ -773,12 +818,20 @@ fn voxel_geomean(f: &Facts, a: &str, b: &str) -> Result<(Ratio, usize), String> 
 
 fn fang_near_pgpu(f: &Facts) -> Measure {
     let (g, n) = voxel_geomean(f, "fang", "pgpu")?;
-    Ok((format!("fang / pgpu {} (geometric mean of {n} cells)", xr(&g)), within(g.lo, g.hi, 0.5, 2.0)))
+    Ok(Found::from((
+        format!("fang / pgpu {} (geometric mean of {n} cells)", xr(&g)),
+        within(g.lo, g.hi, 0.5, 2.0),
+    ))
+    .with(Value::ratio(&g)))
 }
 
 fn mp_beats_fang(f: &Facts) -> Measure {
     let (g, n) = voxel_geomean(f, "fang", "zoned")?;
-    Ok((format!("fang / zoned {} (geometric mean of {n} cells)", xr(&g)), above(g.lo, g.hi, 1.0)))
+    Ok(Found::from((
+        format!("fang / zoned {} (geometric mean of {n} cells)", xr(&g)),
+        above(g.lo, g.hi, 1.0),
+    ))
+    .with(Value::ratio(&g)))
 }
 
 /// The methods of `methods`, fastest first by geometric-mean time over the cells where
@@ -819,7 +872,7 @@ fn ranked(f: &Facts, methods: &[&str], holds: fn(&[String]) -> bool) -> Measure 
     let (medians, per_rep) = voxel_rankings(f, methods)?;
     let order = medians.join(" < ");
     if per_rep.is_empty() {
-        return Ok((format!("fastest first: {order}"), holds(&medians).into()));
+        return Ok((format!("fastest first: {order}"), holds(&medians).into()).into());
     }
     let agree = per_rep.iter().filter(|r| holds(r)).count();
     let decision = if agree == per_rep.len() && holds(&medians) {
@@ -832,7 +885,8 @@ fn ranked(f: &Facts, methods: &[&str], holds: fn(&[String]) -> bool) -> Measure 
     Ok((
         format!("fastest first: {order}; the rule holds in {agree} of {} repetitions", per_rep.len()),
         decision,
-    ))
+    )
+        .into())
 }
 
 fn fastest_two(f: &Facts) -> Measure {
@@ -850,7 +904,8 @@ fn gpu_gain_voxel(f: &Facts) -> Measure {
         })
         .ok_or_else(|| missing_cells(&t, &["cpu", "zoned"], f))?;
     let r = voxel_ratio(f, m, *n, "cpu", "zoned").ok_or("no cpu and zoned pair")?;
-    Ok((format!("cpu / zoned {} ({m} {n}³)", xr(&r)), at_least(r.lo, r.hi, 2.0)))
+    Ok(Found::from((format!("cpu / zoned {} ({m} {n}³)", xr(&r)), at_least(r.lo, r.hi, 2.0)))
+        .with(Value::ratio(&r)))
 }
 
 fn mp_best_gpu(f: &Facts) -> Measure {
@@ -895,7 +950,8 @@ fn gpu_linear_in_faces(f: &Facts) -> Measure {
             fitted(models, reps)
         ),
         Decision::all(slopes.iter().map(|s| within(s.2.1, s.2.2, 0.8, 1.2))),
-    ))
+    )
+        .into())
 }
 
 fn sramek(f: &Facts) -> Measure {
@@ -912,7 +968,11 @@ fn sramek(f: &Facts) -> Measure {
         .filter_map(|(m, n)| Some(voxel_get(&t, m, *n, "sramek")?.value / voxel_get(&t, m, *n, "cpu")?.value))
         .collect();
     let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
-    Ok((format!("sramek / cpu at 512³: at least {} ({} models)", x(lo), r.len()), (lo >= 2.0).into()))
+    Ok(Found::from((
+        format!("sramek / cpu at 512³: at least {} ({} models)", x(lo), r.len()),
+        (lo >= 2.0).into(),
+    ))
+    .with(Value { value: lo, lo, hi: lo, unit: "ratio" }))
 }
 
 pub const VOXELIZE: &[Claim] = &[
@@ -1012,7 +1072,13 @@ fn reduction(f: &Facts, sizes: std::ops::Range<f64>, at_least: f64, best: bool) 
     let lo = inside.iter().map(|p| p.2.value).fold(f64::INFINITY, f64::min);
     let hi = inside.iter().map(|p| p.2.value).fold(0.0, f64::max);
     let shown = format!("{} … {} saved ({} pairs; counted, no noise)", pct(lo), pct(hi), inside.len());
-    Ok((shown, (if best { hi >= at_least } else { lo >= at_least }).into()))
+    let decided = if best { hi } else { lo };
+    Ok(Found::from((shown, (decided >= at_least).into())).with(Value {
+        value: decided,
+        lo: decided,
+        hi: decided,
+        unit: "share",
+    }))
 }
 
 fn grouping_small(f: &Facts) -> Measure {
@@ -1048,10 +1114,11 @@ fn all_ops_as_one(f: &Facts) -> Measure {
     let r = ratios(f, "boolean", "time:all-ops", "time:one-op")?;
     let (model, _, worst) =
         r.iter().max_by(|a, b| a.2.value.total_cmp(&b.2.value)).ok_or_else(|| "no pair".to_string())?;
-    Ok((
+    Ok(Found::from((
         format!("all three / one at most {} ({model}; {} pairs)", xr(worst), r.len()),
         Decision::all(r.iter().map(|p| at_most(p.2.lo, p.2.hi, 1.25))),
     ))
+    .with(Value::ratio(worst)))
 }
 
 fn boolean_gpu_better(f: &Facts) -> Measure {
@@ -1149,7 +1216,8 @@ fn crossover(f: &Facts, rival: &str) -> Measure {
         return Ok((
             format!("ahead at level 5 on {ahead} of {} models (level 5 only)", r.len()),
             (ahead == r.len()).into(),
-        ));
+        )
+            .into());
     }
     let sweep = f.models_of("subdivide");
     let (model, _) = sweep
@@ -1161,6 +1229,7 @@ fn crossover(f: &Facts, rival: &str) -> Measure {
     let mut from = None;
     let mut lines = Vec::new();
     let mut last = Decision::DoesNotHold;
+    let mut last_ratio = None;
     for level in 1..=5u32 {
         let fact = |k: &str| f.find("subdivide", model, &format!("level:{level}:{k}"));
         let gpu_levels =
@@ -1170,6 +1239,7 @@ fn crossover(f: &Facts, rival: &str) -> Measure {
             continue; // the CPU did the whole level: nothing to compare
         }
         last = above(q.lo, q.hi, 1.0);
+        last_ratio = Some(Value::ratio(&q));
         lines.push(format!("L{level} {}", xr(&q)));
         if last == Decision::Holds {
             from = from.or(Some(level));
@@ -1182,7 +1252,11 @@ fn crossover(f: &Facts, rival: &str) -> Measure {
         None => format!("at no level up to 5 ({model}: {})", lines.join(", ")),
     };
     // From some level k ≤ 5 on: it comes down to level 5.
-    Ok((shown, last))
+    let found = Found::from((shown, last));
+    Ok(match last_ratio {
+        Some(v) => found.with(v),
+        None => found,
+    })
 }
 
 fn crossover_cpu(f: &Facts) -> Measure {
@@ -1205,7 +1279,7 @@ fn one_pass_per_level(f: &Facts) -> Measure {
         }
     })?;
     let ok = p.iter().filter(|q| q.2.value == q.3.value).count();
-    Ok((format!("one pass per GPU level on {ok} of {} models", p.len()), (ok == p.len()).into()))
+    Ok((format!("one pass per GPU level on {ok} of {} models", p.len()), (ok == p.len()).into()).into())
 }
 
 fn real_time_cube(f: &Facts) -> Measure {
@@ -1221,7 +1295,12 @@ fn real_time_cube(f: &Facts) -> Measure {
     } else {
         format!("{} ms ({})", ms(t.value), cube.0)
     };
-    Ok((shown, at_most(t.min, t.max, 1.0 / 30.0)))
+    Ok(Found::from((shown, at_most(t.min, t.max, 1.0 / 30.0))).with(Value {
+        value: t.value,
+        lo: t.min,
+        hi: t.max,
+        unit: "s",
+    }))
 }
 
 pub const SUBDIVIDE: &[Claim] = &[
@@ -1321,7 +1400,7 @@ mod tests {
             "subdivide",
             &[("cube", 100.0, &[("time:osd", &[12.0, 9.0, 11.0]), ("time:gpu-path", &[10.0, 10.0, 10.0])])],
         );
-        let (shown, d) = gpu_beats_osd_l5(&f).unwrap();
+        let Found { shown, decision: d, .. } = gpu_beats_osd_l5(&f).unwrap();
         assert_eq!(d, Decision::Inconclusive, "{shown}");
         assert!(shown.contains("(0.90–1.20×)"), "the interval is shown: {shown}");
         // Every repetition ahead: decided.
@@ -1344,7 +1423,7 @@ mod tests {
                 &[("time:tcpu2", &[40.0, 80.0, 40.0]), ("time:gpu-path", &[10.0, 20.0, 10.0])],
             )],
         );
-        let (shown, d) = gpu_beats_cpu_l5(&f).unwrap();
+        let Found { shown, decision: d, .. } = gpu_beats_cpu_l5(&f).unwrap();
         assert_eq!(d, Decision::Holds, "{shown}");
         assert!(shown.starts_with("4.00× (cube)"), "{shown}");
     }
@@ -1356,7 +1435,7 @@ mod tests {
         let sb: [(&str, &[f64]); 2] = [("time:phase2-cpu", &[2.0; 3]), ("time:phase2-gpu", &[20.0; 3])];
         let sc: [(&str, &[f64]); 2] = [("time:phase2-cpu", &[1.0; 3]), ("time:phase2-gpu", &[7.0; 3])];
         let f = today("boolean", &[("small", 1e3, &sa), ("mid", 1e4, &sb), ("large", 1e5, &sc)]);
-        let (shown, d) = boolean_gpu_grows(&f).unwrap();
+        let Found { shown, decision: d, .. } = boolean_gpu_grows(&f).unwrap();
         assert_eq!(d, Decision::DoesNotHold, "{shown}");
     }
 
@@ -1367,11 +1446,12 @@ mod tests {
         };
         // Per repetition 1.05, 0.95, 1.0: equal within its noise, so never slower.
         let (a, b) = (cell(&[9.5, 10.5, 10.0]), cell(&[12.0, 12.5, 11.0]));
-        let (shown, d) = mp_never_slower(&today("voxelize", &[("knot", 1e3, &a)])).unwrap();
+        let Found { shown, decision: d, .. } =
+            mp_never_slower(&today("voxelize", &[("knot", 1e3, &a)])).unwrap();
         assert_eq!(d, Decision::Holds, "{shown}");
         assert!(shown.contains("(0.95–1.05×)"), "the interval is shown: {shown}");
         // Slower in every repetition on one model: does not hold, and the cell is named.
-        let (shown, d) =
+        let Found { shown, decision: d, .. } =
             mp_never_slower(&today("voxelize", &[("knot", 1e3, &a), ("tube", 1e4, &b)])).unwrap();
         assert_eq!(d, Decision::DoesNotHold, "{shown}");
         assert!(shown.contains("zoned slower at tube 64³"), "{shown}");
@@ -1380,7 +1460,8 @@ mod tests {
     #[test]
     fn real_time_shows_the_range_of_its_runs() {
         let keys: [(&str, &[f64]); 1] = [("time:tgpu", &[20.0, 40.0, 30.0])];
-        let (shown, d) = real_time_cube(&today("subdivide", &[("cube", 6.0, &keys)])).unwrap();
+        let Found { shown, decision: d, .. } =
+            real_time_cube(&today("subdivide", &[("cube", 6.0, &keys)])).unwrap();
         assert!(shown.starts_with("30.00 ms (20.00–40.00 ms over 3 runs"), "{shown}");
         assert_eq!(d, Decision::Inconclusive, "1/30 s lies inside the runs: {shown}");
     }
@@ -1403,7 +1484,7 @@ mod tests {
         for level in 1..=5 {
             f.add("subdivide", "builtin:knot", &format!("level:{level}:gpu-levels"), "", Stat::exact(1.0));
         }
-        let (shown, d) = crossover_osd(&f).unwrap();
+        let Found { shown, decision: d, .. } = crossover_osd(&f).unwrap();
         assert_eq!(d, Decision::Inconclusive, "{shown}");
         assert!(shown.contains("L5 1.00× (0.99–1.01×)"), "{shown}");
     }

@@ -28,7 +28,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use claims::{Claim, Decision, Verdict};
+pub use claims::{Claim, Decision, Found, Value, Verdict};
 pub use compare::compare;
 pub use experiments::{EXPERIMENTS, Experiment, Figure};
 pub use facts::{Facts, Stat};
@@ -322,9 +322,10 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
         monitor.end(e.title, elapsed);
         sections.push(Section { experiment: e, blocks, status, elapsed });
     }
-    let (claims, verdicts) = claims_table(&thesis, &c.today);
+    let (claims, claim_numbers, verdicts) = claims_table(&thesis, &c.today);
     let elapsed = start.elapsed();
     header.state = Some(watch.finish());
+    let claims = (claims, claim_numbers);
     let blocks = assemble(&header, &layout, sections, claims, verdicts, &c.disagreements, elapsed)?;
     let (report, html) = write_report(&layout, &header, &c, blocks)?;
     Ok(Outcome { report, html, failures: c.failures, disagreements: c.disagreements, verdicts, elapsed })
@@ -425,7 +426,8 @@ const CLAIMS_NOTE: &str = "Verdicts are computed from the numbers by the rule in
      rule's threshold; otherwise it is \"inconclusive (within noise)\" (more repetitions with `--repeat N` narrow the \
      intervals). Counts, bytes and single builds carry no interval. \"not measurable\" says why in \"measured here\".";
 
-/// The columns of the claims table (`csv/claims.csv`); `--compare` reads them back.
+/// The columns of the claims table; `csv/claims.csv` has them and [`CLAIM_NUMBERS`]
+/// after them, and `--compare` reads them back.
 pub const CLAIM_COLUMNS: [&str; 7] = [
     "id",
     "source",
@@ -436,24 +438,35 @@ pub const CLAIM_COLUMNS: [&str; 7] = [
     "verdict",
 ];
 
+/// The numbers `csv/claims.csv` adds to [`CLAIM_COLUMNS`]: the value the rule decided on
+/// from the thesis' tables and from today's measurements, today's interval, and their
+/// unit (empty where the rule counts models rather than deciding on one number).
+pub const CLAIM_NUMBERS: [&str; 5] =
+    ["thesis value", "measured value", "measured interval low", "measured interval high", "unit"];
+
 /// Every claim of every experiment, computed from the thesis' numbers and from
-/// `today`'s, and how many claims have each verdict ([`Verdict::index`]).
-fn claims_table(thesis: &Facts, today: &Facts) -> (Table, [usize; 4]) {
+/// `today`'s: the report's table, the same rows with the deciding numbers for
+/// `csv/claims.csv`, and how many claims have each verdict ([`Verdict::index`]).
+fn claims_table(thesis: &Facts, today: &Facts) -> (Table, Table, [usize; 4]) {
     let mut table = Table::new("Claims of the theses, checked against today's measurements", &CLAIM_COLUMNS);
+    let mut numbers = Table::new(&table.title, &[&CLAIM_COLUMNS[..], &CLAIM_NUMBERS].concat());
     let mut verdicts = [0usize; 4];
     for c in EXPERIMENTS.iter().flat_map(|e| e.claims) {
         let (then, now) = ((c.measure)(thesis), (c.measure)(today));
         let verdict = Verdict::of(&now);
         verdicts[verdict.index()] += 1;
         let thesis_cell = match &then {
-            Ok((shown, _)) => format!("{shown} ({})", Verdict::of(&then).word()),
+            Ok(found) => format!("{} ({})", found.shown, Verdict::of(&then).word()),
             Err(why) => format!("– ({why})"),
         };
         let measured = match &now {
-            Ok((shown, _)) => shown.clone(),
+            Ok(found) => found.shown.clone(),
             Err(why) => why.clone(),
         };
-        table.row(vec![
+        let value = |m: &claims::Measure| m.as_ref().ok().and_then(|f| f.value);
+        let number = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+        let (t, n) = (value(&then), value(&now));
+        let row = vec![
             c.id.to_string(),
             c.source.to_string(),
             format!("{} («{}»)", c.claim, c.quote),
@@ -461,19 +474,30 @@ fn claims_table(thesis: &Facts, today: &Facts) -> (Table, [usize; 4]) {
             thesis_cell,
             measured,
             verdict.word().to_string(),
+        ];
+        let mut with_numbers = row.clone();
+        with_numbers.extend([
+            number(t.map(|v| v.value)),
+            number(n.map(|v| v.value)),
+            number(n.map(|v| v.lo)),
+            number(n.map(|v| v.hi)),
+            n.or(t).map(|v| v.unit.to_string()).unwrap_or_default(),
         ]);
+        table.row(row);
+        numbers.row(with_numbers);
     }
     table.note(CLAIMS_NOTE);
-    (table, verdicts)
+    (table, numbers, verdicts)
 }
 
-/// The report's blocks: the verdict counts, the machine, the summary, the claims, each
-/// experiment's section and the list of files.
+/// The report's blocks: the verdict counts, the machine, the summary, the claims (shown
+/// as the first table, written to `csv/claims.csv` as the second, which adds the
+/// numbers), each experiment's section and the list of files.
 fn assemble(
     header: &header::Header,
     layout: &Layout,
     sections: Vec<Section>,
-    claims: Table,
+    (claims, claim_numbers): (Table, Table),
     verdicts: [usize; 4],
     disagreements: &[String],
     elapsed: Duration,
@@ -516,7 +540,9 @@ fn assemble(
         }
     )));
     blocks.push(Block::Heading(2, "Claims".into()));
-    blocks.push(write_table(claims, "claims")?);
+    let csv = format!("{}/claims.csv", Layout::CSV);
+    layout.write(&csv, claim_numbers.to_csv().as_bytes())?;
+    blocks.push(Block::Table { table: claims, csv });
     for s in sections {
         let e = s.experiment;
         blocks.push(Block::Heading(2, e.title.to_string()));

@@ -115,7 +115,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             "CPU / GPU",
             "OpenSubdiv / GPU",
         ],
-    );
+    )
+    .unit("ms", 3..6);
     for l in &levels {
         let (g, c, o) = (l.gpu.median_ms(), l.cpu.median_ms(), l.osd.1 * 1e3);
         sweep.row(vec![
