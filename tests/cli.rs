@@ -27,6 +27,20 @@ fn mesh_stats_and_convert() {
     assert!(o.status.success(), "{}", stderr(&o));
     let o = texgeo(&["mesh", "stats", obj.to_str().unwrap()]);
     assert!(stdout(&o).contains("1200 (1200×3-gon)"), "{}", stdout(&o));
+    // -o/--output as every command spells it; the positional form above still works.
+    for flag in ["-o", "--output"] {
+        let off = dir.join(format!("cube{flag}.off"));
+        let o = texgeo(&["mesh", "convert", "builtin:cube", flag, off.to_str().unwrap()]);
+        assert!(o.status.success(), "{flag}: {}", stderr(&o));
+        assert!(std::fs::read_to_string(&off).unwrap().starts_with("OFF"), "{flag}");
+    }
+    let o = texgeo(&["mesh", "convert", "builtin:cube"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--output"), "{}", stderr(&o));
+    let (a, b) = (dir.join("a.off"), dir.join("b.off"));
+    let o = texgeo(&["mesh", "convert", "builtin:cube", a.to_str().unwrap(), "-o", b.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "two outputs are refused");
+    assert!(!a.exists() && !b.exists());
 }
 
 #[test]

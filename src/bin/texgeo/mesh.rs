@@ -26,7 +26,11 @@ pub enum Command {
         /// A mesh file (.obj .off .ply .stl) or `builtin:NAME` (see `texgeo mesh builtins`).
         input: MeshArg,
         /// The output file (.obj .off .ply .stl), written atomically.
-        output: PathBuf,
+        #[arg(short = 'o', long, value_name = "OUTPUT", required_unless_present = "output_positional")]
+        output: Option<PathBuf>,
+        /// The output file given without -o (the older spelling, still accepted).
+        #[arg(value_name = "OUTPUT", conflicts_with = "output", hide = true)]
+        output_positional: Option<PathBuf>,
     },
     /// List the built-in procedural models (use them as `builtin:NAME`).
     Builtins,
@@ -122,7 +126,10 @@ pub fn run(cmd: Command) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Convert { input, output } => {
+        Command::Convert { input, output, output_positional } => {
+            let Some(output) = output.or(output_positional) else {
+                anyhow::bail!("mesh convert: name the output file with -o OUTPUT")
+            };
             formats::Format::from_path(&output)?;
             texgeo::output::check_output(&output, &MeshArg::files([&input]))?;
             let m = load(&input)?;
