@@ -431,7 +431,7 @@ fn the_html_report_is_self_contained() {
     }
     // Every CSV a table names is a link to it, and the pictures' colours are named.
     assert_eq!(html.matches("<p class=\"note\">CSV: <a href=\"csv/").count(), md_tables);
-    for legend in ["operand A", "valence 3", "on the boundary", "support ring"] {
+    for legend in ["operand A", "valence 3", "on the boundary", "support ring", "crease sharpness 10"] {
         assert!(html.contains(&format!("</span>{legend}")), "a legend names {legend}");
     }
     // The verdict counts head the report, coloured, and every verdict cell is coloured.

@@ -1,6 +1,6 @@
 //! The report's pictures, rendered headless by texgeo's own Vulkan pipeline
 //! (`render`): subdivision levels coloured by valence (2010 Figs. 27–30), voxelized
-//! models in Perlin aspect colours (2006 Fig. 5-9), an inclusion slice, the fragment-mesh
+//! models in Perlin aspect colours (2006 Fig. 5-9), creases by sharpness, an inclusion slice, the fragment-mesh
 //! layout and Boolean results (2006 Figs. 6-9 … 6-12). Each picture is described in `figures.json` (camera, model,
 //! level) so a test can check it against the geometry.
 
@@ -15,7 +15,7 @@ use crate::render::{
     Camera, Content, Look, Model, Picture, Points, Polyline, Renderer, Scene, SceneMesh, Shading, View,
     colour,
 };
-use crate::subdiv::{cpu, fragment};
+use crate::subdiv::{Features, Surface, cpu, fragment};
 use crate::voxel::aspect::Aspect;
 use crate::voxel::{self, Method as VoxelMethod};
 
@@ -197,6 +197,63 @@ pub fn valence_levels(run: &mut Run) -> Result<Vec<Block>> {
         blocks.push(run.picture(&picture, &format!("valence-level{level}"), &caption, record)?);
     }
     Ok(blocks)
+}
+
+/// The sharpness of the crease picture's edges, three edges each.
+const CREASE_SHARPNESS: [f32; 4] = [1.0, 2.0, 4.0, 10.0];
+
+/// The crease colours (`colour::crease_colour`) of [`CREASE_SHARPNESS`], as a legend.
+fn crease_legend() -> Block {
+    let items: Vec<(String, colour::Rgba)> = CREASE_SHARPNESS
+        .iter()
+        .map(|&s| {
+            let what = if s >= 10.0 { "10 (infinitely sharp)".to_string() } else { format!("{s}") };
+            (format!("crease sharpness {what}"), colour::crease_colour(s))
+        })
+        .collect();
+    legend(&items.iter().map(|(w, c)| (w.as_str(), *c)).collect::<Vec<_>>())
+}
+
+/// A cube whose twelve edges are creased at sharpness 1, 2, 4 and 10 (three edges each),
+/// refined to level 3 by the GPU fragment passes, its crease edges drawn in the colour of
+/// their sharpness: semi-sharp creases round off, infinitely sharp ones stay edges.
+pub fn crease_sharpness(run: &mut Run) -> Result<Vec<Block>> {
+    let cube = procedural::cube();
+    let mut features = Features::feature_edges(&cube, 30.0, 10.0);
+    for (i, c) in features.creases.iter_mut().enumerate() {
+        c.sharpness = CREASE_SHARPNESS[i % CREASE_SHARPNESS.len()];
+    }
+    let creases = features.creases.len();
+    let (lo, hi) = cube.bounds();
+    let surface = Surface { features, ..Surface::smooth(cube) };
+    let level = 3;
+    let look = Look { valence: false, wireframe: false, shading: Shading::Smooth, colour: colour::SURFACE };
+    let mut model = Model::new(run.ctx, Content::Surface(surface), level, look, None)?;
+    let (vertices, faces) = model.counts();
+    let scene = model.scene(run.ctx)?;
+    let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
+    let picture = render(run, &scene, camera)?;
+    let record = FigureRecord {
+        kind: "creases".into(),
+        model: "builtin:cube".into(),
+        level,
+        camera: camera.into(),
+        note: format!("{creases} creased edges at sharpness 1, 2, 4, 10; {vertices} vertices, {faces} faces"),
+        ..FigureRecord::default()
+    };
+    let caption = format!(
+        "Cube, level {level} on the GPU: its {creases} edges creased at sharpness 1, 2, 4 and 10, crease edges \
+         coloured by sharpness"
+    );
+    Ok(vec![
+        Block::Para(
+            "Sharpness decays by one per level: an edge of sharpness 1 is sharp for one level and then smooth, \
+             one of 10 or more stays sharp at every level."
+                .into(),
+        ),
+        crease_legend(),
+        run.picture(&picture, "crease-sharpness", &caption, record)?,
+    ])
 }
 
 /// The knot (quick) or armadillo voxelized, in Perlin marble, whole and cut open

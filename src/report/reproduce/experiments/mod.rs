@@ -107,6 +107,12 @@ pub const EXPERIMENTS: &[Experiment] = &[
                 draw: Ok(figures::valence_levels),
             },
             Figure {
+                key: "crease-sharpness",
+                title: "creases of every sharpness",
+                thesis: "sharp features, as OpenSubdiv refines them",
+                draw: Ok(figures::crease_sharpness),
+            },
+            Figure {
                 key: "fragment-layout",
                 title: "the fragment-mesh layout of one face",
                 thesis: "2010 §3.3.1, SPEC §5.2",
