@@ -1384,7 +1384,7 @@ mod tests {
     }
 
     fn decision(m: Measure) -> Decision {
-        m.expect("measurable").1
+        m.expect("measurable").decision
     }
 
     #[test]

@@ -568,7 +568,7 @@ mod tests {
                 f.add_runs("inclusion", model, key, Stat::mean_of(&runs), &runs);
             }
         }
-        let (claims, _) = super::super::claims_table(&super::super::thesis::facts(), &f);
+        let (_, claims, _) = super::super::claims_table(&super::super::thesis::facts(), &f);
         std::fs::write(dir.join("csv/claims.csv"), claims.to_csv()).unwrap();
         std::fs::write(dir.join("csv/measurements.csv"), measurements_csv(&f)).unwrap();
         std::fs::write(dir.join("csv/models.csv"), models_csv(&f)).unwrap();
