@@ -125,6 +125,25 @@ fn every_table_is_present_with_every_row_filled() {
             assert!(row.iter().all(|c| !c.is_empty()), "{}: empty cell in {row:?}", t.title);
         }
     }
+    // Every median of the Boolean and subdivision timings has its spread beside it.
+    for (wanted, medians) in [
+        (
+            "Table 6-1 today",
+            &["phase 1", "phase 2 grouped CPU", "phase 2 grouped GPU", "phase 2 plain CPU"][..],
+        ),
+        ("Table 5 today", &["GPU path", "TCPU² CPU reference", "OpenSubdiv"]),
+        ("The GPU against the CPU level by level", &["GPU path", "CPU reference", "OpenSubdiv"]),
+    ] {
+        let t =
+            all.iter().find(|t| t.title.starts_with(wanted)).unwrap_or_else(|| panic!("no table {wanted}"));
+        for m in medians {
+            let i = t.columns.iter().position(|c| c == m).unwrap_or_else(|| panic!("{wanted}: no {m}"));
+            assert!(t.columns[i + 1].ends_with("spread ± %"), "{wanted}: {m} has no spread beside it");
+            for row in &t.rows {
+                assert!(row[i + 1].parse::<f64>().is_ok(), "{wanted}: {m}'s spread in {row:?}");
+            }
+        }
+    }
     assert!(md.contains("**All methods agree on every point**"), "inclusion answers checked");
     assert!(md.contains("**All methods agree on every voxel**"), "voxel answers checked");
     assert!(md.contains("equals OpenSubdiv's on every vertex"), "subdivision answers checked");

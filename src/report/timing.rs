@@ -48,6 +48,13 @@ impl Samples {
         self.spread_percent(self.median()).map_or_else(|| "–".to_string(), |p| super::sig(p, 2))
     }
 
+    /// Run by run sums of the same runs of several parts (the runs of a whole made of
+    /// them, so its median and spread can be taken).
+    pub fn sum(parts: &[&Samples]) -> Samples {
+        let n = parts.iter().map(|s| s.0.len()).min().unwrap_or(0);
+        Samples((0..n).map(|i| parts.iter().map(|s| s.0[i]).sum::<Duration>()).collect())
+    }
+
     pub fn median_ms(&self) -> f64 {
         self.median().as_secs_f64() * 1e3
     }

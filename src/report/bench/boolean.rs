@@ -130,8 +130,9 @@ pub fn sequential(method: impl Into<Choice>, grouping: Grouping) -> Options {
 
 /// The columns of Table 6-1 between the pair and the totals, shared with `texgeo
 /// reproduce`'s table: the thesis' pair, the operation and the measured phases (ms, the
-/// columns [`PHASE_MS`]).
-pub const PHASE_COLUMNS: [&str; 11] = [
+/// columns [`PHASE_MS`]), each with its spread: half the range of its runs as a share of
+/// its median.
+pub const PHASE_COLUMNS: [&str; 15] = [
     "thesis pair",
     "op",
     "triangles",
@@ -140,14 +141,18 @@ pub const PHASE_COLUMNS: [&str; 11] = [
     "point tests plain",
     "saved",
     "phase 1",
+    "phase 1 spread ± %",
     "phase 2 grouped CPU",
+    "phase 2 grouped CPU spread ± %",
     "phase 2 grouped GPU",
+    "phase 2 grouped GPU spread ± %",
     "phase 2 plain CPU",
+    "phase 2 plain CPU spread ± %",
 ];
 
 /// The columns of a table that starts with the pair's name and [`PHASE_COLUMNS`] that
 /// hold milliseconds.
-pub const PHASE_MS: std::ops::RangeInclusive<usize> = 8..=11;
+pub const PHASE_MS: [usize; 4] = [8, 10, 12, 14];
 
 /// Runs the benchmark.
 pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Report> {
@@ -160,8 +165,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
     let mut table = Table::new("Table 6-1: Boolean operations (ms; thesis in s)", &columns)
         .named("table6-1")
         .unit("ms", PHASE_MS)
-        .unit("ms", 12..=13)
-        .unit("s", 14..=15);
+        .unit("ms", 16..=17)
+        .unit("s", 18..=19);
     let mut refused = Vec::new();
     for pair in pairs {
         let triangles = pair.a.num_faces() + pair.b.num_faces();
@@ -212,9 +217,13 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
                 plain.as_ref().map_or("–".into(), |p| p.3.classification.stats.point_tests.to_string()),
                 format!("{:.1} %", 100.0 * s.saved_share()),
                 ms(p1.median()),
+                p1.spread_cell(),
                 ms(p2.median() + asm[k].median()),
+                Samples::sum(&[&p2, &asm[k]]).spread_cell(),
                 format!("{}{}", ms(p2_gpu.median() + asm[k].median()), if same { "" } else { " (DIFFERS)" }),
+                Samples::sum(&[&p2_gpu, &asm[k]]).spread_cell(),
                 plain.as_ref().map_or("–".into(), |p| ms(p.1.median() + p.2[k].median())),
+                plain.as_ref().map_or("–".into(), |p| Samples::sum(&[&p.1, &p.2[k]]).spread_cell()),
                 ms(total),
                 reference
                     .as_ref()
@@ -227,7 +236,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         crate::note!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
     }
     table.note(format!(
-        "Medians of {} runs after a warm-up (plain: one run). triangles = both operands; cut = input \
+        "Medians of {} runs after a warm-up (plain: one run); spread: half the range of the runs as a share of \
+         the median (– for one run). triangles = both operands; cut = input \
          triangles re-triangulated; point tests = one per group (§6.5.1) / one per triangle off the other \
          surface (on-triangles are decided exactly without a test); saved = the thesis' reduction. phase 1 = \
          index + pair tests + intersection points + constrained re-triangulation (the operand checks — closed, \

@@ -284,14 +284,17 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             "TCPU¹ base level",
             "TGPU passes",
             "GPU path",
+            "GPU path spread ± %",
             "TCPU² CPU reference",
+            "TCPU² spread ± %",
             "OpenSubdiv",
+            "OpenSubdiv spread ± %",
             "GPU path / OpenSubdiv",
             "vs OpenSubdiv",
             "largest distance / diagonal",
         ],
     )
-    .unit("ms", 5..=9);
+    .unit("ms", [5, 6, 7, 9, 11]);
     let mut split = Table::new(
         format!("Where the GPU path's time goes: level {level}, medians (ms)"),
         &[
@@ -335,8 +338,11 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             ms(gpu.base),
             ms(gpu.passes_total()),
             ms(gpu.total),
+            m.gpu_totals.spread_cell(),
             ms(m.cpu.median()),
+            m.cpu.spread_cell(),
             ms(osd_time),
+            m.osd_runs.spread_cell(),
             format!("{ratio:.2}"),
             m.verdict.clone(),
             m.max_error.map_or("–".into(), |e| format!("{e:.1e}")),
@@ -365,7 +371,8 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
          clock, no file writing; the pipeline and render targets are made once and reused (the cold first \
          run, which pays shader compilation and allocation, is in the next table). TCPU²: texgeo's f64 CPU \
          reference, one thread. OpenSubdiv: its helper's own median of refine + interpolate (topology, \
-         uniform refinement with full topology, PrimvarRefiner in double), one thread.",
+         uniform refinement with full topology, PrimvarRefiner in double), one thread. Spread: half the range \
+         of the runs as a share of the median (the three were run in turn, run after run).",
         settings.runs
     ));
     for t in targets {
@@ -451,7 +458,9 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             "fragments with data",
             "fragments",
             "GPU path, no creases",
+            "no creases spread ± %",
             "GPU path, creased",
+            "creased spread ± %",
             "ratio (median of pairs)",
             "passes, no creases",
             "passes, creased",
@@ -459,7 +468,7 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
             "target ≤ 1.2",
         ],
     )
-    .unit("ms", [6, 7, 9, 10]);
+    .unit("ms", [6, 8, 11, 12]);
     let mut subdivider = Subdivider::new(ctx)?;
     for model in models {
         let smooth = Surface::smooth(model.mesh.clone());
@@ -486,6 +495,7 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
                 }
             }
             let (p, s) = (median_times(&plain), median_times(&sharp));
+            let spread = |t: &[Times]| Samples(t.iter().map(|t| t.total).collect()).spread_cell();
             let median = |v: &mut Vec<f64>| {
                 v.sort_by(f64::total_cmp);
                 let n = v.len();
@@ -504,7 +514,9 @@ pub fn run_creases(ctx: &Context, models: &[Model], settings: CreaseSettings) ->
                 fragments.0.to_string(),
                 fragments.1.to_string(),
                 ms(p.total),
+                spread(&plain),
                 ms(s.total),
+                spread(&sharp),
                 format!("{ratio:.2}"),
                 ms(p.passes_total()),
                 ms(s.passes_total()),

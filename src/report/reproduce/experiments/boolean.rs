@@ -42,12 +42,6 @@ fn volume(m: &Mesh) -> f64 {
     crate::mesh::covering::measures(m).0
 }
 
-/// Element-wise sums of timed runs (the same runs of one evaluation's parts).
-fn sum(parts: &[&Samples]) -> Samples {
-    let n = parts.iter().map(|s| s.0.len()).min().unwrap_or(0);
-    Samples((0..n).map(|i| parts.iter().map(|s| s.0[i]).sum::<Duration>()).collect())
-}
-
 fn ms(d: Duration) -> String {
     format!("{:.1}", d.as_secs_f64() * 1e3)
 }
@@ -92,7 +86,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
     .concat();
     let mut table = Table::new("Table 6-1 today: Boolean operations (ms)", &columns)
         .unit("ms", crate::report::bench::boolean::PHASE_MS)
-        .unit("ms", 12..=13);
+        .unit("ms", 16..=17);
     let mut found = Findings::default();
     for model in models {
         r.progress.step(&format!("{}: phases, grouped and plain, CPU and GPU", model.name));
@@ -111,7 +105,8 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         r.disagreement(format!("boolean: no answer on {f}"));
     }
     table.note(format!(
-        "Medians of {runs} runs after a warm-up, each run measuring grouped CPU, grouped GPU and plain in turn. \
+        "Medians of {runs} runs after a warm-up, each run measuring grouped CPU, grouped GPU and plain in turn; \
+         spread: half the range of the runs as a share of the median. \
          Each pair is a solid and its copy \
          rotated 10° about y and moved by 1 % of its diagonal along x (`texgeo bench boolean`'s pairs); triangles = \
          both operands. phase 1 = index + pair tests + intersection points + re-triangulation; phase 2 = both \
@@ -216,13 +211,13 @@ fn record_facts(r: &mut Run, pair: &Pair, v: &Variants) {
     let timed = |f: &mut crate::report::reproduce::Facts, key: &str, s: &Samples| {
         f.add_runs(EXP, name, key, Stat::median_of(s), s);
     };
-    let phase2_cpu = sum(&[p2, &asm[2]]);
+    let phase2_cpu = Samples::sum(&[p2, &asm[2]]);
     timed(f, "time:phase1", p1);
     timed(f, "time:phase2-grouped", &phase2_cpu);
     timed(f, "time:phase2-cpu", &phase2_cpu);
-    timed(f, "time:phase2-gpu", &sum(&[p2_gpu, &asm_gpu[2]]));
-    timed(f, "time:phase2-plain", &sum(&[p2_plain, &asm_plain[2]]));
-    timed(f, "time:total", &sum(&[p1, p2, &asm[2]]));
+    timed(f, "time:phase2-gpu", &Samples::sum(&[p2_gpu, &asm_gpu[2]]));
+    timed(f, "time:phase2-plain", &Samples::sum(&[p2_plain, &asm_plain[2]]));
+    timed(f, "time:total", &Samples::sum(&[p1, p2, &asm[2]]));
     let stats = v.grouped.3.classification.stats;
     f.add(EXP, name, "reduction", "", Stat::exact(stats.saved_share()));
     f.add(EXP, name, "point-tests", "", Stat::exact(stats.point_tests as f64));
@@ -230,13 +225,13 @@ fn record_facts(r: &mut Run, pair: &Pair, v: &Variants) {
     // All three operations from one refinement and classification, against the
     // dearest single one.
     let dearest = (0..OPERATIONS.len()).max_by_key(|&k| asm[k].median()).unwrap_or(0);
-    timed(f, "time:all-ops", &sum(&[p1, p2, &asm[0], &asm[1], &asm[2]]));
-    timed(f, "time:one-op", &sum(&[p1, p2, &asm[dearest]]));
+    timed(f, "time:all-ops", &Samples::sum(&[p1, p2, &asm[0], &asm[1], &asm[2]]));
+    timed(f, "time:one-op", &Samples::sum(&[p1, p2, &asm[dearest]]));
     for (k, &op) in OPERATIONS.iter().enumerate() {
         for (kind, times) in [
-            ("grouped", sum(&[p1, p2_gpu, &asm_gpu[k]])),
-            ("grouped-cpu", sum(&[p1, p2, &asm[k]])),
-            ("plain", sum(&[p1, p2_plain, &asm_plain[k]])),
+            ("grouped", Samples::sum(&[p1, p2_gpu, &asm_gpu[k]])),
+            ("grouped-cpu", Samples::sum(&[p1, p2, &asm[k]])),
+            ("plain", Samples::sum(&[p1, p2_plain, &asm_plain[k]])),
         ] {
             f.add(EXP, name, &format!("time:{kind}:{}", op.name()), "s", Stat::median_of(&times));
         }
@@ -295,10 +290,14 @@ fn table_rows(
             v.plain.3.classification.stats.point_tests.to_string(),
             format!("{:.1} %", 100.0 * s.saved_share()),
             ms(p1.median()),
+            p1.spread_cell(),
             ms(p2.median() + asm[k].median()),
+            Samples::sum(&[p2, &asm[k]]).spread_cell(),
             ms(p2_gpu.median() + asm_gpu[k].median()),
+            Samples::sum(&[p2_gpu, &asm_gpu[k]]).spread_cell(),
             ms(p2_plain.median() + asm_plain[k].median()),
-            ms(sum(&[p1, p2_gpu, &asm_gpu[k]]).median()),
+            Samples::sum(&[p2_plain, &asm_plain[k]]).spread_cell(),
+            ms(Samples::sum(&[p1, p2_gpu, &asm_gpu[k]]).median()),
             cgal_cell,
             num(vol),
             against.to_string(),

@@ -110,13 +110,16 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             "faces",
             "GPU levels",
             "GPU path",
+            "GPU path spread ± %",
             "CPU reference",
+            "CPU reference spread ± %",
             "OpenSubdiv",
+            "OpenSubdiv spread ± %",
             "CPU / GPU",
             "OpenSubdiv / GPU",
         ],
     )
-    .unit("ms", 3..6);
+    .unit("ms", [3, 5, 7]);
     for l in &levels {
         let (g, c, o) = (l.gpu.median_ms(), l.cpu.median_ms(), l.osd.1 * 1e3);
         sweep.row(vec![
@@ -124,15 +127,18 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             l.faces.to_string(),
             l.gpu_levels.to_string(),
             subdiv::ms(l.gpu.median()),
+            l.gpu.spread_cell(),
             subdiv::ms(l.cpu.median()),
+            l.cpu.spread_cell(),
             subdiv::ms(std::time::Duration::from_secs_f64(l.osd.1)),
+            l.osd_runs.spread_cell(),
             format!("{:.2}", c / g.max(1e-9)),
             format!("{:.2}", o / g.max(1e-9)),
         ]);
     }
     sweep.note(
         "Levels the CPU does before fragments exist (1 for quads, 2 otherwise) have no GPU level: there the GPU path \
-         is the CPU.",
+         is the CPU. Spread: half the range of the runs as a share of the median.",
     );
     blocks.push(r.table(sweep, "subdivide-levels")?);
 
