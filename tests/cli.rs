@@ -29,7 +29,7 @@ fn mesh_stats_and_convert() {
     assert!(stdout(&o).contains("1200 (1200×3-gon)"), "{}", stdout(&o));
     // -o/--output as every command spells it; the positional form above still works.
     for flag in ["-o", "--output"] {
-        let off = dir.join(format!("cube{flag}.off"));
+        let off = dir.join(&format!("cube{flag}.off"));
         let o = texgeo(&["mesh", "convert", "builtin:cube", flag, off.to_str().unwrap()]);
         assert!(o.status.success(), "{flag}: {}", stderr(&o));
         assert!(std::fs::read_to_string(&off).unwrap().starts_with("OFF"), "{flag}");
