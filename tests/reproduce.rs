@@ -595,3 +595,27 @@ fn a_damaged_report_is_listed_and_gives_status_2() {
     assert!(err.contains("claims.csv: missing"), "{err}");
     std::fs::remove_dir_all(base).unwrap();
 }
+
+#[test]
+fn the_results_page_is_the_saved_report_regenerated() {
+    // docs/results.md's marked tables, written anew from the report saved under
+    // docs/report/, give the committed page byte for byte: the page shows what that run
+    // measured, not numbers pasted by hand.
+    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/results.md");
+    let text = std::fs::read_to_string(&page).unwrap();
+    let (new, tables) = texgeo::report::reproduce::results_page(&page, &text).unwrap();
+    assert!(tables >= 5, "{tables} generated tables");
+    assert!(new == text, "docs/results.md differs from its report: run `texgeo reproduce --results-md docs/results.md`");
+    // The command says so, and rewrites nothing.
+    let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("unchanged"));
+    // A page without markers is refused.
+    let dir = temp("page");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("p.md"), "# nothing to regenerate\n").unwrap();
+    let o = texgeo(&["reproduce", "--results-md", dir.join("p.md").to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo reproduce table: FILE -->\" marker"));
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -1,5 +1,6 @@
 //! `texgeo reproduce -o DIR`: every experiment of both theses, one report (Markdown,
-//! HTML, CSV, plots, pictures, claims); `--compare A B` sets two runs side by side.
+//! HTML, CSV, plots, pictures, claims); `--compare A B` sets two runs side by side;
+//! `--results-md PAGE` writes a saved report's tables into a results page.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -25,7 +26,13 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Output folder: report.md, report.html, csv/, plots/, figures/, run.json.
-    #[arg(short, long = "output", alias = "out", value_name = "DIR", required_unless_present = "compare")]
+    #[arg(
+        short,
+        long = "output",
+        alias = "out",
+        value_name = "DIR",
+        required_unless_present_any = ["compare", "results_md"]
+    )]
     out: Option<PathBuf>,
     /// Compare two report folders (two devices, or two runs): every claim's verdict on
     /// both side by side, the GPU's speed-ups over the CPU on both beside the thesis',
@@ -33,6 +40,11 @@ pub struct Args {
     /// claims whose verdict changed.
     #[arg(long, num_args = 2, value_names = ["OLD", "NEW"], conflicts_with_all = ["quick", "only", "out"])]
     compare: Option<Vec<PathBuf>>,
+    /// Rewrite the tables of a Markdown page (docs/results.md) from the saved report's CSV
+    /// files its marker comments name (`<!-- texgeo reproduce table: FILE; columns: … -->`
+    /// … `<!-- end of texgeo reproduce table -->`); the rest of the page is kept as it is.
+    #[arg(long, value_name = "PAGE", conflicts_with_all = ["quick", "only", "out", "compare"])]
+    results_md: Option<PathBuf>,
 }
 
 /// Progress bars on standard error: one per experiment and one overall (at a terminal;
@@ -93,6 +105,19 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         if !c.damage.is_empty() {
             anyhow::bail!("damaged report(s), compared in part only: {}", c.damage.join("; "));
         }
+        return Ok(());
+    }
+    if let Some(page) = &args.results_md {
+        let text = std::fs::read_to_string(page).map_err(|e| anyhow::anyhow!("{}: {e}", page.display()))?;
+        let (new, tables) = reproduce::results_page(page, &text)?;
+        if tables == 0 {
+            anyhow::bail!("{}: no \"<!-- texgeo reproduce table: FILE -->\" marker", page.display());
+        }
+        let what = if new == text { "unchanged" } else { "rewritten" };
+        if new != text {
+            reproduce::write_atomic(page, new.as_bytes())?;
+        }
+        say!("{}: {tables} table(s) from the saved report, {what}", page.display());
         return Ok(());
     }
     let out = args.out.clone().ok_or_else(|| anyhow::anyhow!("-o DIR is required"))?;

@@ -12,7 +12,8 @@
 //! measured value with the range of its repeated runs, which `--compare` uses as its
 //! noise — and `claims.csv`), `plots/` (SVG + PNG), `figures/` (PNG pictures rendered by
 //! texgeo's own Vulkan pipeline, described in `figures.json`) and `run.json` (machine,
-//! device, version). Every file is written atomically.
+//! device, version). Every file is written atomically. A saved report's tables are
+//! written into a Markdown page between marker comments by [`results_page`].
 
 mod claims;
 mod compare;
@@ -22,6 +23,7 @@ mod facts;
 mod figures;
 mod files;
 mod header;
+mod page;
 mod thesis;
 
 use std::collections::HashSet;
@@ -34,6 +36,7 @@ pub use experiments::{EXPERIMENTS, Experiment, Figure};
 pub use facts::{Facts, Stat};
 pub use figures::{FigureRecord, valence_model};
 pub use files::{check_writable, write_atomic};
+pub use page::regenerate as results_page;
 
 use crate::gpu::Context;
 use crate::report::{Progress, Table};
