@@ -596,25 +596,86 @@ fn a_damaged_report_is_listed_and_gives_status_2() {
     std::fs::remove_dir_all(base).unwrap();
 }
 
+/// `from` copied into `to`, folders included.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
 #[test]
 fn the_results_page_is_the_saved_report_regenerated() {
     // docs/results.md's marked tables, written anew from the report saved under
     // docs/report/, give the committed page byte for byte: the page shows what that run
     // measured, not numbers pasted by hand.
-    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/results.md");
-    let text = std::fs::read_to_string(&page).unwrap();
-    let (new, tables) = texgeo::report::reproduce::results_page(&page, &text).unwrap();
-    assert!(tables >= 5, "{tables} generated tables");
-    assert!(new == text, "docs/results.md differs from its report: run `texgeo reproduce --results-md docs/results.md`");
-    // The command says so, and rewrites nothing.
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let committed = std::fs::read(docs.join("results.md")).unwrap();
+    let dir = temp("page");
+    copy_tree(&docs.join("report"), &dir.join("report"));
+    let page = dir.join("results.md");
+    // A page whose tables were emptied is filled again with exactly the committed ones.
+    let text = String::from_utf8(committed.clone()).unwrap();
+    let mut emptied = String::new();
+    let mut inside = false;
+    for line in text.split_inclusive('\n') {
+        if line.starts_with("<!-- end of texgeo reproduce table") {
+            inside = false;
+        }
+        if !inside {
+            emptied.push_str(line);
+        }
+        if line.starts_with("<!-- texgeo reproduce table: ") {
+            inside = true;
+        }
+    }
+    assert!(emptied.len() < text.len(), "docs/results.md has no generated table");
+    std::fs::write(&page, &emptied).unwrap();
+    let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("rewritten"));
+    assert!(
+        std::fs::read(&page).unwrap() == committed,
+        "docs/results.md differs from its saved report: run `texgeo reproduce --results-md docs/results.md`"
+    );
+    // Regenerating the committed page changes nothing, and says so.
     let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).contains("unchanged"));
-    // A page without markers is refused.
-    let dir = temp("page");
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("p.md"), "# nothing to regenerate\n").unwrap();
-    let o = texgeo(&["reproduce", "--results-md", dir.join("p.md").to_str().unwrap()], &[]);
+    assert!(std::fs::read(&page).unwrap() == committed);
+    // The page names the device and the machine's state as the report recorded them.
+    let mut run = csv::Reader::from_path(docs.join("report/csv/run.csv")).unwrap();
+    let run: HashMap<String, String> =
+        run.records().map(|r| r.unwrap()).map(|r| (r[0].to_string(), r[1].to_string())).collect();
+    for what in ["device", "driver", "load average (1, 5, 15 min)", "CPU time", "other processes"] {
+        let row = format!("| {what} | {} |", run.get(what).unwrap_or_else(|| panic!("run.csv has no {what}")));
+        assert!(text.contains(&row), "docs/results.md has no \"{row}\" row");
+    }
+
+    // Refusals: one line, status 2, the page left as it was.
+    let refused = |what: &str, expect: &str| {
+        let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{what}: {err}");
+        assert!(err.contains(expect), "{what}: {err}");
+        assert!(std::fs::read(&page).unwrap() == committed, "{what}: the page changed");
+    };
+    // A damaged report: a table without the columns the page shows.
+    std::fs::write(dir.join("report/csv/claims.csv"), "id,verdict\nI1,holds\n").unwrap();
+    refused("damaged", "report/csv/claims.csv has no column \"claim (the thesis' words)\"");
+    // No report at all beside the page.
+    std::fs::remove_dir_all(dir.join("report")).unwrap();
+    refused("missing", "report/csv/run.csv: missing (no saved report there");
+    // A page without markers.
+    std::fs::write(&page, "# nothing to regenerate\n").unwrap();
+    let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo reproduce table: FILE -->\" marker"));
     std::fs::remove_dir_all(dir).unwrap();

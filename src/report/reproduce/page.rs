@@ -56,6 +56,9 @@ fn numeric(cell: &str) -> bool {
 /// The Markdown table of the CSV file at `path` (`name` as the page links it), its
 /// `columns` in that order (all when empty), and the link to the file.
 fn table(path: &Path, name: &str, columns: &[&str]) -> std::result::Result<String, String> {
+    if !path.is_file() {
+        return Err(format!("{name}: missing (no saved report there; `texgeo reproduce -o DIR` makes one)"));
+    }
     let mut r = csv::Reader::from_path(path).map_err(|e| format!("{name}: {e}"))?;
     let header: Vec<String> =
         r.headers().map_err(|e| format!("{name}: {e}"))?.iter().map(String::from).collect();
@@ -150,7 +153,7 @@ mod tests {
             e(column)
         );
         let missing = "<!-- texgeo reproduce table: r/none.csv -->\n<!-- end of texgeo reproduce table -->\n";
-        assert!(e(missing).contains("page.md:1: r/none.csv:"), "{}", e(missing));
+        assert!(e(missing).contains("page.md:1: r/none.csv: missing (no saved report there"), "{}", e(missing));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
