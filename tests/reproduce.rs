@@ -654,7 +654,8 @@ fn the_results_page_is_the_saved_report_regenerated() {
     let run: HashMap<String, String> =
         run.records().map(|r| r.unwrap()).map(|r| (r[0].to_string(), r[1].to_string())).collect();
     for what in ["device", "driver", "load average (1, 5, 15 min)", "CPU time", "other processes"] {
-        let row = format!("| {what} | {} |", run.get(what).unwrap_or_else(|| panic!("run.csv has no {what}")));
+        let row =
+            format!("| {what} | {} |", run.get(what).unwrap_or_else(|| panic!("run.csv has no {what}")));
         assert!(text.contains(&row), "docs/results.md has no \"{row}\" row");
     }
 
@@ -677,6 +678,8 @@ fn the_results_page_is_the_saved_report_regenerated() {
     std::fs::write(&page, "# nothing to regenerate\n").unwrap();
     let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo reproduce table: FILE -->\" marker"));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo reproduce table: FILE -->\" marker")
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -183,7 +183,11 @@ impl Header {
                     Some(o) => format!(
                         "{:.0} % of all cores' time{}",
                         100.0 * o,
-                        if s.busy() { " (busy: times are slower and noisier than on a quiet machine)" } else { "" }
+                        if s.busy() {
+                            " (busy: times are slower and noisier than on a quiet machine)"
+                        } else {
+                            ""
+                        }
                     ),
                     None => "unknown (no /proc)".into(),
                 },

@@ -153,7 +153,11 @@ mod tests {
             e(column)
         );
         let missing = "<!-- texgeo reproduce table: r/none.csv -->\n<!-- end of texgeo reproduce table -->\n";
-        assert!(e(missing).contains("page.md:1: r/none.csv: missing (no saved report there"), "{}", e(missing));
+        assert!(
+            e(missing).contains("page.md:1: r/none.csv: missing (no saved report there"),
+            "{}",
+            e(missing)
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
