@@ -131,10 +131,6 @@ impl DeviceInfo {
 }
 
 pub(crate) struct Device {
-    _entry: ash::Entry,
-    pub instance: ash::Instance,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-    log: Option<Box<validation::Log>>,
     pub physical: vk::PhysicalDevice,
     pub raw: ash::Device,
     pub push_descriptor: ash::khr::push_descriptor::Device,
@@ -149,12 +145,16 @@ pub(crate) struct Device {
     /// Kept between runs in the user's cache folder ([`super::pipeline_cache`]).
     pub pipeline_cache: Mutex<super::pipeline_cache::PipelineCache>,
     pub info: DeviceInfo,
+    /// Last, so it is destroyed after everything made from it (fields drop after
+    /// `Device::drop`, in order).
+    pub instance: Instance,
 }
 
 impl Drop for Device {
     fn drop(&mut self) {
         // SAFETY: every resource holds an Arc<Device>, so none is alive here; wait for
-        // the queue, then destroy in reverse creation order (allocator before device).
+        // the queue, then destroy in reverse creation order (allocator before device); the
+        // instance goes last, as the last field.
         let leaks = self.leaks();
         unsafe {
             let _ = self.raw.device_wait_idle();
@@ -165,27 +165,10 @@ impl Drop for Device {
             if let Ok(pool) = self.command_pool.get_mut() {
                 self.raw.destroy_command_pool(*pool, None);
             }
-            // Every resource holds the device, so anything still allocated here was leaked
-            // by a bug in texgeo: say so loudly (gpu-allocator itself only logs it).
-            if let Ok(allocator) = self.allocator.get_mut() {
-                let report = allocator.generate_report();
-                if !report.allocations.is_empty() {
-                    let names: Vec<_> = report.allocations.iter().map(|a| a.name.as_str()).collect();
-                    crate::note!(
-                        "gpu-allocator: {} allocation(s) leaked at teardown: {}",
-                        names.len(),
-                        names.join(", ")
-                    );
-                }
-            }
             ManuallyDrop::drop(&mut self.allocator);
             self.raw.destroy_device(None);
-            if let Some((loader, messenger)) = self.debug.take() {
-                loader.destroy_debug_utils_messenger(messenger, None);
-            }
-            self.instance.destroy_instance(None);
         }
-        if let Some(log) = &self.log {
+        if let Some(log) = &self.instance.log {
             let errors = log.take();
             if !errors.is_empty() {
                 crate::note!("Vulkan validation errors at teardown:\n{}", errors.join("\n"));
@@ -194,10 +177,11 @@ impl Drop for Device {
                 }
             }
         }
-        // Leaks and failed frees are bugs: loud under validation (tests), a warning otherwise.
+        // Leaks and failed frees are bugs in texgeo: loud under validation (tests), a
+        // warning otherwise (gpu-allocator itself would only log them).
         if !leaks.is_empty() {
             crate::note!("texgeo: GPU memory problems at teardown:\n{}", leaks.join("\n"));
-            if self.log.is_some() && !std::thread::panicking() {
+            if self.instance.log.is_some() && !std::thread::panicking() {
                 panic!("{} GPU memory problem(s) at teardown: {}", leaks.len(), leaks.join("; "));
             }
         }
@@ -207,7 +191,7 @@ impl Drop for Device {
 impl Device {
     /// Validation errors and memory problems since the last check, as an error.
     pub fn check_validation(&self) -> Result<()> {
-        let errors = self.log.as_ref().map(|log| log.take()).unwrap_or_default();
+        let errors = self.instance.log.as_ref().map(|log| log.take()).unwrap_or_default();
         if !errors.is_empty() {
             return Err(GpuError::Validation(errors));
         }
@@ -258,9 +242,10 @@ pub struct Context {
     pub(crate) dev: Arc<Device>,
 }
 
-struct Instance {
+/// The Vulkan instance and, with validation, its debug messenger and the log it fills.
+pub(crate) struct Instance {
     entry: ash::Entry,
-    instance: ash::Instance,
+    pub raw: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     log: Option<Box<validation::Log>>,
 }
@@ -302,10 +287,10 @@ impl Instance {
         }
         // SAFETY: all pointers in `info` outlive the call.
         let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
-        let mut this = Instance { entry, instance, debug: None, log: None };
+        let mut this = Instance { entry, raw: instance, debug: None, log: None };
         if validate {
             let log = Box::new(validation::Log::default());
-            let loader = ash::ext::debug_utils::Instance::new(&this.entry, &this.instance);
+            let loader = ash::ext::debug_utils::Instance::new(&this.entry, &this.raw);
             let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
                 .message_severity(
                     vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
@@ -330,13 +315,13 @@ impl Instance {
 
 impl Drop for Instance {
     fn drop(&mut self) {
-        // Only reached when device creation failed; on success the parts move into Device.
-        // SAFETY: nothing else was created from this instance.
+        // SAFETY: whatever was made from this instance (a device, a surface) is gone: the
+        // device owns the instance as its last field, a pending surface borrows it.
         unsafe {
             if let Some((loader, messenger)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);
             }
-            self.instance.destroy_instance(None);
+            self.raw.destroy_instance(None);
         }
     }
 }
@@ -405,13 +390,13 @@ fn is_lavapipe(info: &DeviceInfo) -> bool {
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
     let inst = Instance::new(false, &[])?;
     // SAFETY: plain enumeration on a live instance.
-    let physicals = unsafe { inst.instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    let physicals = unsafe { inst.raw.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     let masked = masked_features()?;
     Ok(physicals
         .iter()
         .enumerate()
         .map(|(i, &p)| {
-            let mut info = describe(&inst.instance, i, p);
+            let mut info = describe(&inst.raw, i, p);
             info.mask(&masked);
             info
         })
@@ -489,6 +474,34 @@ impl Drop for PendingSurface<'_> {
     }
 }
 
+/// The new device and its command pool and sampler while `Context::create` still runs:
+/// destroyed in reverse order if a later step fails, handed on by [`Partial::keep`].
+struct Partial<'a> {
+    raw: &'a ash::Device,
+    pool: vk::CommandPool,
+    sampler: vk::Sampler,
+}
+
+impl Partial<'_> {
+    fn keep(self) -> (vk::CommandPool, vk::Sampler) {
+        let kept = (self.pool, self.sampler);
+        // Disarmed (it owns no memory): the device goes on to live in `Device`.
+        std::mem::forget(self);
+        kept
+    }
+}
+
+impl Drop for Partial<'_> {
+    fn drop(&mut self) {
+        // SAFETY: nothing uses these yet; null handles are ignored.
+        unsafe {
+            self.raw.destroy_sampler(self.sampler, None);
+            self.raw.destroy_command_pool(self.pool, None);
+            self.raw.destroy_device(None);
+        }
+    }
+}
+
 impl Context {
     /// Opens the device `options` ask for (defaults: `TEXGEO_DEVICE`, `TEXGEO_VALIDATION`).
     pub fn new(options: &ContextOptions) -> Result<Context> {
@@ -526,20 +539,20 @@ impl Context {
                 // SAFETY: the handles come from a live window the caller keeps open while
                 // the surface exists.
                 let raw =
-                    unsafe { ash_window::create_surface(&inst.entry, &inst.instance, display, handle, None) }
+                    unsafe { ash_window::create_surface(&inst.entry, &inst.raw, display, handle, None) }
                         .vk("vkCreate…SurfaceKHR")?;
                 Some(PendingSurface {
                     inst: &inst,
-                    loader: ash::khr::surface::Instance::new(&inst.entry, &inst.instance),
+                    loader: ash::khr::surface::Instance::new(&inst.entry, &inst.raw),
                     raw,
                 })
             }
             None => None,
         };
-        let (physical, info) = choose(&inst.instance, &options.device)?;
+        let (physical, info) = choose(&inst.raw, &options.device)?;
 
         // SAFETY: valid physical device.
-        let families = unsafe { inst.instance.get_physical_device_queue_family_properties(physical) };
+        let families = unsafe { inst.raw.get_physical_device_queue_family_properties(physical) };
         let presents = |i: usize| match &pending {
             // SAFETY: valid physical device, family index and surface.
             Some(p) => unsafe { p.loader.get_physical_device_surface_support(physical, i as u32, p.raw) }
@@ -575,8 +588,7 @@ impl Context {
             .enabled_features(&features)
             .push_next(&mut f13);
         // SAFETY: all pointers in device_info outlive the call.
-        let raw =
-            unsafe { inst.instance.create_device(physical, &device_info, None) }.vk("vkCreateDevice")?;
+        let raw = unsafe { inst.raw.create_device(physical, &device_info, None) }.vk("vkCreateDevice")?;
         // SAFETY: the queue family and index exist (created above).
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -592,59 +604,30 @@ impl Context {
         // Leaks are reported by `Device::drop` itself, loudly (gpu-allocator would only log).
         let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
         debug_settings.log_leaks_on_shutdown = false;
+        let mut partial = Partial { raw: &raw, pool: vk::CommandPool::null(), sampler: vk::Sampler::null() };
+        // SAFETY: valid device and create infos; `partial` destroys what exists if a step fails.
+        partial.pool = unsafe { raw.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        // SAFETY: as above.
+        partial.sampler = unsafe { raw.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
         let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: inst.instance.clone(),
+            instance: inst.raw.clone(),
             device: raw.clone(),
             physical_device: physical,
             debug_settings,
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        });
-        // SAFETY: valid device; on any failure below everything created so far is destroyed.
-        let (command_pool, sampler, allocator) = unsafe {
-            let pool = raw.create_command_pool(&pool_info, None);
-            let sampler = raw.create_sampler(&sampler_info, None);
-            match (pool, sampler, allocator) {
-                (Ok(p), Ok(s), Ok(a)) => (p, s, a),
-                (p, s, a) => {
-                    drop(a);
-                    if let Ok(p) = p {
-                        raw.destroy_command_pool(p, None);
-                    }
-                    if let Ok(s) = s {
-                        raw.destroy_sampler(s, None);
-                    }
-                    raw.destroy_device(None);
-                    return Err(GpuError::Unsupported(
-                        "cannot create command pool, sampler or allocator".into(),
-                    ));
-                }
-            }
-        };
-        let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.instance, &raw);
+        })?;
+        let (command_pool, sampler) = partial.keep();
+        let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.raw, &raw);
         // SAFETY: valid physical device.
-        let props = unsafe { inst.instance.get_physical_device_properties(physical) };
+        let props = unsafe { inst.raw.get_physical_device_properties(physical) };
         let pipeline_cache =
             super::pipeline_cache::PipelineCache::open(&raw, super::pipeline_cache::Identity::of(&props));
         // The surface now outlives this function in the caller's `Surface`.
         let surface = pending.as_mut().map(|p| (p.loader.clone(), std::mem::take(&mut p.raw)));
         drop(pending);
-        // Move the instance parts into the device, which now owns their destruction.
-        let inst = ManuallyDrop::new(inst);
-        // SAFETY: each field is read exactly once out of a ManuallyDrop that is never dropped.
-        let (entry, instance, debug, log) = unsafe {
-            (
-                std::ptr::read(&inst.entry),
-                std::ptr::read(&inst.instance),
-                std::ptr::read(&inst.debug),
-                std::ptr::read(&inst.log),
-            )
-        };
+        // The device owns the instance from here on and destroys it last.
         let dev = Device {
-            _entry: entry,
-            instance,
-            debug,
-            log,
             physical,
             raw,
             push_descriptor,
@@ -655,6 +638,7 @@ impl Context {
             sampler,
             pipeline_cache: Mutex::new(pipeline_cache),
             info,
+            instance: inst,
         };
         let ctx = Context { dev: Arc::new(dev) };
         if let Err(e) = ctx.dev.check_validation() {
@@ -684,7 +668,7 @@ impl Context {
 
     /// Whether the validation layer is on for this context.
     pub fn validating(&self) -> bool {
-        self.dev.log.is_some()
+        self.dev.instance.log.is_some()
     }
 
     /// Records commands with `record`, submits them, waits, and reports validation errors.
@@ -701,7 +685,7 @@ impl Context {
         record: impl FnOnce(&mut Recorder) -> Result<T>,
     ) -> Result<T> {
         let dev = &self.dev;
-        let pool = dev.command_pool.lock().map_err(|_| GpuError::Internal("command pool lock poisoned"))?;
+        let pool = super::error::lock(&dev.command_pool, "command pool")?;
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(*pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -742,7 +726,7 @@ impl Context {
                 .wait_semaphore_infos(&waits)
                 .signal_semaphore_infos(&signals)];
             let waited = (|| {
-                let queue = dev.queue.lock().map_err(|_| GpuError::Internal("queue lock poisoned"))?;
+                let queue = super::error::lock(&dev.queue, "queue")?;
                 // SAFETY: the command buffer is complete; the fence is unsignalled.
                 unsafe { dev.raw.queue_submit2(*queue, &submit, fence) }.vk("vkQueueSubmit2")?;
                 drop(queue);
@@ -770,6 +754,19 @@ impl Context {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_poisoned_lock_is_the_same_error_everywhere() {
+        let ctx = Context::new(&ContextOptions::default()).expect("a Vulkan device (tools/setup)");
+        let dev = ctx.dev.clone();
+        let poisoner = std::thread::spawn(move || {
+            let _queue = dev.queue.lock();
+            panic!("a panic while the queue is locked (expected by this test)");
+        });
+        assert!(poisoner.join().is_err());
+        let err = ctx.submit(|_| Ok(())).expect_err("a submission through a poisoned queue lock");
+        assert!(matches!(err, GpuError::Poisoned("queue")), "{err}");
+    }
 
     #[test]
     fn a_leaked_allocation_fails_at_teardown() {

@@ -1,3 +1,5 @@
+use std::sync::{Mutex, MutexGuard};
+
 use ash::vk;
 
 pub type Result<T, E = GpuError> = std::result::Result<T, E>;
@@ -24,6 +26,9 @@ pub enum GpuError {
     /// A broken invariant of texgeo's own GPU code (a bug, not bad input).
     #[error("internal GPU error (a texgeo bug): {0}")]
     Internal(&'static str),
+    /// A lock of the device's shared state held by a thread that panicked (see [`lock`]).
+    #[error("internal GPU error (a texgeo bug): the {0} lock was poisoned by an earlier panic")]
+    Poisoned(&'static str),
     /// Memory that could not be freed (reported after the fact, from a `Drop`).
     #[error("GPU memory could not be released: {}", .0.join("; "))]
     Release(Vec<String>),
@@ -51,6 +56,12 @@ impl From<gpu_allocator::AllocationError> for GpuError {
     fn from(e: gpu_allocator::AllocationError) -> GpuError {
         GpuError::Memory(e)
     }
+}
+
+/// Locks one of the device's shared parts (`what`: "queue", "allocator" …); a poisoned
+/// lock is the same error everywhere.
+pub(crate) fn lock<'a, T>(mutex: &'a Mutex<T>, what: &'static str) -> Result<MutexGuard<'a, T>> {
+    mutex.lock().map_err(|_| GpuError::Poisoned(what))
 }
 
 /// Attaches the name of the failing Vulkan call to a `vk::Result`.

@@ -37,28 +37,18 @@ impl Buffer {
         let raw = unsafe { dev.raw.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         // SAFETY: `raw` was just created.
         let requirements = unsafe { dev.raw.get_buffer_memory_requirements(raw) };
-        let allocated =
-            dev.allocator.lock().map_err(|_| GpuError::Internal("allocator lock poisoned")).and_then(
-                |mut a| {
-                    Ok(a.allocate(&AllocationCreateDesc {
-                        name,
-                        requirements,
-                        location,
-                        linear: true,
-                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                    })?)
-                },
-            );
-        let allocation = match allocated {
-            Ok(a) => a,
-            Err(e) => {
-                // SAFETY: unbound buffer owned here.
-                unsafe { dev.raw.destroy_buffer(raw, None) };
-                return Err(e);
-            }
-        };
-        let buffer = Buffer { dev, raw, allocation: Some(allocation), size };
-        let a = buffer.allocation.as_ref().ok_or(GpuError::Internal("buffer without memory"))?;
+        let mut buffer = Buffer { dev, raw, allocation: None, size };
+        // From here on `buffer`'s Drop cleans up whatever was created if a step fails (the
+        // same guard as a texture's).
+        let allocation =
+            super::error::lock(&buffer.dev.allocator, "allocator")?.allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })?;
+        let a = buffer.allocation.insert(allocation);
         // SAFETY: memory and offset come from the allocator for this buffer's requirements.
         unsafe { buffer.dev.raw.bind_buffer_memory(raw, a.memory(), a.offset()) }.vk("vkBindBufferMemory")?;
         Ok(buffer)

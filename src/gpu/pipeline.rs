@@ -467,10 +467,7 @@ impl Pipeline {
         // SAFETY: every pointer in `info` outlives the call; modules are alive until after it.
         // The device's cache (kept between runs); locked, as Vulkan wants a cache used by
         // one thread at a time.
-        let cache = dev
-            .pipeline_cache
-            .lock()
-            .map_err(|_| GpuError::Unsupported("pipeline cache lock poisoned".into()))?;
+        let cache = super::error::lock(&dev.pipeline_cache, "pipeline cache")?;
         let created = unsafe { dev.raw.create_graphics_pipelines(cache.raw, &[info], None) };
         drop(cache);
         pipeline.raw =

@@ -138,7 +138,7 @@ impl Swapchain {
             .present_mode(mode)
             .clipped(true)
             .old_swapchain(old.map_or(vk::SwapchainKHR::null(), |o| o.raw));
-        let loader = ash::khr::swapchain::Device::new(&dev.instance, &dev.raw);
+        let loader = ash::khr::swapchain::Device::new(&dev.instance.raw, &dev.raw);
         let mut chain = Swapchain {
             dev: dev.clone(),
             surface: surface.clone(),
@@ -227,7 +227,7 @@ impl Swapchain {
         let indices = [index];
         let info =
             vk::PresentInfoKHR::default().wait_semaphores(&waits).swapchains(&chains).image_indices(&indices);
-        let queue = self.dev.queue.lock().map_err(|_| GpuError::Usage("queue lock poisoned".into()))?;
+        let queue = super::error::lock(&self.dev.queue, "queue")?;
         // SAFETY: the image was acquired and its copy submitted, signalling `waits`.
         let shown = unsafe { self.loader.queue_present(*queue, &info) };
         drop(queue);

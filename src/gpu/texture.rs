@@ -193,7 +193,8 @@ impl Texture {
         }
         let dev = ctx.dev.clone();
         // SAFETY: plain query on the context's physical device.
-        let props = unsafe { dev.instance.get_physical_device_format_properties(dev.physical, format.vk()) };
+        let props =
+            unsafe { dev.instance.raw.get_physical_device_format_properties(dev.physical, format.vk()) };
         let (needed, usage) = if format.is_depth() {
             (vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)
         } else if samples > 1 {
@@ -255,19 +256,17 @@ impl Texture {
         // SAFETY: the image was just created.
         let requirements = unsafe { tex.dev.raw.get_image_memory_requirements(image) };
         let allocation =
-            tex.dev.allocator.lock().map_err(|_| GpuError::Internal("allocator lock poisoned"))?.allocate(
-                &AllocationCreateDesc {
-                    name,
-                    requirements,
-                    location: MemoryLocation::GpuOnly,
-                    linear: false,
-                    allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-                },
-            )?;
+            super::error::lock(&tex.dev.allocator, "allocator")?.allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })?;
+        let allocation = tex.allocation.insert(allocation);
         // SAFETY: memory allocated for this image's requirements.
         unsafe { tex.dev.raw.bind_image_memory(image, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
-        tex.allocation = Some(allocation);
         let view_type =
             if layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
         tex.view = tex.make_view(view_type, 0, layers)?;
