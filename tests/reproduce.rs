@@ -98,6 +98,16 @@ fn report(dir: &Path) -> String {
 #[test]
 fn every_table_is_present_with_every_row_filled() {
     let md = report(quick());
+    // Both theses are cited in full at the top.
+    let head = &md[..md.find("Where this ran").expect("the run table")];
+    for cited in [
+        "Carlos J. Ogayar Anguita",
+        "Universidad de Granada, 2006",
+        "Arasay Baryolo Morales",
+        "La Habana, 2010",
+    ] {
+        assert!(head.contains(cited), "the report's header does not cite {cited}");
+    }
     let all = tables(&md);
     for wanted in [
         "Where this ran",

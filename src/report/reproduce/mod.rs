@@ -511,7 +511,11 @@ fn assemble(
         Ok(Block::Table { table: t, csv })
     };
     let longest = sections.iter().max_by_key(|s| s.elapsed).map(|s| (s.experiment.title, s.elapsed));
-    let mut blocks = vec![Block::Verdicts(verdicts)];
+    let mut blocks = vec![
+        Block::Para("This report reproduces the experiments of two theses:".into()),
+        Block::List(thesis::CITATIONS.iter().map(|c| c.to_string()).collect()),
+        Block::Verdicts(verdicts),
+    ];
     blocks.extend(header.state.as_ref().and_then(|s| s.warning()));
     blocks.push(write_table(header.table(elapsed, longest), "run")?);
     blocks.push(header::Header::note());

@@ -4,6 +4,16 @@
 use super::facts::{Facts, Source, Stat};
 use crate::report::bench::{boolean, inclusion, subdiv, voxelize};
 
+/// The two theses this report reproduces, cited in full wherever the report names them.
+pub const CITATIONS: [&str; 2] = [
+    "Carlos J. Ogayar Anguita, “Optimización de algoritmos geométricos básicos mediante el uso de \
+     recubrimientos simpliciales”, PhD thesis, Universidad de Granada, 2006 (inclusion test, voxelization, \
+     Booleans).",
+    "Arasay Baryolo Morales and Yandry Fernández Font, “Subdivisión de superficies mediante el uso de la \
+     unidad de procesamiento gráfico”, diploma thesis, Universidad de las Ciencias Informáticas, La Habana, \
+     2010 (Catmull-Clark subdivision).",
+];
+
 /// (column of the thesis CSV, fact key, unit, scale to texgeo's unit).
 type Columns<'a> = &'a [(&'a str, &'a str, &'static str)];
 
