@@ -276,3 +276,47 @@ fn a_sliver_difference_is_repaired_says_so_and_is_an_operand() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The unit cube with its top split so that a vertex lies on the top front edge, which
+/// the front face keeps whole: a face of no area (corners on that edge) closes it, as STL
+/// export of polygon meshes makes them. `plug_corners` extra vertices lie on the edge:
+/// one plugged by a triangle, two by a quad.
+fn plugged_cube(plug_corners: usize) -> String {
+    let (extra, top, plug) = match plug_corners {
+        1 => ("0.5 0 1\n", vec!["3 4 8 6", "3 8 7 6", "3 8 5 7"], "3 4 5 8"),
+        _ => ("0.25 0 1\n0.75 0 1\n", vec!["6 4 8 9 5 7 6"], "4 4 5 9 8"),
+    };
+    let mut faces: Vec<&str> = FACES[..5].to_vec();
+    faces.extend(top);
+    faces.push(plug);
+    format!("OFF\n{} {} 0\n{CUBE_VERTICES}{extra}{}\n", 8 + plug_corners, faces.len(), faces.join("\n"))
+}
+
+#[test]
+fn faces_of_no_area_are_left_out_as_every_command_does() {
+    for corners in [1, 2] {
+        let cube = write(&temp(&format!("plugged-{corners}.off")), &plugged_cube(corners));
+        let stats = stdout(&texgeo(&["mesh", "stats", &cube]));
+        assert!(stats.contains("degenerate faces       1") && stats.contains("solid: yes"), "{stats}");
+        // B straddles the top front edge around the plugged junction.
+        let transform = "scale 0.25; translate 0.5 0 1";
+        for (op, want) in [("union", 1.09375), ("difference", 0.96875), ("intersection", 0.03125)] {
+            let out = temp(&format!("plugged-{corners}-{op}.off"));
+            let o = texgeo(&[
+                "boolean",
+                &cube,
+                "builtin:cube",
+                "--transform-b",
+                transform,
+                "--op",
+                op,
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{corners} {op}: {}", stderr(&o));
+            assert!((volume(&out) - want).abs() < 1e-12, "{corners} {op}: {}", volume(&out));
+            let stats = stdout(&texgeo(&["mesh", "stats", out.to_str().unwrap()]));
+            assert!(stats.contains("solid: yes"), "{corners} {op}: {stats}");
+        }
+    }
+}

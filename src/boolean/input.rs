@@ -1,7 +1,8 @@
 //! What a Boolean operand must be, checked before any work: a closed, consistently
 //! oriented solid of positive volume whose faces do not cross each other, or the empty
-//! solid (no faces). Non-manifold solids (two cubes sharing an edge), cavities and
-//! polygon faces are fine.
+//! solid (no faces). Non-manifold solids (two cubes sharing an edge), cavities, polygon
+//! faces and faces of no area (left out exactly: they carry no volume) are fine, as they
+//! are for every other command.
 //!
 //! Each refusal names the operand and the reason; the command exits with status 2 and
 //! writes nothing. (NaN and infinite coordinates never get this far: the mesh readers
@@ -13,7 +14,7 @@ use crate::mesh::Mesh;
 use crate::mesh::covering::Covering;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
-use crate::mesh::intersect::{TriangleSoup, is_degenerate};
+use crate::mesh::intersect::TriangleSoup;
 use crate::mesh::solidity::{self, NotSolid, Policy};
 use crate::mesh::triangulate::TriangulateError;
 
@@ -26,7 +27,11 @@ pub enum InputError {
     NotSolid(#[from] NotSolid),
     #[error("face {face} cannot be triangulated in its plane: {reason}")]
     Face { face: usize, reason: TriangulateError },
-    #[error("face {face} has no area (its corners are collinear)")]
+    /// Faces of no area are left out (they carry no volume); these are stacked along one
+    /// line so that leaving them out would open the surface.
+    #[error(
+        "face {face} has no area, and leaving it out would open the surface (faces of no area overlap along one line)"
+    )]
     Degenerate { face: usize },
     #[error("it encloses no volume")]
     Flat,
@@ -44,9 +49,9 @@ fn remedy(defect: &solidity::Defect) -> &'static str {
 }
 
 /// Checks one operand, given in `frame`, and returns its triangles (polygon faces tessellated
-/// as every command sees them, [`TriangleSoup::new`]; vertices welded by position): the
-/// shared solid check of every command, then what refinement
-/// needs on top (faces with area, a volume). `allow_self_intersections` excuses faces that
+/// as every command sees them, [`TriangleSoup::new`]; vertices welded by position; triangles
+/// of no area left out, [`TriangleSoup::without_zero_area`]): the shared solid check of
+/// every command, then what refinement needs on top (faces it can triangulate, a volume). `allow_self_intersections` excuses faces that
 /// cross; an inverted operand is refused (the command flips it first when asked).
 pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
     if mesh.num_faces() == 0 {
@@ -60,15 +65,12 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
     }
     let soup = TriangleSoup::new(mesh);
     if let Some((face, reason)) = soup.failed.first().cloned() {
-        return Err(if reason == TriangulateError::Degenerate {
-            InputError::Degenerate { face: face as usize }
-        } else {
-            InputError::Face { face: face as usize, reason }
-        });
+        return Err(InputError::Face { face: face as usize, reason });
     }
-    if let Some(t) = (0..soup.triangles.len()).find(|&t| is_degenerate(soup.triangle(t))) {
-        return Err(InputError::Degenerate { face: soup.face_of[t] as usize });
-    }
+    // Triangles of no area carry no volume: the surface without them is the one every
+    // command sees (mesh stats, inclusion and voxelize measure and test it the same).
+    let soup =
+        soup.without_zero_area().map_err(|face| InputError::Degenerate { face: face as usize })?.into_owned();
     // In the frame: the volume in the input's units may underflow.
     let volume = Covering::new(mesh).volume();
     if volume.abs() <= flatness_bound(piece_boxes(&soup)) {

@@ -61,6 +61,13 @@ pub fn is_degenerate(t: [DVec3; 3]) -> bool {
     exact_normal_signs(t[0], t[1], t[2]) == DVec3::ZERO
 }
 
+/// All of `points` lie exactly on one line (or coincide).
+fn all_collinear(points: &[DVec3]) -> bool {
+    let Some(&a) = points.first() else { return true };
+    let Some(&b) = points.iter().find(|&&p| p != a) else { return true };
+    points.iter().all(|&c| is_degenerate([a, b, c]))
+}
+
 /// Closed 2D segments [p, q] and [r, s] share a point.
 fn segments_meet_2d(p: glam::DVec2, q: glam::DVec2, r: glam::DVec2, s: glam::DVec2) -> bool {
     let d1 = orient2d(r, s, p);
@@ -169,7 +176,8 @@ pub struct TriangleSoup {
     pub triangles: Vec<[u32; 3]>,
     /// The mesh face of each triangle.
     pub face_of: Vec<u32>,
-    /// Faces that could not be tessellated, with the reason (self-crossing outline, no area).
+    /// Faces that could not be tessellated, with the reason (self-crossing outline, no
+    /// vector area without lying on one line).
     pub failed: Vec<(u32, TriangulateError)>,
 }
 
@@ -200,6 +208,11 @@ impl TriangleSoup {
                 let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
                 match triangulate::polygon(&corners) {
                     Ok(tris) => Tess::Many(tris.into_iter().map(|t| t.map(|k| face[k as usize])).collect()),
+                    // Corners on one line: the fan of triangles of no area, like a triangle
+                    // face of no area (it may plug a T-junction, [`split_at_t_junctions`]).
+                    Err(TriangulateError::Degenerate) if all_collinear(&corners) => {
+                        Tess::Many((1..face.len() - 1).map(|i| [face[0], face[i], face[i + 1]]).collect())
+                    }
                     Err(e) => Tess::Failed(e),
                 }
             })
@@ -233,6 +246,43 @@ impl TriangleSoup {
             }
         }
         soup
+    }
+
+    /// The same surface without its triangles of no area (exactly collinear or coinciding
+    /// corners), which carry neither area nor volume: every triangle with the whole segment
+    /// of such a triangle as an edge is split at the segment's middle corner, which lies
+    /// exactly on it ([`split_at_t_junctions`]), then the triangles of no area are dropped.
+    /// Exact (no point is made, no tolerance) and the faces keep their names. A closed soup
+    /// stays closed; `Err(face)` names a face of no area whose removal would leave edges
+    /// unmatched (such triangles stacked along one line in a way the split does not
+    /// resolve).
+    pub fn without_zero_area(&self) -> Result<std::borrow::Cow<'_, TriangleSoup>, u32> {
+        let degenerate: Vec<bool> = (0..self.triangles.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|t| is_degenerate(self.triangle(t)))
+            .collect();
+        let Some(first) = degenerate.iter().position(|&d| d) else {
+            return Ok(std::borrow::Cow::Borrowed(self));
+        };
+        let split = split_at_t_junctions(self);
+        let split = split.as_ref().unwrap_or(self);
+        let mut out = TriangleSoup {
+            positions: self.positions.clone(),
+            triangles: Vec::with_capacity(split.triangles.len()),
+            face_of: Vec::with_capacity(split.triangles.len()),
+            failed: self.failed.clone(),
+        };
+        for (t, (&tri, &f)) in split.triangles.iter().zip(&split.face_of).enumerate() {
+            if !is_degenerate(split.triangle(t)) {
+                out.triangles.push(tri);
+                out.face_of.push(f);
+            }
+        }
+        if !edges_balanced(&out.triangles) && edges_balanced(&self.triangles) {
+            return Err(self.face_of[first]);
+        }
+        Ok(std::borrow::Cow::Owned(out))
     }
 
     /// The corners of triangle `t`.
@@ -271,6 +321,19 @@ pub fn weld_by_position(positions: &[DVec3]) -> Vec<u32> {
         k = j;
     }
     weld
+}
+
+/// Every directed edge a→b of `triangles` is matched by a use b→a (edges from a vertex to
+/// itself aside).
+fn edges_balanced(triangles: &[[u32; 3]]) -> bool {
+    let mut uses: Vec<(u64, i32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter(|(a, b)| a != b)
+        .map(|(a, b)| ((a.min(b) as u64) << 32 | a.max(b) as u64, if a < b { 1 } else { -1 }))
+        .collect();
+    uses.par_sort_unstable();
+    uses.chunk_by(|x, y| x.0 == y.0).all(|run| run.iter().map(|x| x.1).sum::<i32>() == 0)
 }
 
 /// How two triangles of one mesh meet, judged by the vertices they share.
