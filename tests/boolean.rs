@@ -350,3 +350,34 @@ fn a_sliver_difference_is_repaired_into_a_valid_operand() {
     let r = again.result(Operation::Intersection, true).unwrap_or_else(|e| panic!("{e}"));
     assert!(close(volume(&r), got, got), "{} vs {got}", volume(&r));
 }
+
+#[test]
+fn point_tests_answer_for_the_triangles_that_are_cut() {
+    // The L-prism with one top corner raised: its top is a non-planar hexagon whose
+    // centroid lies outside it, so its triangles are made in its projection plane, while
+    // the covering (centroid fan) passes above them over the long arm. A small box in
+    // that gap is outside the triangles, inside the covering: the Boolean cuts and keeps
+    // the triangles, so its point tests must answer for them.
+    let l = procedural::l_prism();
+    let mut p = l.positions().to_vec();
+    p[7].z = 3.0; // (4, 0, 1) → (4, 0, 3)
+    let raised = Mesh::new(p, l.faces().map(<[u32]>::to_vec).collect()).unwrap();
+    let soup = TriangleSoup::new(&raised);
+    let corner = DVec3::new(3.0, 0.45, 2.2);
+    assert_eq!(boolean::classify::exact_parity(corner, &soup), Some(false));
+    let cut_surface = texgeo::mesh::triangulate::triangulated(&raised);
+    let a = boxed([3.0, 0.45, 2.2], [3.2, 0.55, 2.28], false);
+    let covering = WindingNumber::new(&raised).unwrap();
+    assert!(a.positions().iter().all(|&p| covering.classify(p) == inclusion::Class::Inside));
+    for method in [Method::Octants, Method::Bvh, Method::Winding] {
+        let ev = evaluate(&raised, &a, method, None);
+        let union = ev.result(Operation::Union, true).unwrap();
+        assert!(union.report().is_closed(), "{method:?}");
+        assert!(
+            close(volume(&union), volume(&cut_surface) + volume(&a), 1.0),
+            "{method:?}: {}",
+            volume(&union)
+        );
+        assert_eq!(ev.result(Operation::Intersection, true).unwrap().num_faces(), 0, "{method:?}");
+    }
+}

@@ -3,7 +3,8 @@
 //! The evaluation of §6.3, one file per step:
 //!
 //! 0. [`input`]: both operands must be closed, consistently oriented solids of positive
-//!    volume whose faces do not cross (non-manifold ones and polygon faces included);
+//!    volume whose faces do not cross (non-manifold ones and polygon faces included; faces
+//!    of no area are left out);
 //!    [`Transform`] ([`crate::mesh::transform`]) places B (the thesis applies a full transform
 //!    to each mesh).
 //! 1. **Refinement** (§6.4) — [`index`] finds candidate triangle pairs in one spatial
@@ -15,7 +16,9 @@
 //! 2. **Classification** (§6.5) — [`classify`]: "on" triangles exactly, the others by
 //!    groups of connected triangles (§6.5.1), one exact probe per group: the exact side
 //!    of a piece against the other surface, or a point-in-solid test at an input vertex
-//!    with any inclusion method: the thesis' GPU test with its exact fallback, or a CPU one
+//!    against the other operand's triangles (the surface the refinement cuts, not the
+//!    covering of its polygon faces) with any inclusion method: the thesis' GPU test with
+//!    its exact fallback, or a CPU one
 //!    (the default, `octants`, is the fastest exact one for the few points grouped
 //!    classification tests; on lavapipe the GPU test's set-up alone costs more).
 //! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
@@ -190,6 +193,12 @@ pub fn evaluate(
     let (a, b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
     let (a, b) = (a.as_ref(), b.as_ref());
     let (sa, sb) = check_operands(a, b, names, frame, options.allow_self_intersections)?;
+    // The point tests answer for the surface the refinement cuts: the operands'
+    // triangles. (A polygon face is its covering for the inclusion methods, which differs
+    // from its triangles on a non-planar face whose centroid fan folds, by up to the
+    // face's distance from a plane: a vertex of the other operand in that gap would take
+    // the wrong side, and the groups around it with it.)
+    let (a, b) = (&sa.to_mesh()?, &sb.to_mesh()?);
     timings.check = start.elapsed();
 
     let build = |mesh: &Mesh, name: &str| {

@@ -285,6 +285,12 @@ impl TriangleSoup {
         Ok(std::borrow::Cow::Owned(out))
     }
 
+    /// The triangles as a mesh over `positions` (unused ones included).
+    pub fn to_mesh(&self) -> super::Result<Mesh> {
+        let offsets = (0..=self.triangles.len()).map(|t| 3 * t).collect();
+        Mesh::from_parts(self.positions.clone(), offsets, self.triangles.as_flattened().to_vec())
+    }
+
     /// The corners of triangle `t`.
     #[inline]
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
