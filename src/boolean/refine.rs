@@ -86,6 +86,9 @@ pub struct RefineStats {
     /// Signs of predicates on implicit points that the floating-point filter could not
     /// decide and exact arithmetic did (see [`implicit::exact_signs`]).
     pub exact_signs: usize,
+    /// New points whose rounded position needed exact arithmetic past double-double
+    /// (see [`implicit::exact_roundings`]).
+    pub exact_roundings: usize,
     /// Input triangles re-triangulated in A and in B.
     pub cut_a: usize,
     pub cut_b: usize,
@@ -317,7 +320,9 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     let mut points = Vec::with_capacity(first as usize + implicit.len());
     points.extend_from_slice(&a.positions);
     points.extend_from_slice(&b.positions);
+    let roundings_before = implicit::exact_roundings();
     points.par_extend(implicit.par_iter().with_min_len(256).map(Point::position));
+    stats.exact_roundings = implicit::exact_roundings() - roundings_before;
     let point = |id: u32| point_of(&points, first, &implicit, id);
 
     // Points on edges and inside triangles, per mesh: exactly where their keys say.

@@ -32,6 +32,7 @@ use glam::DVec3;
 
 use super::expansion::Exact;
 use super::predicates::{Sign, orient3d};
+use super::rounding::{Ball, quotient_exact, quotient_fast};
 
 /// A closed interval [lo, hi] that contains the exact value of what it was computed from:
 /// every operation rounds its ends outward by one ulp. NaN (∞ − ∞, 0·∞) never decides.
@@ -122,6 +123,21 @@ impl Ring for Interval {
     }
     fn times(&self, o: &Self) -> Self {
         self.mul(*o)
+    }
+}
+
+impl Ring for Ball {
+    fn of(x: f64) -> Self {
+        Ball::of(x)
+    }
+    fn plus(&self, o: &Self) -> Self {
+        self.add(o)
+    }
+    fn minus(&self, o: &Self) -> Self {
+        self.sub(o)
+    }
+    fn times(&self, o: &Self) -> Self {
+        self.mul(o)
     }
 }
 
@@ -225,17 +241,37 @@ impl Point {
         }
     }
 
-    /// The coordinates rounded to f64 (within a few ulps of the real point): for output and
-    /// for constructions, never for decisions.
+    /// The coordinates, each X/W rounded to the nearest f64 (ties to even), so that one
+    /// real point has one rounded position however it is defined: for output and for
+    /// constructions, never for decisions. Double-double first; expansions only for a
+    /// coordinate within about 2⁻¹⁰⁰ of a rounding midpoint (see [`super::rounding`]).
     pub fn position(&self) -> DVec3 {
         match self.definition {
             Definition::Explicit(p) => p,
             Definition::EdgePlane { .. } => {
-                let [x, y, z, w] = self.exact().each_ref().map(Exact::approx);
-                DVec3::new(x / w, y / w, z / w)
+                let fast = rounded_fast(&self.definition);
+                if fast.iter().all(Option::is_some) {
+                    return DVec3::from_array(fast.map(|c| c.unwrap_or_default()));
+                }
+                EXACT_ROUNDINGS.fetch_add(1, AtomicOrdering::Relaxed);
+                let e = self.exact();
+                DVec3::from_array(std::array::from_fn(|i| fast[i].unwrap_or_else(|| quotient_exact(&e[i], &e[3]))))
             }
         }
     }
+}
+
+/// Each coordinate X/W rounded to nearest where double-double decides it.
+fn rounded_fast(d: &Definition) -> [Option<f64>; 3] {
+    let h = homogeneous::<Ball>(d);
+    std::array::from_fn(|i| quotient_fast(&h[i], &h[3]))
+}
+
+/// Each coordinate X/W rounded to nearest with expansions only.
+#[cfg(test)]
+fn rounded_exact(d: &Definition) -> [f64; 3] {
+    let h = homogeneous::<Exact>(d);
+    std::array::from_fn(|i| quotient_exact(&h[i], &h[3]))
 }
 
 /// (X, Y, Z, W) of a definition, in the ring R.
@@ -287,6 +323,15 @@ fn det4<R: Ring>(r: [&[R; 4]; 4]) -> R {
     };
     let term = |i: usize| r[i][3].times(&minor(i));
     term(1).minus(&term(0)).plus(&term(3).minus(&term(2)))
+}
+
+/// How many points' positions needed expansions, process-wide (for `--stats`).
+static EXACT_ROUNDINGS: AtomicUsize = AtomicUsize::new(0);
+
+/// The number of points whose rounded position needed the exact path so far in this
+/// process.
+pub fn exact_roundings() -> usize {
+    EXACT_ROUNDINGS.load(AtomicOrdering::Relaxed)
 }
 
 /// How many signs the filter left to the exact path, process-wide (for `--stats`).
@@ -462,6 +507,85 @@ mod tests {
         assert_eq!(Point::edge_edge(p, q, r, s, on(0.875, 0.5)).unwrap_err(), ImplicitError::OffInPlane);
         assert_eq!(Point::edge_edge(p, q, r, off, s).unwrap_err(), ImplicitError::NotCoplanar);
         assert_eq!(Point::edge_plane(p, p, [r, s, off]).unwrap_err(), ImplicitError::NoCrossing);
+    }
+
+    /// The double-double rounding agrees bit for bit with the exact one, on generic points
+    /// and on the near-degenerate ones where its balls are too wide and it must hand over:
+    /// segments grazing their plane, coordinates near zero, mixed scales, dyadic inputs
+    /// whose crossings are exact or rounding ties, coplanar segment pairs.
+    #[test]
+    fn rounded_positions_are_the_exact_ones_bit_for_bit() {
+        let mut rng = Rng::new(21);
+        let (mut points, mut handed_over) = (0, 0);
+        let mut check = |x: &Point| {
+            let want = rounded_exact(x.definition());
+            let fast = rounded_fast(x.definition());
+            for i in 0..3 {
+                if let Some(f) = fast[i] {
+                    assert_eq!(f.to_bits(), want[i].to_bits(), "{:?} axis {i}", x.definition());
+                }
+            }
+            handed_over += fast.iter().any(Option::is_none) as usize;
+            points += 1;
+            assert_eq!(x.position().to_array().map(f64::to_bits), want.map(f64::to_bits));
+        };
+        let dyadic = |rng: &mut Rng| DVec3::from_array([0; 3].map(|_| (rng.below(33) as f64 - 16.0) / 8.0));
+        for round in 0..3000 {
+            let (plane, p, q) = match round % 6 {
+                // Generic.
+                0 => ([0; 3].map(|_| rand_point(&mut rng)), rand_point(&mut rng), rand_point(&mut rng)),
+                // Dyadic: many crossings are exact or exact midpoints between two f64.
+                1 => ([0; 3].map(|_| dyadic(&mut rng)), dyadic(&mut rng), dyadic(&mut rng)),
+                // Grazing: p and q within 1e-12 .. 1e-15 of the plane.
+                2 => {
+                    let plane = [0; 3].map(|_| rand_point(&mut rng));
+                    let [a, b, c] = plane;
+                    let n = (b - a).cross(c - a).normalize_or_zero();
+                    let on = |rng: &mut Rng| a + (b - a) * rng.next_f64() + (c - a) * rng.next_f64();
+                    let (p, q) = (on(&mut rng) + n * 1e-12, on(&mut rng) - n * 1e-15);
+                    (plane, p, q)
+                }
+                // A coordinate of the crossing near zero.
+                3 => {
+                    let tiny = |rng: &mut Rng| rng.range_f64(-1e-14, 1e-14);
+                    let mut plane = [0; 3].map(|_| rand_point(&mut rng));
+                    for v in &mut plane {
+                        v.x = tiny(&mut rng);
+                    }
+                    (plane, DVec3::new(-1.0, 0.3, 0.2), DVec3::new(1.0, -0.1, 0.7))
+                }
+                // Mixed scales.
+                4 => {
+                    let s = |rng: &mut Rng| rand_point(rng) * 2f64.powi(rng.below(41) as i32 - 20);
+                    ([0; 3].map(|_| s(&mut rng)), s(&mut rng), s(&mut rng))
+                }
+                // Ties: pq crosses z = 0 halfway, between coordinates one ulp apart.
+                _ => {
+                    let x = rng.range_f64(0.5, 1.0);
+                    let flat = [DVec3::new(-3.0, 0.1, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(0.3, 5.0, 0.0)];
+                    (flat, DVec3::new(x, -x, -1.0), DVec3::new(x.up(), (-x).down(), 1.0))
+                }
+            };
+            if let Ok(x) = Point::edge_plane(p, q, plane) {
+                check(&x);
+                if round % 6 == 5 {
+                    // The exact midpoint ties to the even neighbour.
+                    let even = |a: f64, b: f64| if a.to_bits() & 1 == 0 { a } else { b };
+                    assert_eq!(x.position().x, even(p.x, q.x));
+                }
+            }
+            // Coplanar segment pairs (in z = const, crossing).
+            if round % 6 == 1 {
+                let z = p.z;
+                let (r, s) = (dyadic(&mut rng), dyadic(&mut rng));
+                let flat = |v: DVec3| DVec3::new(v.x, v.y, z);
+                if let Ok(x) = Point::edge_edge(flat(p), flat(q), flat(r), flat(s), flat(p) + DVec3::Z) {
+                    check(&x);
+                }
+            }
+        }
+        // Both paths ran: most points never needed expansions, the hard ones did.
+        assert!(points > 2500 && handed_over > 300 && handed_over < points / 2, "{handed_over} of {points}");
     }
 
     /// Orientation tests among several implicit points agree with a direct evaluation on

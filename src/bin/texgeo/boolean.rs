@@ -142,12 +142,13 @@ fn evaluation_lines(a: &str, b: &str, ev: &Evaluation) -> [String; 3] {
             ev.b.triangles.len()
         ),
         format!(
-            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points (implicit; {} signs decided by exact arithmetic past the filter), cut triangles A {} B {}, refined triangles A {} B {}",
+            "refinement: {} candidate pairs, {} meeting ({} coplanar), {} new points (implicit; {} signs decided by exact arithmetic past the filter, {} positions rounded exactly past double-double), cut triangles A {} B {}, refined triangles A {} B {}",
             r.candidate_pairs,
             r.meeting_pairs,
             r.coplanar_pairs,
             r.new_points,
             r.exact_signs,
+            r.exact_roundings,
             r.cut_a,
             r.cut_b,
             ev.refinement.a.triangles.len(),
@@ -182,6 +183,7 @@ fn evaluation_json(a: &str, b: &str, ev: &Evaluation) -> serde_json::Value {
             "coplanar_pairs": r.coplanar_pairs,
             "new_points": r.new_points,
             "exact_signs": r.exact_signs,
+            "exact_roundings": r.exact_roundings,
             "cut_a": r.cut_a,
             "cut_b": r.cut_b,
             "refined_a": ev.refinement.a.triangles.len(),
