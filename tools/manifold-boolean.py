@@ -93,12 +93,17 @@ def main():
         m = transform(args.transform_b)
         pb = pb @ m[:3, :3].T + m[:3, 3]
 
+    ops = {"union": lambda a, b: a + b, "intersection": lambda a, b: a ^ b,
+           "difference": lambda a, b: a - b}
+    if args.op not in ops:
+        sys.exit(f"unknown op {args.op}")
+
     def run():
-        a = m3d.Manifold(m3d.Mesh(pa.astype(np.float32), ta))
-        b = m3d.Manifold(m3d.Mesh(pb.astype(np.float32), tb))
-        op = {"union": a + b, "intersection": a ^ b, "difference": a - b}
-        r = op[args.op] if args.op in op else sys.exit(f"unknown op {args.op}")
-        return r, r.to_mesh()
+        # f64 positions (Mesh64), as tools/boolean-compare.py calls it: the same inputs texgeo reads.
+        a = m3d.Manifold(m3d.Mesh64(pa, ta.astype(np.uint64)))
+        b = m3d.Manifold(m3d.Mesh64(pb, tb.astype(np.uint64)))
+        r = ops[args.op](a, b)
+        return r, r.to_mesh64()
 
     r, mesh = run()
     print(f"volume={r.volume()} triangles={len(mesh.tri_verts)} status={r.status()}")

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
+
 use texgeo::mesh::Mesh;
 use texgeo::report::{Report, bench};
 
@@ -67,6 +69,14 @@ pub enum Command {
         /// Triangle counts of the scaling series (sphere − turned copy); 0 = none.
         #[arg(long, value_delimiter = ',', default_values_t = vec![1_000, 4_000, 16_000, 64_000, 100_000])]
         scaling: Vec<usize>,
+        /// Only the scaling series, not Table 6-1.
+        #[arg(long)]
+        scaling_only: bool,
+        /// Also write each scaling pair as DIR/sphere-N-a.off and DIR/sphere-N-b.off (N
+        /// the --scaling count), so that peers can be timed on the same inputs
+        /// (tools/boolean-scaling).
+        #[arg(long, value_name = "DIR")]
+        write_scaling: Option<PathBuf>,
         #[command(flatten)]
         common: Common,
     },
@@ -372,17 +382,41 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             let cfg = Config { points, methods, sizes, voxel_methods, threads: thread_counts, runs, budget };
             finish(around.run(|| bench::scale::run(ctx, &inclusion, &voxel, &cfg))?, &Common { runs, out })
         }
-        Command::Boolean { models, method: cpu_method, no_plain, no_cgal, scaling, common } => {
-            use bench::boolean::{Config, Pair, STAND_INS};
+        Command::Boolean {
+            models,
+            method: cpu_method,
+            no_plain,
+            no_cgal,
+            scaling,
+            scaling_only,
+            write_scaling,
+            common,
+        } => {
+            use bench::boolean::{Config, Pair, STAND_INS, scaling_pair};
             anyhow::ensure!(
                 cpu_method.is_cpu(),
                 "--method takes a CPU inclusion method (the GPU one always runs)"
             );
-            let pairs = models
-                .load(STAND_INS)?
-                .into_iter()
-                .map(|(thesis, name, mesh)| Ok(Pair::with_turned_copy(thesis, name, mesh)?))
-                .collect::<anyhow::Result<Vec<_>>>()?;
+            let pairs = if scaling_only {
+                Vec::new()
+            } else {
+                models
+                    .load(STAND_INS)?
+                    .into_iter()
+                    .map(|(thesis, name, mesh)| Ok(Pair::with_turned_copy(thesis, name, mesh)?))
+                    .collect::<anyhow::Result<Vec<_>>>()?
+            };
+            if let Some(dir) = &write_scaling {
+                texgeo::output::check_dir(dir)?;
+                for &n in scaling.iter().filter(|&&n| n > 0) {
+                    let pair = scaling_pair(n)?;
+                    for (side, mesh) in [("a", &pair.a), ("b", &pair.b)] {
+                        let path = dir.join(format!("sphere-{n}-{side}.off"));
+                        texgeo::mesh::formats::write(&path, mesh)
+                            .with_context(|| format!("writing {}", path.display()))?;
+                    }
+                }
+            }
             let cfg = Config {
                 runs: common.runs,
                 cpu_method,

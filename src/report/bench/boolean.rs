@@ -54,6 +54,13 @@ pub fn turned_copy(mesh: &Mesh) -> crate::mesh::Result<Mesh> {
     t.apply(mesh)
 }
 
+/// The scaling series' pair for about n triangles in both operands together: a UV sphere
+/// (r rings, 2r segments: about 4r² triangles) and its turned copy.
+pub fn scaling_pair(n: usize) -> crate::mesh::Result<Pair> {
+    let r = ((n as f64 / 8.0).sqrt().round() as usize).max(3);
+    Pair::with_turned_copy("–", format!("sphere {r}×{}", 2 * r), procedural::sphere(r, 2 * r))
+}
+
 pub struct Config {
     /// Timed runs per measurement (after one warm-up); medians reported.
     pub runs: usize,
@@ -253,7 +260,8 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
     if !refused.is_empty() {
         table.note(format!("Refused as operands, so not measured: {}.", refused.join("; ")));
     }
-    let mut tables = vec![table];
+    // No pairs (only the scaling series asked for): no empty Table 6-1.
+    let mut tables = if pairs.is_empty() { Vec::new() } else { vec![table] };
     if !cfg.scaling.is_empty() {
         let mut scaling = Table::new(
             "Growth with size: sphere − turned copy (ms)",
@@ -273,10 +281,7 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         // (triangles, phase 1 s, phase 2 s) per size, for the growth exponents.
         let mut growth: Vec<(f64, f64, f64)> = Vec::new();
         for &n in &cfg.scaling {
-            // n triangles for both; a UV sphere with r rings and 2r segments has about 4r².
-            let r = ((n as f64 / 8.0).sqrt().round() as usize).max(3);
-            let pair =
-                Pair::with_turned_copy("–", format!("sphere {r}×{}", 2 * r), procedural::sphere(r, 2 * r))?;
+            let pair = scaling_pair(n)?;
             let (p1, p2, asm, ev) =
                 measure(&pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs)?;
             let total = p1.median() + p2.median() + asm[2].median();
