@@ -323,7 +323,7 @@ impl Evaluation {
             .map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
         let from_a = done.origin.iter().filter(|&&o| (o as usize) < from_a).count();
         let repair = Repair { moved: self.frame.length_out(done.repair.moved), ..done.repair };
-        Ok(Output { mesh: select::assemble(&r.points, &done.triangles), from_a, repair })
+        Ok(Output { mesh: select::assemble(&done.positions, &done.triangles), from_a, repair })
     }
 
     /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its

@@ -32,7 +32,11 @@
 //! removed by splitting its neighbour across that edge at the corner. A collapse keeps every directed edge balanced — the triangles on the
 //! edge vanish and their other edges pair up — so the result stays closed and oriented;
 //! two triangles that come to coincide with opposite orientations cancel. The moved
-//! triangles are checked again, for a few rounds. A shell that encloses no volume by the
+//! triangles are checked again, for a few rounds. A crossing that none of this removes
+//! (rounding put it there by an ulp) goes by moving one of the intersection points among
+//! its triangles' corners to a neighbouring f64 position, each coordinate by an ulp or two,
+//! where the exact tests around that point find nothing crossing ([`nudge`]); then
+//! everything is checked again. A shell that encloses no volume by the
 //! operand rule (a sliver flattened by rounding) is dropped whole. Anything still
 //! invalid is an error naming the faces and the place: never a silently invalid result.
 
@@ -84,6 +88,9 @@ pub struct Repair {
     /// Points snapped onto a point a few ulps away (the corners of crossing or flat
     /// triangles: nearly coincident points of the two operands and the cut).
     pub snapped: usize,
+    /// Intersection points moved to a neighbouring f64 position (each coordinate by an ulp
+    /// or two) where a crossing remained that no snap or collapse removed.
+    pub ulp_moves: usize,
     /// Edges collapsed.
     pub collapsed_edges: usize,
     /// Triangles removed by the snaps and collapses (those left without area, pairs that
@@ -120,12 +127,13 @@ impl std::fmt::Display for Repair {
         write!(
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
-             {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
+             {} points moved by an ulp or two, {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
              ({} triangles rebuilt), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
             self.snapped,
+            self.ulp_moves,
             self.collapsed_edges,
             self.removed_triangles,
             self.moved,
@@ -173,6 +181,8 @@ impl InvalidResult {
 /// was done.
 #[derive(Clone, Debug)]
 pub struct Finished {
+    /// The points, as given except those moved by an ulp or two ([`Repair::ulp_moves`]).
+    pub positions: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
     pub origin: Vec<u32>,
     pub repair: Repair,
@@ -190,7 +200,12 @@ pub fn finish(
 ) -> Result<Finished, InvalidResult> {
     let mut repair = Repair::default();
     if tris.is_empty() {
-        return Ok(Finished { triangles: Vec::new(), origin: Vec::new(), repair });
+        return Ok(Finished {
+            positions: points.to_vec(),
+            triangles: Vec::new(),
+            origin: Vec::new(),
+            repair,
+        });
     }
     // Points are identified by position, as when the file is read back.
     let weld = weld_by_position(points);
@@ -210,7 +225,9 @@ pub fn finish(
     let snap = snap_distance(max_abs);
     // Welding is a collapse of edges of length zero: the same clean-up.
     collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), &mut repair);
-    for round in 0..=ROUNDS {
+    // Rounds of ulp moves, once nothing else applies (each moves at least one point).
+    let mut nudges = 0;
+    for round in 0.. {
         let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
         let flat: Vec<usize> = (0..soup.triangles.len())
             .into_par_iter()
@@ -253,7 +270,7 @@ pub fn finish(
                     } else {
                         (p.min(q), p.max(q))
                     };
-                    (points[p as usize].distance(points[q as usize]), keep, gone)
+                    (soup.positions[p as usize].distance(soup.positions[q as usize]), keep, gone)
                 })
                 .filter(|e| e.0 <= limit)
                 .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
@@ -334,10 +351,14 @@ pub fn finish(
                 continue;
             }
         }
-        if round == ROUNDS || edges.is_empty() {
-            return Err(stuck
-                .or_else(|| crossings.first().map(crossing))
-                .unwrap_or_else(|| flat_face(&flat[0])));
+        if round >= ROUNDS || edges.is_empty() {
+            let err =
+                stuck.or_else(|| crossings.first().map(crossing)).unwrap_or_else(|| flat_face(&flat[0]));
+            if nudges < ROUNDS && nudge(&mut soup, &crossings, &flat, first_new, &mut repair) {
+                nudges += 1;
+                continue;
+            }
+            return Err(err);
         }
         // Shortest first; each point takes part in one collapse per round, and goes
         // the way (onto either end when both are intersection points) after which the
@@ -369,9 +390,13 @@ pub fn finish(
             repair.moved = repair.moved.max(length);
         }
         if map.is_empty() {
-            return Err(stuck
-                .or_else(|| crossings.first().map(crossing))
-                .unwrap_or_else(|| flat_face(&flat[0])));
+            let err =
+                stuck.or_else(|| crossings.first().map(crossing)).unwrap_or_else(|| flat_face(&flat[0]));
+            if nudges < ROUNDS && nudge(&mut soup, &crossings, &flat, first_new, &mut repair) {
+                nudges += 1;
+                continue;
+            }
+            return Err(err);
         }
         collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
     }
@@ -383,7 +408,7 @@ pub fn finish(
         origin = order.iter().map(|&k| origin[k]).collect();
     }
     drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
-    Ok(Finished { triangles: soup.triangles, origin, repair })
+    Ok(Finished { positions: soup.positions, triangles: soup.triangles, origin, repair })
 }
 
 /// The snaps for the corners of `faces`: every point of the soup within `snap` (per
@@ -596,6 +621,28 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
         (lo.min(boxes[t].0), hi.max(boxes[t].1))
     });
     // The collapse moves the triangles at `gone` towards `keep`, inside this box.
+    let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
+    let count = |sub: &TriangleSoup, at: &[u32]| {
+        let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
+        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
+        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
+    };
+    let (k, g) = (ids[&keep], ids[&gone]);
+    let before = count(&sub, &[g, k]);
+    let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
+    let mut changed = vec![true; sub.triangles.len()];
+    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), &mut Repair::default());
+    (before, count(&sub, &[k]))
+}
+
+/// The triangles of `soup` whose boxes meet the box `lo`..`hi`, as a soup of their own
+/// (triangle k of it is `local[k]`), and the ids of their corners in it.
+fn sub_soup(
+    soup: &TriangleSoup,
+    boxes: &[(DVec3, DVec3)],
+    lo: DVec3,
+    hi: DVec3,
+) -> (TriangleSoup, HashMap<u32, u32>) {
     let local: Vec<usize> = (0..soup.triangles.len())
         .filter(|&t| boxes[t].0.cmple(hi).all() && lo.cmple(boxes[t].1).all())
         .collect();
@@ -615,17 +662,140 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
         });
         sub.triangles.push(tri);
     }
-    let count = |sub: &TriangleSoup, at: &[u32]| {
-        let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
-        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
-        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
-    };
-    let (k, g) = (ids[&keep], ids[&gone]);
-    let before = count(&sub, &[g, k]);
-    let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
-    let mut changed = vec![true; sub.triangles.len()];
-    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), &mut Repair::default());
-    (before, count(&sub, &[k]))
+    (sub, ids)
+}
+
+/// `x` moved by `k` ulps (up for k > 0), across zero as well.
+fn step_ulps(x: f64, k: i64) -> f64 {
+    // f64s in order as integers: the bits of a positive one, minus those of a negative one.
+    let bits = x.to_bits() as i64;
+    let ordinal = (if bits < 0 { -(bits & i64::MAX) } else { bits }) + k;
+    if ordinal < 0 {
+        f64::from_bits(ordinal.unsigned_abs() | (1 << 63))
+    } else {
+        f64::from_bits(ordinal as u64)
+    }
+}
+
+/// The f64 positions around `p`, nearest first: each coordinate moved by up to one ulp
+/// (26 positions), then by up to two (98 more).
+fn neighbour_positions(p: DVec3) -> Vec<DVec3> {
+    let mut steps: Vec<[i64; 3]> = Vec::with_capacity(124);
+    for i in -2..=2i64 {
+        for j in -2..=2i64 {
+            for k in -2..=2i64 {
+                if (i, j, k) != (0, 0, 0) {
+                    steps.push([i, j, k]);
+                }
+            }
+        }
+    }
+    let reach = |s: &[i64; 3]| s.iter().map(|d| d.abs()).max().unwrap_or(0);
+    let size = |s: &[i64; 3]| s.iter().map(|d| d.abs()).sum::<i64>();
+    steps.sort_by_key(|s| (reach(s), size(s), *s));
+    steps
+        .into_iter()
+        .map(|[i, j, k]| DVec3::new(step_ulps(p.x, i), step_ulps(p.y, j), step_ulps(p.z, k)))
+        .collect()
+}
+
+/// The last resort for crossings (and triangles without area) that no snap or collapse
+/// removed: rounding put them there by an ulp, so one of the intersection points among
+/// their corners (ids from `first_new` on) goes to a neighbouring f64 position
+/// ([`neighbour_positions`], nearest first) — the first one after which, by the exact
+/// tests over the triangles at that point against those whose boxes meet theirs, no
+/// triangle there crosses another or has no area; failing that, the first one after which
+/// fewer do and none that did not before. Never onto another point's position (the file
+/// read back would make them one). The topology does not change, so the result stays
+/// closed and oriented. True when a point moved (the caller checks everything again).
+fn nudge(
+    soup: &mut TriangleSoup,
+    crossings: &[(usize, usize)],
+    flat: &[usize],
+    first_new: u32,
+    repair: &mut Repair,
+) -> bool {
+    let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
+    let mut star: HashMap<u32, Vec<usize>> = HashMap::new();
+    let mut taken = std::collections::HashSet::new();
+    for (t, tri) in soup.triangles.iter().enumerate() {
+        for &v in tri {
+            star.entry(v).or_default().push(t);
+            taken.insert(key(soup.positions[v as usize]));
+        }
+    }
+    let mut boxes = soup.boxes();
+    let mut moved = std::collections::HashSet::new();
+    let defects = crossings.iter().map(|&(a, b)| vec![a, b]).chain(flat.iter().map(|&f| vec![f]));
+    for faces in defects {
+        let mut corners: Vec<u32> =
+            faces.iter().flat_map(|&f| soup.triangles[f]).filter(|&v| v >= first_new).collect();
+        corners.sort_unstable();
+        corners.dedup();
+        for v in corners {
+            if moved.contains(&v) {
+                continue;
+            }
+            let p = soup.positions[v as usize];
+            let around = &star[&v];
+            // Every candidate lies within two ulps per coordinate.
+            let reach = |k: i64| DVec3::new(step_ulps(p.x, k), step_ulps(p.y, k), step_ulps(p.z, k));
+            let (lo, hi) = around
+                .iter()
+                .fold((reach(-2), reach(2)), |(lo, hi), &t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
+            let (mut sub, ids) = sub_soup(soup, &boxes, lo, hi);
+            let at = ids[&v];
+            let near: Vec<bool> = sub.triangles.iter().map(|t| t.contains(&at)).collect();
+            let defects = |sub: &TriangleSoup| {
+                let mut found: Vec<(usize, usize)> = soup_self_intersections_near(sub, &near, usize::MAX);
+                found.extend(
+                    (0..sub.triangles.len())
+                        .filter(|&t| near[t] && is_degenerate(sub.triangle(t)))
+                        .map(|t| (t, t)),
+                );
+                found.sort_unstable();
+                found
+            };
+            let before = defects(&sub);
+            if before.is_empty() {
+                continue; // an earlier move here removed them
+            }
+            let mut fewer = None;
+            let mut clean = None;
+            for q in neighbour_positions(p) {
+                if taken.contains(&key(q)) {
+                    continue;
+                }
+                sub.positions[at as usize] = q;
+                let after = defects(&sub);
+                if after.is_empty() {
+                    clean = Some(q);
+                    break;
+                }
+                if fewer.is_none()
+                    && after.len() < before.len()
+                    && after.iter().all(|d| before.binary_search(d).is_ok())
+                {
+                    fewer = Some(q);
+                }
+            }
+            let Some(q) = clean.or(fewer) else { continue };
+            taken.remove(&key(p));
+            taken.insert(key(q));
+            soup.positions[v as usize] = q;
+            for &t in around {
+                let [a, b, c] = soup.triangle(t);
+                boxes[t] = (a.min(b).min(c), a.max(b).max(c));
+            }
+            moved.insert(v);
+            repair.ulp_moves += 1;
+            repair.moved = repair.moved.max(p.distance(q));
+            if clean.is_some() {
+                break;
+            }
+        }
+    }
+    !moved.is_empty()
 }
 
 /// Applies `map` (point → the point it collapses onto) to every triangle, removes the
