@@ -28,6 +28,14 @@
 //! from an octree over the triangles and their edges that leaves out pairs which cannot
 //! count ([`super::crosstree`]). Restricted to marked triangles, they are the marked
 //! triangles' boxes against all others in the grid.
+//!
+//! Big strictly convex faces (a cone's or a cylinder's one-polygon base) are first
+//! triangulated with short chords ([`triangulate::convex_short_chords`]): a Delaunay
+//! triangulation of corners on a circle draws chords across the whole face, which the
+//! octree must then follow through every cell on their way. Whether faces cross does not
+//! depend on how such a face is tiled (see [`short_chord_soup`]), so a mesh found clean
+//! that way is clean; one that does cross is answered again from the triangles every
+//! command sees, because which crossing comes first may depend on the tiling.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -187,10 +195,18 @@ impl TriangleSoup {
     /// `positions`, after the mesh's vertices, in face order), any other polygon in its
     /// plane ([`triangulate::polygon`]).
     pub fn new(mesh: &Mesh) -> TriangleSoup {
+        Self::build(mesh, false).0
+    }
+
+    /// [`TriangleSoup::new`], or with `short_chords` every strictly convex face of at least
+    /// [`SHORT_CHORDS_FROM`] corners triangulated by [`triangulate::convex_short_chords`]
+    /// instead; also which faces were, and the weld ([`weld_by_position`]).
+    fn build(mesh: &Mesh, short_chords: bool) -> (TriangleSoup, Vec<bool>, Vec<u32>) {
         // A triangle face needs no allocation.
         enum Tess {
             One([u32; 3]),
             Many(Vec<[u32; 3]>),
+            Short(Vec<[u32; 3]>),
             Fan(DVec3),
             Failed(TriangulateError),
         }
@@ -201,6 +217,12 @@ impl TriangleSoup {
                 let face = mesh.face(f);
                 if face.len() == 3 {
                     return Tess::One([face[0], face[1], face[2]]);
+                }
+                if short_chords && face.len() >= SHORT_CHORDS_FROM {
+                    let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
+                    if let Some(tris) = triangulate::convex_short_chords(&corners) {
+                        return Tess::Short(tris.into_iter().map(|t| t.map(|k| face[k as usize])).collect());
+                    }
                 }
                 if let Some(c) = triangulate::fan_centre(mesh.positions(), face) {
                     return Tess::Fan(c);
@@ -217,6 +239,7 @@ impl TriangleSoup {
                 }
             })
             .collect();
+        let short: Vec<bool> = per_face.iter().map(|r| matches!(r, Tess::Short(_))).collect();
         let mut positions = mesh.positions().to_vec();
         positions.extend(per_face.iter().filter_map(|r| if let Tess::Fan(c) = r { Some(*c) } else { None }));
         let weld = weld_by_position(&positions);
@@ -234,7 +257,7 @@ impl TriangleSoup {
             };
             match r {
                 Tess::One(t) => push(t),
-                Tess::Many(tris) => tris.into_iter().for_each(push),
+                Tess::Many(tris) | Tess::Short(tris) => tris.into_iter().for_each(push),
                 Tess::Fan(_) => {
                     let face = mesh.face(f);
                     for (i, &v) in face.iter().enumerate() {
@@ -245,7 +268,7 @@ impl TriangleSoup {
                 Tess::Failed(e) => soup.failed.push((f as u32, e)),
             }
         }
-        soup
+        (soup, short, weld)
     }
 
     /// The same surface without its triangles of no area (exactly collinear or coinciding
@@ -458,7 +481,78 @@ fn split_at_t_junctions(soup: &TriangleSoup) -> Option<TriangleSoup> {
 /// reported as `(f, f)`. Faces with no area (exactly collinear corners) are skipped:
 /// [`super::validate::Report::degenerate_faces`] counts them.
 pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
+    if let Some(soup) = short_chord_soup(mesh) {
+        if soup_self_intersections(&soup, limit).is_empty() {
+            return Vec::new();
+        }
+    }
     soup_self_intersections(&TriangleSoup::new(mesh), limit)
+}
+
+/// Faces with fewer corners have few chords however they are triangulated.
+const SHORT_CHORDS_FROM: usize = 16;
+
+/// The faces of `mesh` as triangles ([`TriangleSoup::build`]) with every strictly convex
+/// face of [`SHORT_CHORDS_FROM`] corners or more tiled with short chords, when that tiling
+/// finds a crossing exactly when the tiling every command sees does: no triangle is
+/// without area (nothing to split at T-junctions), and each such face F shares with every
+/// other face G at most one corner, or the two ends of a side of F that is also a side of
+/// G where G is such a face too. `None` otherwise, or when no face is such.
+///
+/// Why: F is a convex region R tiled by triangles whose corners are F's corners. A corner
+/// of F, an extreme point of R, lies in a triangle of F only as its corner; a point inside
+/// a side of F lies only in the triangle on that side. Let a triangle t of F and u of
+/// another face meet at x beyond their common corners (or coincide, which needs three
+/// common corners). With the corners common to F and u at most one corner or a side's
+/// two ends, x is then none of them and not inside that side (else t would have them as
+/// corners too), so x ∈ R ∩ u lies beyond what F and u share, and the triangle of any
+/// other tiling of R that holds x meets u beyond their common corners. Two such faces:
+/// the same, from both sides. Triangles of other faces are the same in both soups.
+fn short_chord_soup(mesh: &Mesh) -> Option<TriangleSoup> {
+    if !mesh.faces().any(|f| f.len() >= SHORT_CHORDS_FROM) {
+        return None;
+    }
+    let (soup, short, weld) = TriangleSoup::build(mesh, true);
+    if !short.contains(&true) {
+        return None;
+    }
+    let n = soup.triangles.len();
+    if (0..n).into_par_iter().with_min_len(4096).any(|t| is_degenerate(soup.triangle(t))) {
+        return None;
+    }
+    // (welded corner, face, position in the face) for the short-chord faces' corners.
+    let mut corners: Vec<(u32, u32, u32)> = Vec::new();
+    for (f, _) in short.iter().enumerate().filter(|(_, s)| **s) {
+        corners.extend(mesh.face(f).iter().enumerate().map(|(k, &v)| (weld[v as usize], f as u32, k as u32)));
+    }
+    corners.sort_unstable();
+    let (mut vertices, mut common) = (Vec::new(), Vec::new());
+    // A face's triangles are consecutive in the soup.
+    let mut start = 0;
+    for run in soup.face_of.chunk_by(|a, b| a == b) {
+        let (g, triangles) = (run[0], &soup.triangles[start..start + run.len()]);
+        start += run.len();
+        vertices.clear();
+        vertices.extend(triangles.iter().flatten().copied());
+        vertices.sort_unstable();
+        vertices.dedup();
+        common.clear();
+        for &w in &vertices {
+            let from = corners.partition_point(|c| c.0 < w);
+            common.extend(
+                corners[from..].iter().take_while(|c| c.0 == w).filter(|c| c.1 != g).map(|c| (c.1, c.2)),
+            );
+        }
+        common.sort_unstable();
+        for shared in common.chunk_by(|a, b| a.0 == b.0) {
+            let sides = mesh.face(shared[0].0 as usize).len() as u32;
+            let side = |a: u32, b: u32| b - a == 1 || b - a == sides - 1;
+            if shared.len() > 2 || (shared.len() == 2 && !side(shared[0].1, shared[1].1)) {
+                return None;
+            }
+        }
+    }
+    Some(soup)
 }
 
 /// [`self_intersections`] of a mesh already tessellated (`soup.face_of` names the faces).
@@ -742,6 +836,59 @@ mod tests {
                 assert!(!expected.is_empty(), "mesh {i} has no crossing to find");
             }
         }
+    }
+
+    #[test]
+    fn short_chords_change_no_answer() {
+        use super::super::procedural::cone;
+        // A cone over one 40-gon: faces 0..40 the sides, 40 the base; vertices 0..40 the
+        // base's corners, 40 the apex, then the extra ones.
+        let (n, base) = (40u32, 40usize);
+        let with = |extra: &[DVec3], faces: &[[u32; 3]]| {
+            let c = cone(n);
+            let mut positions = c.positions().to_vec();
+            positions.extend_from_slice(extra);
+            let all = c.faces().map(<[u32]>::to_vec).chain(faces.iter().map(|f| f.to_vec())).collect();
+            Mesh::new(positions, all).unwrap_or_else(|e| panic!("{e}"))
+        };
+        let k = n + 1;
+        assert!(short_chord_soup(&cone(n)).is_some());
+        assert_eq!(self_intersections(&cone(n), 10), vec![]);
+        // A triangle through the base's interior, below the sides.
+        let pierced = with(&[v(0.3, 0.2, -0.5), v(0.35, 0.2, 0.5), v(0.3, 0.3, 0.5)], &[[k, k + 1, k + 2]]);
+        assert!(short_chord_soup(&pierced).is_some());
+        assert_eq!(self_intersections(&pierced, 10), vec![(base, base + 1)]);
+        // A triangle through the fan of sides and the base: the same face pairs, in the
+        // same order, as testing every pair of the triangles every command sees.
+        let through = with(&[v(0.2, 0.1, -0.5), v(0.25, 0.1, 1.5), v(0.9, -0.6, 0.7)], &[[k, k + 1, k + 2]]);
+        let expected = all_pairs(&through);
+        assert!(expected.len() > 2 && expected.iter().all(|&(_, g)| g == base + 1), "{expected:?}");
+        assert_eq!(self_intersections(&through, usize::MAX), expected);
+        assert_eq!(self_intersections(&through, 1), expected[..1]);
+        // A triangle hanging below the base from one of its diagonals touches it only
+        // along that diagonal in a tiling that has it as a chord, and crosses the
+        // triangles it passes through in one that does not: such a face is tiled as every
+        // command tiles it. Without that rule some diagonal would be missed.
+        let mut missed = 0;
+        for i in 0..n {
+            for j in i + 2..n {
+                if j - i == n - 1 {
+                    continue;
+                }
+                let m = with(&[v(0.0, 0.0, -1.0)], &[[i, j, k]]);
+                assert!(short_chord_soup(&m).is_none());
+                let expected = all_pairs(&m);
+                assert_eq!(self_intersections(&m, 10), expected, "diagonal {i}–{j}");
+                let short = TriangleSoup::build(&m, true).0;
+                missed += usize::from(!expected.is_empty() && soup_self_intersections(&short, 10).is_empty());
+            }
+        }
+        assert!(missed > 0);
+        // A face without area (three corners on a line) anywhere: the tiling every command
+        // sees, whose triangles are split at T-junctions.
+        let plugged = with(&[v(2.0, 0.0, 0.0), v(3.0, 0.0, 0.0), v(4.0, 0.0, 0.0)], &[[k, k + 1, k + 2]]);
+        assert!(short_chord_soup(&plugged).is_none());
+        assert_eq!(self_intersections(&plugged, 10), all_pairs(&plugged));
     }
 
     #[test]

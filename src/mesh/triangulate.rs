@@ -137,6 +137,45 @@ pub fn polygon_or_fan(corners: &[DVec3]) -> Vec<[u32; 3]> {
     polygon(corners).unwrap_or_else(|_| fan())
 }
 
+/// Triangles with short chords for a polygon whose corners lie exactly in one plane and
+/// turn strictly left all the way round, once (a strictly convex face; the outline's edges
+/// change the sign of their first projected coordinate exactly twice): the triangle of
+/// three corners a third of the way apart, then over each arc's chord the triangle to the
+/// arc's middle corner. Chords are short where the outline is dense, about the perimeter
+/// times log n in all, where a fan or a Delaunay triangulation of corners on a circle
+/// draws chords across the whole face. Oriented like the face, none without area (no three
+/// corners of a strictly convex polygon are collinear). `None` for any other polygon.
+pub fn convex_short_chords(corners: &[DVec3]) -> Option<Vec<[u32; 3]>> {
+    let n = corners.len();
+    if n < 4 || !is_planar(corners) {
+        return None;
+    }
+    let proj = Projection::along(newell_normal(corners.iter().copied()))?;
+    let p: Vec<DVec2> = corners.iter().map(|&c| proj.apply(c)).collect();
+    if !(0..n).all(|i| orient2d(p[i], p[(i + 1) % n], p[(i + 2) % n]) > 0) {
+        return None;
+    }
+    // Left turns only: the outline is simple (not a star wound twice) iff its direction
+    // turns round once. A difference of f64 has the exact difference's sign.
+    let signs: Vec<bool> =
+        (0..n).map(|i| p[(i + 1) % n].x - p[i].x).filter(|&d| d != 0.0).map(|d| d > 0.0).collect();
+    let changes = (0..signs.len()).filter(|&i| signs[i] != signs[(i + 1) % signs.len()]).count();
+    if changes != 2 {
+        return None;
+    }
+    let (b, c) = (n / 3, 2 * n / 3);
+    let mut triangles = vec![[0, b as u32, c as u32]];
+    let mut arcs = vec![(0, b), (b, c), (c, n)];
+    while let Some((i, j)) = arcs.pop() {
+        if j - i >= 2 {
+            let m = (i + j) / 2;
+            triangles.push([i as u32, m as u32, (j % n) as u32]);
+            arcs.extend([(i, m), (m, j)]);
+        }
+    }
+    Some(triangles)
+}
+
 /// The corners lie in one plane, decided exactly: every corner is coplanar (`orient3d`)
 /// with three of them that are not collinear. Corners that are all collinear count as
 /// planar (they have no area to place anywhere).
@@ -338,6 +377,70 @@ mod tests {
                 0.5 * (b - a).cross(c - a)
             })
             .sum()
+    }
+
+    #[test]
+    fn short_chords_tile_strictly_convex_faces_only() {
+        let circle = |n: usize, z: f64| -> Vec<DVec3> {
+            (0..n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / n as f64;
+                    DVec3::new(a.cos(), a.sin(), z)
+                })
+                .collect()
+        };
+        for n in [4, 5, 7, 16, 100, 1000] {
+            let p = circle(n, 0.5);
+            let tris = convex_short_chords(&p).unwrap_or_else(|| panic!("{n}-gon"));
+            assert_eq!(tris.len(), n - 2);
+            // Every triangle turns like the face: same orientation, and together they
+            // cover its area exactly once (up to rounding).
+            assert!(tris.iter().all(|t| {
+                let [a, b, c] = t.map(|i| p[i as usize]);
+                (b - a).cross(c - a).z > 0.0
+            }));
+            let whole = area(&p, &(1..n as u32 - 1).map(|i| [0, i, i + 1]).collect::<Vec<_>>());
+            assert!((area(&p, &tris) - whole).length() <= 1e-12 * whole.length());
+            // Each edge of the outline in one triangle, each chord in two: a tiling.
+            let mut edges = std::collections::HashMap::new();
+            for t in &tris {
+                for k in 0..3 {
+                    let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                    *edges.entry((a, b)).or_insert(0) += 1;
+                }
+            }
+            assert!(
+                edges
+                    .iter()
+                    .all(|(&(a, b), &c)| c == if b - a == 1 || b - a == n as u32 - 1 { 1 } else { 2 })
+            );
+            // Short chords: far less in all than the fan's n − 3 chords of length up to 2.
+            let chords: f64 = edges
+                .keys()
+                .filter(|(a, b)| b - a != 1 && b - a != n as u32 - 1)
+                .map(|&(a, b)| p[a as usize].distance(p[b as usize]))
+                .sum();
+            assert!(chords <= 2.0 * std::f64::consts::TAU * (n as f64).log2(), "{n}: {chords}");
+        }
+        // Not planar, a corner turning right, three corners on a line, a star (all left
+        // turns, wound twice), reversed corners: none.
+        let mut bent = circle(8, 0.0);
+        bent[3].z = 1e-9;
+        assert!(convex_short_chords(&bent).is_none());
+        let mut dented = circle(8, 0.0);
+        dented[3] *= 0.5;
+        assert!(convex_short_chords(&dented).is_none());
+        let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let mut straight = square.to_vec();
+        straight.insert(1, (square[0] + square[1]) * 0.5);
+        assert!(convex_short_chords(&square).is_some());
+        assert!(convex_short_chords(&straight).is_none());
+        let ring = circle(5, 0.0);
+        let star: Vec<DVec3> = (0..5).map(|i| ring[i * 2 % 5]).collect();
+        assert!(convex_short_chords(&star).is_none());
+        let reversed: Vec<DVec3> = ring.iter().rev().copied().collect();
+        assert!(convex_short_chords(&reversed).is_some());
+        assert!(convex_short_chords(&ring[..3]).is_none());
     }
 
     #[test]
