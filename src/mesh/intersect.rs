@@ -29,13 +29,14 @@
 //! count ([`super::crosstree`]). Restricted to marked triangles, they are the marked
 //! triangles' boxes against all others in the grid.
 //!
-//! Big strictly convex faces (a cone's or a cylinder's one-polygon base) are first
-//! triangulated with short chords ([`triangulate::convex_short_chords`]): a Delaunay
-//! triangulation of corners on a circle draws chords across the whole face, which the
-//! octree must then follow through every cell on their way. Whether faces cross does not
-//! depend on how such a face is tiled (see [`short_chord_soup`]), so a mesh found clean
-//! that way is clean; one that does cross is answered again from the triangles every
-//! command sees, because which crossing comes first may depend on the tiling.
+//! Big strictly convex faces (a cone's or a cylinder's one-polygon base) are first tiled
+//! for the search alone ([`triangulate::convex_tiling`]: a fan from a point inside, or
+//! short chords): a Delaunay triangulation of corners on a circle draws long triangles
+//! across the whole face, which the octree must follow through every cell on their way.
+//! Whether faces cross does not depend on how such a face is tiled (see
+//! [`search_soup`]), so a mesh found clean that way is clean; one that does cross is
+//! answered again from the triangles every command sees, because which crossing comes
+//! first may depend on the tiling.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -43,7 +44,7 @@ use rayon::prelude::*;
 use super::Mesh;
 use super::boxgrid::{box_pairs, box_pairs_within};
 use super::crosstree::candidate_pairs;
-use super::triangulate::{self, Projection, TriangulateError};
+use super::triangulate::{self, ConvexTiling, Projection, TriangulateError};
 use crate::exact::{Sign, orient2d, orient2d_approx, orient3d};
 
 /// An exact projection for the plane of triangle (a, b, c): along the axis where its
@@ -198,16 +199,18 @@ impl TriangleSoup {
         Self::build(mesh, false).0
     }
 
-    /// [`TriangleSoup::new`], or with `short_chords` every strictly convex face of at least
-    /// [`SHORT_CHORDS_FROM`] corners triangulated by [`triangulate::convex_short_chords`]
-    /// instead; also which faces were, and the weld ([`weld_by_position`]).
-    fn build(mesh: &Mesh, short_chords: bool) -> (TriangleSoup, Vec<bool>, Vec<u32>) {
+    /// [`TriangleSoup::new`], or with `for_search` every strictly convex face of at least
+    /// [`SEARCH_TILING_FROM`] corners tiled by [`triangulate::convex_tiling`] instead
+    /// (its centre, if any, added like a non-planar face's); also which faces were, and
+    /// the weld ([`weld_by_position`]).
+    fn build(mesh: &Mesh, for_search: bool) -> (TriangleSoup, Vec<bool>, Vec<u32>) {
         // A triangle face needs no allocation.
         enum Tess {
             One([u32; 3]),
             Many(Vec<[u32; 3]>),
             Short(Vec<[u32; 3]>),
             Fan(DVec3),
+            ShortFan(DVec3),
             Failed(TriangulateError),
         }
         let per_face: Vec<Tess> = (0..mesh.num_faces())
@@ -218,10 +221,16 @@ impl TriangleSoup {
                 if face.len() == 3 {
                     return Tess::One([face[0], face[1], face[2]]);
                 }
-                if short_chords && face.len() >= SHORT_CHORDS_FROM {
+                if for_search && face.len() >= SEARCH_TILING_FROM {
                     let corners: Vec<DVec3> = face.iter().map(|&v| mesh.positions()[v as usize]).collect();
-                    if let Some(tris) = triangulate::convex_short_chords(&corners) {
-                        return Tess::Short(tris.into_iter().map(|t| t.map(|k| face[k as usize])).collect());
+                    match triangulate::convex_tiling(&corners) {
+                        Some(ConvexTiling::Centre(c)) => return Tess::ShortFan(c),
+                        Some(ConvexTiling::Corners(tris)) => {
+                            return Tess::Short(
+                                tris.into_iter().map(|t| t.map(|k| face[k as usize])).collect(),
+                            );
+                        }
+                        None => {}
                     }
                 }
                 if let Some(c) = triangulate::fan_centre(mesh.positions(), face) {
@@ -239,9 +248,13 @@ impl TriangleSoup {
                 }
             })
             .collect();
-        let short: Vec<bool> = per_face.iter().map(|r| matches!(r, Tess::Short(_))).collect();
+        let short: Vec<bool> =
+            per_face.iter().map(|r| matches!(r, Tess::Short(_) | Tess::ShortFan(_))).collect();
         let mut positions = mesh.positions().to_vec();
-        positions.extend(per_face.iter().filter_map(|r| if let Tess::Fan(c) = r { Some(*c) } else { None }));
+        positions.extend(per_face.iter().filter_map(|r| match r {
+            Tess::Fan(c) | Tess::ShortFan(c) => Some(*c),
+            _ => None,
+        }));
         let weld = weld_by_position(&positions);
         let mut soup = TriangleSoup {
             triangles: Vec::with_capacity(mesh.num_faces()),
@@ -258,7 +271,7 @@ impl TriangleSoup {
             match r {
                 Tess::One(t) => push(t),
                 Tess::Many(tris) | Tess::Short(tris) => tris.into_iter().for_each(push),
-                Tess::Fan(_) => {
+                Tess::Fan(_) | Tess::ShortFan(_) => {
                     let face = mesh.face(f);
                     for (i, &v) in face.iter().enumerate() {
                         push([next_centre, v, face[(i + 1) % face.len()]]);
@@ -481,7 +494,7 @@ fn split_at_t_junctions(soup: &TriangleSoup) -> Option<TriangleSoup> {
 /// reported as `(f, f)`. Faces with no area (exactly collinear corners) are skipped:
 /// [`super::validate::Report::degenerate_faces`] counts them.
 pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
-    if let Some(soup) = short_chord_soup(mesh) {
+    if let Some(soup) = search_soup(mesh) {
         if soup_self_intersections(&soup, limit).is_empty() {
             return Vec::new();
         }
@@ -490,16 +503,18 @@ pub fn self_intersections(mesh: &Mesh, limit: usize) -> Vec<(usize, usize)> {
 }
 
 /// Faces with fewer corners have few chords however they are triangulated.
-const SHORT_CHORDS_FROM: usize = 16;
+const SEARCH_TILING_FROM: usize = 16;
 
 /// The faces of `mesh` as triangles ([`TriangleSoup::build`]) with every strictly convex
-/// face of [`SHORT_CHORDS_FROM`] corners or more tiled with short chords, when that tiling
+/// face of [`SEARCH_TILING_FROM`] corners or more tiled for the search, when that tiling
 /// finds a crossing exactly when the tiling every command sees does: no triangle is
-/// without area (nothing to split at T-junctions), and each such face F shares with every
-/// other face G at most one corner, or the two ends of a side of F that is also a side of
-/// G where G is such a face too. `None` otherwise, or when no face is such.
+/// without area (nothing to split at T-junctions), no centre of a fan is at any other
+/// vertex, and each such face F shares with every other face G at most one corner, or
+/// the two ends of a side of F that is also a side of G where G is such a face too.
+/// `None` otherwise, or when no face is such.
 ///
-/// Why: F is a convex region R tiled by triangles whose corners are F's corners. A corner
+/// Why: F is a convex region R tiled by triangles whose corners are F's corners and at
+/// most a point inside R that no other face has. A corner
 /// of F, an extreme point of R, lies in a triangle of F only as its corner; a point inside
 /// a side of F lies only in the triangle on that side. Let a triangle t of F and u of
 /// another face meet at x beyond their common corners (or coincide, which needs three
@@ -508,8 +523,8 @@ const SHORT_CHORDS_FROM: usize = 16;
 /// corners too), so x ∈ R ∩ u lies beyond what F and u share, and the triangle of any
 /// other tiling of R that holds x meets u beyond their common corners. Two such faces:
 /// the same, from both sides. Triangles of other faces are the same in both soups.
-fn short_chord_soup(mesh: &Mesh) -> Option<TriangleSoup> {
-    if !mesh.faces().any(|f| f.len() >= SHORT_CHORDS_FROM) {
+fn search_soup(mesh: &Mesh) -> Option<TriangleSoup> {
+    if !mesh.faces().any(|f| f.len() >= SEARCH_TILING_FROM) {
         return None;
     }
     let (soup, short, weld) = TriangleSoup::build(mesh, true);
@@ -518,6 +533,12 @@ fn short_chord_soup(mesh: &Mesh) -> Option<TriangleSoup> {
     }
     let n = soup.triangles.len();
     if (0..n).into_par_iter().with_min_len(4096).any(|t| is_degenerate(soup.triangle(t))) {
+        return None;
+    }
+    // Fan centres (added after the mesh's vertices) welded to nothing else.
+    let mut welded = vec![0u32; weld.len()];
+    weld.iter().for_each(|&w| welded[w as usize] += 1);
+    if (mesh.num_vertices()..weld.len()).any(|c| weld[c] as usize != c || welded[c] != 1) {
         return None;
     }
     // (welded corner, face, position in the face) for the short-chord faces' corners.
@@ -839,34 +860,42 @@ mod tests {
     }
 
     #[test]
-    fn short_chords_change_no_answer() {
+    fn search_tiling_changes_no_answer() {
         use super::super::procedural::cone;
-        // A cone over one 40-gon: faces 0..40 the sides, 40 the base; vertices 0..40 the
-        // base's corners, 40 the apex, then the extra ones.
+        // A cone over one 40-gon in the plane z = tilt · x: faces 0..40 the sides, 40 the
+        // base; vertices 0..40 the base's corners, 40 the apex, then the extra ones.
         let (n, base) = (40u32, 40usize);
-        let with = |extra: &[DVec3], faces: &[[u32; 3]]| {
+        let with = |tilt: f64, extra: &[DVec3], faces: &[[u32; 3]]| {
             let c = cone(n);
-            let mut positions = c.positions().to_vec();
+            let mut positions: Vec<DVec3> =
+                c.positions().iter().map(|p| if p.z == 0.0 { v(p.x, p.y, tilt * p.x) } else { *p }).collect();
             positions.extend_from_slice(extra);
             let all = c.faces().map(<[u32]>::to_vec).chain(faces.iter().map(|f| f.to_vec())).collect();
             Mesh::new(positions, all).unwrap_or_else(|e| panic!("{e}"))
         };
         let k = n + 1;
-        assert!(short_chord_soup(&cone(n)).is_some());
-        assert_eq!(self_intersections(&cone(n), 10), vec![]);
+        for tilt in [0.0, 0.5] {
+            let clean = with(tilt, &[], &[]);
+            assert!(search_soup(&clean).is_some());
+            assert_eq!(self_intersections(&clean, 10), vec![]);
+        }
         // A triangle through the base's interior, below the sides.
-        let pierced = with(&[v(0.3, 0.2, -0.5), v(0.35, 0.2, 0.5), v(0.3, 0.3, 0.5)], &[[k, k + 1, k + 2]]);
-        assert!(short_chord_soup(&pierced).is_some());
+        let pierced =
+            with(0.0, &[v(0.3, 0.2, -0.5), v(0.35, 0.2, 0.5), v(0.3, 0.3, 0.5)], &[[k, k + 1, k + 2]]);
+        assert!(search_soup(&pierced).is_some());
         assert_eq!(self_intersections(&pierced, 10), vec![(base, base + 1)]);
         // A triangle through the fan of sides and the base: the same face pairs, in the
         // same order, as testing every pair of the triangles every command sees.
-        let through = with(&[v(0.2, 0.1, -0.5), v(0.25, 0.1, 1.5), v(0.9, -0.6, 0.7)], &[[k, k + 1, k + 2]]);
-        let expected = all_pairs(&through);
-        assert!(expected.len() > 2 && expected.iter().all(|&(_, g)| g == base + 1), "{expected:?}");
-        assert_eq!(self_intersections(&through, usize::MAX), expected);
-        assert_eq!(self_intersections(&through, 1), expected[..1]);
-        // A triangle hanging below the base from one of its diagonals touches it only
-        // along that diagonal in a tiling that has it as a chord, and crosses the
+        for tilt in [0.0, 0.5] {
+            let through =
+                with(tilt, &[v(0.2, 0.1, -0.5), v(0.25, 0.1, 1.5), v(0.9, -0.6, 0.7)], &[[k, k + 1, k + 2]]);
+            let expected = all_pairs(&through);
+            assert!(expected.len() > 2 && expected.iter().all(|&(_, g)| g == base + 1), "{expected:?}");
+            assert_eq!(self_intersections(&through, usize::MAX), expected);
+            assert_eq!(self_intersections(&through, 1), expected[..1]);
+        }
+        // A triangle hanging below the tilted base from one of its diagonals touches it
+        // only along that diagonal in a tiling that has it as a chord, and crosses the
         // triangles it passes through in one that does not: such a face is tiled as every
         // command tiles it. Without that rule some diagonal would be missed.
         let mut missed = 0;
@@ -875,8 +904,8 @@ mod tests {
                 if j - i == n - 1 {
                     continue;
                 }
-                let m = with(&[v(0.0, 0.0, -1.0)], &[[i, j, k]]);
-                assert!(short_chord_soup(&m).is_none());
+                let m = with(0.5, &[v(0.0, 0.0, -1.0)], &[[i, j, k]]);
+                assert!(search_soup(&m).is_none());
                 let expected = all_pairs(&m);
                 assert_eq!(self_intersections(&m, 10), expected, "diagonal {i}–{j}");
                 let short = TriangleSoup::build(&m, true).0;
@@ -884,11 +913,21 @@ mod tests {
             }
         }
         assert!(missed > 0);
-        // A face without area (three corners on a line) anywhere: the tiling every command
-        // sees, whose triangles are split at T-junctions.
-        let plugged = with(&[v(2.0, 0.0, 0.0), v(3.0, 0.0, 0.0), v(4.0, 0.0, 0.0)], &[[k, k + 1, k + 2]]);
-        assert!(short_chord_soup(&plugged).is_none());
+        // A face without area (three corners on a line) anywhere, or a vertex at the
+        // base's centre (the base's fan, as the face is listed): the tiling every command
+        // sees.
+        let plugged =
+            with(0.0, &[v(2.0, 0.0, 0.0), v(3.0, 0.0, 0.0), v(4.0, 0.0, 0.0)], &[[k, k + 1, k + 2]]);
+        assert!(search_soup(&plugged).is_none());
         assert_eq!(self_intersections(&plugged, 10), all_pairs(&plugged));
+        let Some(ConvexTiling::Centre(centre)) =
+            triangulate::convex_tiling(&cone(n).positions()[..40].iter().rev().copied().collect::<Vec<_>>())
+        else {
+            panic!("the base is fanned from its centre")
+        };
+        let touched = with(0.0, &[centre, v(0.0, 0.1, -1.0), v(0.1, 0.0, -1.0)], &[[k, k + 1, k + 2]]);
+        assert!(search_soup(&touched).is_none());
+        assert_eq!(self_intersections(&touched, 10), all_pairs(&touched));
     }
 
     #[test]

@@ -137,15 +137,26 @@ pub fn polygon_or_fan(corners: &[DVec3]) -> Vec<[u32; 3]> {
     polygon(corners).unwrap_or_else(|_| fan())
 }
 
-/// Triangles with short chords for a polygon whose corners lie exactly in one plane and
-/// turn strictly left all the way round, once (a strictly convex face; the outline's edges
-/// change the sign of their first projected coordinate exactly twice): the triangle of
-/// three corners a third of the way apart, then over each arc's chord the triangle to the
-/// arc's middle corner. Chords are short where the outline is dense, about the perimeter
-/// times log n in all, where a fan or a Delaunay triangulation of corners on a circle
-/// draws chords across the whole face. Oriented like the face, none without area (no three
-/// corners of a strictly convex polygon are collinear). `None` for any other polygon.
-pub fn convex_short_chords(corners: &[DVec3]) -> Option<Vec<[u32; 3]>> {
+/// A tiling of a strictly convex face for the crossing search ([`convex_tiling`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConvexTiling {
+    /// The fan from this point: the corners' mean, strictly inside the face and exactly
+    /// in its plane (a plane of constant coordinate, which the mean keeps).
+    Centre(DVec3),
+    /// Triangles over the corners (index triples into them).
+    Corners(Vec<[u32; 3]>),
+}
+
+/// A tiling for the crossing search of a polygon whose corners lie exactly in one plane
+/// and turn strictly left all the way round, once (a strictly convex face; the outline's
+/// edges change the sign of their first projected coordinate exactly twice): in a plane
+/// of constant coordinate the fan from the corners' mean (every triangle at that point,
+/// where the search stops splitting), elsewhere the triangle of three corners a third of
+/// the way apart, then over each arc's chord the triangle to the arc's middle corner
+/// (chords about the perimeter times log n long in all). A Delaunay triangulation of
+/// corners on a circle, or a fan from one corner, draws chords across the whole face
+/// instead. Oriented like the face, none without area. `None` for any other polygon.
+pub fn convex_tiling(corners: &[DVec3]) -> Option<ConvexTiling> {
     let n = corners.len();
     if n < 4 || !is_planar(corners) {
         return None;
@@ -163,6 +174,14 @@ pub fn convex_short_chords(corners: &[DVec3]) -> Option<Vec<[u32; 3]>> {
     if changes != 2 {
         return None;
     }
+    if let Some(k) = (0..3).find(|&k| corners.iter().all(|c| c[k] == corners[0][k])) {
+        let mut centre = corners.iter().sum::<DVec3>() / n as f64;
+        centre[k] = corners[0][k];
+        let c = proj.apply(centre);
+        if (0..n).all(|i| orient2d(c, p[i], p[(i + 1) % n]) > 0) {
+            return Some(ConvexTiling::Centre(centre));
+        }
+    }
     let (b, c) = (n / 3, 2 * n / 3);
     let mut triangles = vec![[0, b as u32, c as u32]];
     let mut arcs = vec![(0, b), (b, c), (c, n)];
@@ -173,7 +192,7 @@ pub fn convex_short_chords(corners: &[DVec3]) -> Option<Vec<[u32; 3]>> {
             arcs.extend([(i, m), (m, j)]);
         }
     }
-    Some(triangles)
+    Some(ConvexTiling::Corners(triangles))
 }
 
 /// The corners lie in one plane, decided exactly: every corner is coplanar (`orient3d`)
@@ -381,27 +400,39 @@ mod tests {
 
     #[test]
     fn short_chords_tile_strictly_convex_faces_only() {
-        let circle = |n: usize, z: f64| -> Vec<DVec3> {
+        // Corners on a circle in the plane z = 0.5 (fanned from the centre) or z = x / 2.
+        let circle = |n: usize, tilt: f64| -> Vec<DVec3> {
             (0..n)
                 .map(|i| {
                     let a = std::f64::consts::TAU * i as f64 / n as f64;
-                    DVec3::new(a.cos(), a.sin(), z)
+                    DVec3::new(a.cos(), a.sin(), if tilt == 0.0 { 0.5 } else { tilt * a.cos() })
                 })
                 .collect()
         };
-        for n in [4, 5, 7, 16, 100, 1000] {
-            let p = circle(n, 0.5);
-            let tris = convex_short_chords(&p).unwrap_or_else(|| panic!("{n}-gon"));
-            assert_eq!(tris.len(), n - 2);
-            // Every triangle turns like the face: same orientation, and together they
-            // cover its area exactly once (up to rounding).
+        for (n, tilt) in [4, 5, 7, 16, 100, 1000].into_iter().flat_map(|n| [(n, 0.0), (n, 0.5)]) {
+            let mut p = circle(n, tilt);
+            let normal = newell_normal(p.iter().copied());
+            let tris = match convex_tiling(&p) {
+                Some(ConvexTiling::Centre(c)) if tilt == 0.0 => {
+                    p.push(c);
+                    (0..n as u32).map(|i| [n as u32, i, (i + 1) % n as u32]).collect()
+                }
+                Some(ConvexTiling::Corners(tris)) if tilt != 0.0 => {
+                    assert_eq!(tris.len(), n - 2);
+                    tris
+                }
+                other => panic!("{n}-gon, tilt {tilt}: {other:?}"),
+            };
+            // Every triangle turns like the face, exactly in its plane, and together they
+            // cover its area once (up to rounding).
             assert!(tris.iter().all(|t| {
                 let [a, b, c] = t.map(|i| p[i as usize]);
-                (b - a).cross(c - a).z > 0.0
+                (b - a).cross(c - a).dot(normal) > 0.0 && orient3d(p[0], p[1], p[2], c) == 0
             }));
             let whole = area(&p, &(1..n as u32 - 1).map(|i| [0, i, i + 1]).collect::<Vec<_>>());
             assert!((area(&p, &tris) - whole).length() <= 1e-12 * whole.length());
-            // Each edge of the outline in one triangle, each chord in two: a tiling.
+            // Each side of the outline in one triangle, each chord in two: a tiling.
+            let side = |a: u32, b: u32| b < n as u32 && (b - a == 1 || b - a == n as u32 - 1);
             let mut edges = std::collections::HashMap::new();
             for t in &tris {
                 for k in 0..3 {
@@ -409,38 +440,38 @@ mod tests {
                     *edges.entry((a, b)).or_insert(0) += 1;
                 }
             }
-            assert!(
-                edges
-                    .iter()
-                    .all(|(&(a, b), &c)| c == if b - a == 1 || b - a == n as u32 - 1 { 1 } else { 2 })
-            );
-            // Short chords: far less in all than the fan's n − 3 chords of length up to 2.
+            assert!(edges.iter().all(|(&(a, b), &c)| c == if side(a, b) { 1 } else { 2 }));
+            // Short chords: far less in all than a corner fan's n − 3 chords of length up
+            // to 2 (the centre's fan has long spokes, all at the centre).
+            if tilt == 0.0 {
+                continue;
+            }
             let chords: f64 = edges
                 .keys()
-                .filter(|(a, b)| b - a != 1 && b - a != n as u32 - 1)
+                .filter(|&&(a, b)| !side(a, b))
                 .map(|&(a, b)| p[a as usize].distance(p[b as usize]))
                 .sum();
-            assert!(chords <= 2.0 * std::f64::consts::TAU * (n as f64).log2(), "{n}: {chords}");
+            assert!(chords <= 4.0 * std::f64::consts::TAU * (n as f64).log2(), "{n}: {chords}");
         }
         // Not planar, a corner turning right, three corners on a line, a star (all left
         // turns, wound twice), reversed corners: none.
         let mut bent = circle(8, 0.0);
         bent[3].z = 1e-9;
-        assert!(convex_short_chords(&bent).is_none());
+        assert!(convex_tiling(&bent).is_none());
         let mut dented = circle(8, 0.0);
         dented[3] *= 0.5;
-        assert!(convex_short_chords(&dented).is_none());
+        assert!(convex_tiling(&dented).is_none());
         let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
         let mut straight = square.to_vec();
         straight.insert(1, (square[0] + square[1]) * 0.5);
-        assert!(convex_short_chords(&square).is_some());
-        assert!(convex_short_chords(&straight).is_none());
+        assert!(convex_tiling(&square).is_some());
+        assert!(convex_tiling(&straight).is_none());
         let ring = circle(5, 0.0);
         let star: Vec<DVec3> = (0..5).map(|i| ring[i * 2 % 5]).collect();
-        assert!(convex_short_chords(&star).is_none());
+        assert!(convex_tiling(&star).is_none());
         let reversed: Vec<DVec3> = ring.iter().rev().copied().collect();
-        assert!(convex_short_chords(&reversed).is_some());
-        assert!(convex_short_chords(&ring[..3]).is_none());
+        assert!(convex_tiling(&reversed).is_some());
+        assert!(convex_tiling(&ring[..3]).is_none());
     }
 
     #[test]
