@@ -12,6 +12,11 @@ fn texgeo(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
 }
 
+/// `texgeo boolean A B --transform-b TRANSFORM --op OP -o OUT`.
+fn boolean(a: &str, b: &str, transform: &str, op: &str, out: &Path) -> Output {
+    texgeo(&["boolean", a, b, "--transform-b", transform, "--op", op, "-o", out.to_str().unwrap()])
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -195,17 +200,7 @@ fn empty_results_are_written_in_every_format_and_read_back_as_operands() {
             [("minus-itself", "scale 1", "difference"), ("disjoint", "translate 5 0 0", "intersection")]
         {
             let empty = temp(&format!("{name}.{ext}"));
-            let o = texgeo(&[
-                "boolean",
-                "builtin:cube",
-                "builtin:cube",
-                "--transform-b",
-                transform,
-                "--op",
-                op,
-                "-o",
-                empty.to_str().unwrap(),
-            ]);
+            let o = boolean("builtin:cube", "builtin:cube", transform, op, &empty);
             assert!(o.status.success(), "{name}.{ext}: {}", stderr(&o));
             assert_eq!(formats::read(&empty).unwrap().num_faces(), 0, "{name}.{ext}");
             let o = texgeo(&["mesh", "stats", empty.to_str().unwrap()]);
@@ -302,17 +297,7 @@ fn faces_of_no_area_are_left_out_as_every_command_does() {
         let transform = "scale 0.25; translate 0.5 0 1";
         for (op, want) in [("union", 1.09375), ("difference", 0.96875), ("intersection", 0.03125)] {
             let out = temp(&format!("plugged-{corners}-{op}.off"));
-            let o = texgeo(&[
-                "boolean",
-                &cube,
-                "builtin:cube",
-                "--transform-b",
-                transform,
-                "--op",
-                op,
-                "-o",
-                out.to_str().unwrap(),
-            ]);
+            let o = boolean(&cube, "builtin:cube", transform, op, &out);
             assert!(o.status.success(), "{corners} {op}: {}", stderr(&o));
             assert!((volume(&out) - want).abs() < 1e-12, "{corners} {op}: {}", volume(&out));
             let stats = stdout(&texgeo(&["mesh", "stats", out.to_str().unwrap()]));

@@ -351,22 +351,17 @@ pub fn finish(
                 continue;
             }
         }
-        if round >= ROUNDS || edges.is_empty() {
-            let err =
-                stuck.or_else(|| crossings.first().map(crossing)).unwrap_or_else(|| flat_face(&flat[0]));
-            if nudges < ROUNDS && nudge(&mut soup, &crossings, &flat, first_new, &mut repair) {
-                nudges += 1;
-                continue;
-            }
-            return Err(err);
-        }
         // Shortest first; each point takes part in one collapse per round, and goes
         // the way (onto either end when both are intersection points) after which the
         // triangles around it cross the fewest others — if that is fewer than before.
+        // Past the last round no collapse is planned: the ulp moves get their turn below.
+        if round >= ROUNDS {
+            edges.clear();
+        }
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         let mut map: HashMap<u32, u32> = HashMap::new();
         let mut busy = std::collections::HashSet::new();
-        let boxes = soup.boxes();
+        let boxes = if edges.is_empty() { Vec::new() } else { soup.boxes() };
         for (length, keep, gone) in edges {
             if busy.contains(&keep) || busy.contains(&gone) {
                 continue;
