@@ -149,12 +149,12 @@ impl std::fmt::Display for Repair {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum InvalidResult {
     #[error(
-        "faces {a} and {b} cross near ({}, {}, {}) once rounded to f64, and no short edge there could be collapsed",
+        "faces {a} and {b} cross near ({}, {}, {}) once rounded to f64, and no snap, short-edge collapse or ulp move there removes it",
         near.x, near.y, near.z
     )]
     Crossing { a: usize, b: usize, near: DVec3 },
     #[error(
-        "face {face} near ({}, {}, {}) has no area once rounded to f64, and no short edge there could be collapsed",
+        "face {face} near ({}, {}, {}) has no area once rounded to f64, and no snap, short-edge collapse or ulp move there removes it",
         near.x, near.y, near.z
     )]
     Flat { face: usize, near: DVec3 },
