@@ -96,6 +96,20 @@ fn render(run: &Run, scene: &Scene, camera: Camera) -> Result<Picture> {
     Ok(renderer.render(&prepared, &view)?)
 }
 
+/// `content` refined to `level` and drawn from `camera`, with the model's vertex and face counts.
+fn draw(
+    run: &Run,
+    content: Content,
+    level: u32,
+    look: Look,
+    camera: Camera,
+) -> Result<(Picture, usize, usize)> {
+    let mut model = Model::new(run.ctx, content, level, look, None)?;
+    let (vertices, faces) = model.counts();
+    let scene = model.scene(run.ctx)?;
+    Ok((render(run, &scene, camera)?, vertices, faces))
+}
+
 fn aspect() -> f64 {
     f64::from(WIDTH) / f64::from(HEIGHT)
 }
@@ -179,10 +193,7 @@ pub fn valence_levels(run: &mut Run) -> Result<Vec<Block>> {
         valence_legend(),
     ];
     for level in 0..=3 {
-        let mut model = Model::new(run.ctx, Content::Mesh(base.clone()), level, look, None)?;
-        let (vertices, faces) = model.counts();
-        let scene = model.scene(run.ctx)?;
-        let picture = render(run, &scene, camera)?;
+        let (picture, vertices, faces) = draw(run, Content::Mesh(base.clone()), level, look, camera)?;
         let record = FigureRecord {
             kind: "valence".into(),
             model: "geodesic sphere (report::reproduce::valence_model)".into(),
@@ -228,11 +239,8 @@ pub fn crease_sharpness(run: &mut Run) -> Result<Vec<Block>> {
     let surface = Surface { features, ..Surface::smooth(cube) };
     let level = 3;
     let look = Look { valence: false, wireframe: false, shading: Shading::Smooth, colour: colour::SURFACE };
-    let mut model = Model::new(run.ctx, Content::Surface(surface), level, look, None)?;
-    let (vertices, faces) = model.counts();
-    let scene = model.scene(run.ctx)?;
     let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
-    let picture = render(run, &scene, camera)?;
+    let (picture, vertices, faces) = draw(run, Content::Surface(surface), level, look, camera)?;
     let record = FigureRecord {
         kind: "creases".into(),
         model: "builtin:cube".into(),
