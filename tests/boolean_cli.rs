@@ -2,33 +2,25 @@
 //! refusals (open, inverted, inconsistent, self-intersecting, NaN, bad output) with
 //! status 2, a message naming the operand and the reason, and no file written.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use std::sync::OnceLock;
+
+use common::{stderr, stdout, texgeo};
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::formats;
-
-fn texgeo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
-}
 
 /// `texgeo boolean A B --transform-b TRANSFORM --op OP -o OUT`.
 fn boolean(a: &str, b: &str, transform: &str, op: &str, out: &Path) -> Output {
     texgeo(&["boolean", a, b, "--transform-b", transform, "--op", op, "-o", out.to_str().unwrap()])
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
+/// `name` in one folder shared by the tests of this file.
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("texgeo-boolean-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| common::fresh_dir("boolean-cli", "outputs")).join(name)
 }
 
 fn write(path: &Path, text: &str) -> String {

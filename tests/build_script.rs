@@ -2,6 +2,8 @@
 //! its `rerun-if-changed` paths is missing, which would recompile every shader and the
 //! whole crate on every `cargo build` and `cargo test`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -37,14 +39,13 @@ fn every_path_the_build_script_watches_exists() {
 
 #[test]
 fn a_fresh_clone_without_packed_refs_watches_its_loose_branch_ref() {
-    let dir = std::env::temp_dir().join(format!("texgeo-build-script-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::TempDir::new("build-script");
+    let dir = tmp.path();
     let git = |args: &[&str]| {
         let o = Command::new("git")
             .args(["-c", "user.name=t", "-c", "user.email=t@t", "-c", "init.defaultBranch=main"])
             .args(args)
-            .current_dir(&dir)
+            .current_dir(dir)
             .output()
             .expect("run git");
         assert!(o.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&o.stderr));
@@ -63,5 +64,4 @@ fn a_fresh_clone_without_packed_refs_watches_its_loose_branch_ref() {
     // Detached, or no git at all: nothing missing either.
     assert_eq!(git_watch::watched(Some(&git_dir), Some(&git_dir), None), vec![git_dir.join("HEAD")]);
     assert!(git_watch::watched(None, None, None).is_empty());
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -2,6 +2,9 @@
 //! where the vertices project, edges and polylines over surfaces, voxel boundaries,
 //! deterministic pictures, PNG files (lavapipe, validation on under tools/test).
 
+mod common;
+
+use common::{TempDir, texgeo};
 use glam::DVec3;
 use texgeo::gpu::Context;
 use texgeo::mesh::{Mesh, procedural};
@@ -283,16 +286,15 @@ fn bad_requests_are_errors() {
 
 #[test]
 fn png_round_trip_leaves_no_temporary_file() {
-    let dir = std::env::temp_dir().join(format!("texgeo-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = TempDir::new("render");
+    let dir = tmp.path();
     let pic = Picture::new(3, 2, (0..24).collect()).unwrap();
     let path = dir.join("p.png");
     pic.save_png(&path).unwrap();
     assert_eq!(Picture::load_png(&path).unwrap(), pic);
-    let names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let names: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(names, vec![std::ffi::OsString::from("p.png")]);
     assert!(pic.save_png(dir.join("no/such/dir/p.png")).is_err());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -310,16 +312,12 @@ fn gpu_memory_is_counted_and_returned() {
     assert_eq!(ctx.live_allocations(), before, "everything the renderer made is freed");
 }
 
-fn texgeo(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().unwrap()
-}
-
 /// `--boolean B --op OP`: the operands in their two colours with the cut curve over them,
 /// and beside them the result, its faces coloured by operand (Figs. 6-9 … 6-12).
 #[test]
 fn boolean_pictures_show_both_operands_and_the_cut_curve() {
-    let dir = std::env::temp_dir().join(format!("texgeo-render-boolean-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = TempDir::new("render-boolean");
+    let dir = tmp.path();
     let png = dir.join("torus-and-knot.png");
     let o = texgeo(&[
         "render",
@@ -344,15 +342,14 @@ fn boolean_pictures_show_both_operands_and_the_cut_curve() {
     let o = texgeo(&["render", "builtin:torus", "--boolean", "builtin:knot", "-o", png.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--op"));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// An OBJ's crease tags are refined with the mesh and their edges drawn over the surface
 /// in the colour of their sharpness; without the tags (the same mesh as OFF) nothing is.
 #[test]
 fn crease_edges_are_drawn_over_the_subdivided_surface() {
-    let dir = std::env::temp_dir().join(format!("texgeo-render-creases-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = TempDir::new("render-creases");
+    let dir = tmp.path();
     let tagged = concat!(env!("CARGO_MANIFEST_DIR"), "/reference/subdiv/cube_creases.obj");
     let plain = dir.join("cube.off");
     assert!(texgeo(&["mesh", "convert", tagged, plain.to_str().unwrap()]).status.success());
@@ -366,13 +363,12 @@ fn crease_edges_are_drawn_over_the_subdivided_surface() {
         counts.push(p.rgba.chunks_exact(4).filter(|c| c[0] > 200 && c[2] < 90).count());
     }
     assert!(counts[0] > 100 && counts[1] == 0, "crease pixels with tags, without: {counts:?}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn render_command_writes_pictures_and_refuses_bad_requests() {
-    let dir = std::env::temp_dir().join(format!("texgeo-render-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = TempDir::new("render-cli");
+    let dir = tmp.path();
     let png = dir.join("cube.png");
     let o = texgeo(&[
         "render",
@@ -414,5 +410,4 @@ fn render_command_writes_pictures_and_refuses_bad_requests() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
     assert!(!dir.join("x.png").exists(), "no picture from a refused request");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

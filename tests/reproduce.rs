@@ -4,28 +4,20 @@
 //! every claim, a self-contained HTML page — and a run on a device without logic-op
 //! XOR, which marks the rows that need it and nothing else.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::sync::OnceLock;
 
+use common::texgeo_env as texgeo;
 use glam::DVec3;
 use texgeo::render::{Camera, Picture, colour};
 use texgeo::report::reproduce::{EXPERIMENTS, FigureRecord, valence_model};
 
-fn texgeo(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_texgeo"));
-    c.args(args);
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run texgeo")
-}
-
+/// A path for a report folder, with nothing there yet.
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("texgeo-reproduce-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_path("reproduce", name)
 }
 
 /// The `--quick` report, made once for all tests of this file.

@@ -2,19 +2,14 @@
 //! run (times aside), and a mesh whose worker panics, aborts, segfaults, runs out of
 //! memory or hangs is recorded as such while the sweep goes on.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn texgeo(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_texgeo"));
-    cmd.args(args);
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("run texgeo")
-}
+use common::texgeo_env as texgeo;
 
 fn ok(o: &Output) -> String {
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
@@ -23,10 +18,7 @@ fn ok(o: &Output) -> String {
 }
 
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("texgeo-sweep-{}", std::process::id())).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir("sweep", name)
 }
 
 /// Built-in models plus broken files: unreadable, not closed, missing.

@@ -54,9 +54,36 @@ impl Drop for TempDir {
     }
 }
 
+/// A path `texgeo-TEST-NAME-PID` in the temporary folder, with nothing there: for outputs
+/// that outlive one helper (a report shared by the tests of a file) or that a command must
+/// create itself. The caller removes what it made.
+pub fn fresh_path(test: &str, name: &str) -> PathBuf {
+    let path = std::env::temp_dir().join(format!("texgeo-{test}-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&path);
+    let _ = std::fs::remove_file(&path);
+    path
+}
+
+/// [`fresh_path`], made an empty folder.
+pub fn fresh_dir(test: &str, name: &str) -> PathBuf {
+    let dir = fresh_path(test, name);
+    std::fs::create_dir_all(&dir).expect("create a temporary folder");
+    dir
+}
+
 /// Runs the `texgeo` binary with `args`.
 pub fn texgeo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texgeo")).args(args).output().expect("run texgeo")
+    texgeo_env(args, &[])
+}
+
+/// Runs the `texgeo` binary with `args` and the variables `env` set.
+pub fn texgeo_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_texgeo"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("run texgeo")
 }
 
 /// Runs `texgeo` through `bash -c` with a shell prefix (e.g. `ulimit -f 1;`): the binary
