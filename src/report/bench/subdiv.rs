@@ -107,11 +107,31 @@ pub struct Measured {
     pub osd: (f64, f64),
     /// OpenSubdiv's every run, interleaved with `gpu_totals` and `cpu`.
     pub osd_runs: Samples,
-    /// "match", "MISMATCH" or "not checked".
-    pub verdict: String,
+    /// How the GPU result compares with OpenSubdiv's.
+    pub verdict: Agreement,
     /// The largest distance from OpenSubdiv's vertices over the bounding box's diagonal,
     /// when they match.
     pub max_error: Option<f64>,
+}
+
+/// The GPU result against OpenSubdiv's, vertex by vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Agreement {
+    /// Equal within the tolerance on every vertex and face.
+    Match,
+    Mismatch,
+    /// Not compared.
+    NotChecked,
+}
+
+impl std::fmt::Display for Agreement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Agreement::Match => "match",
+            Agreement::Mismatch => "MISMATCH",
+            Agreement::NotChecked => "not checked",
+        })
+    }
 }
 
 /// Steps [`measure`] reports.
@@ -167,12 +187,12 @@ pub fn measure(
         let (verdict, max_error) = if settings.validate {
             let c = Comparison::new(&run.mesh, &osd::refine(mesh, level)?, 1e-5);
             if c.is_match() {
-                ("match", Some(c.max_error / c.diagonal.max(f64::MIN_POSITIVE)))
+                (Agreement::Match, Some(c.max_error / c.diagonal.max(f64::MIN_POSITIVE)))
             } else {
-                ("MISMATCH", None)
+                (Agreement::Mismatch, None)
             }
         } else {
-            ("not checked", None)
+            (Agreement::NotChecked, None)
         };
         out.push(Measured {
             name: model.name.clone(),
@@ -189,7 +209,7 @@ pub fn measure(
             cpu,
             osd: osd_times,
             osd_runs,
-            verdict: verdict.to_string(),
+            verdict,
             max_error,
         });
     }
@@ -344,7 +364,7 @@ pub fn report(measured: &[Measured], settings: Settings, environment: Environmen
             ms(osd_time),
             m.osd_runs.spread_cell(),
             format!("{ratio:.2}"),
-            m.verdict.clone(),
+            m.verdict.to_string(),
             m.max_error.map_or("–".into(), |e| format!("{e:.1e}")),
         ]);
         let passes: Vec<String> = gpu.passes.iter().map(|&p| ms(p)).collect();

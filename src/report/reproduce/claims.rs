@@ -367,7 +367,7 @@ fn tetragrid_memory_grows(f: &Facts) -> Measure {
         }
     }
     if total == 0 {
-        return Err(f.why_not_run("inclusion").unwrap_or("no TetraGrid memory measured").to_string());
+        return Err(f.not_run_or("inclusion", "no TetraGrid memory measured"));
     }
     Ok((format!("grows on {grows} of {total} models (counted bytes, no noise)"), (grows == total).into())
         .into())
@@ -392,9 +392,8 @@ fn tetragrid_build_order(f: &Facts) -> Measure {
             }
         }
     }
-    let ((k, lo, hi, reps), m) = worst.ok_or_else(|| {
-        f.why_not_run("inclusion").unwrap_or("no TetraGrid build times at 16³–64³").to_string()
-    })?;
+    let ((k, lo, hi, reps), m) =
+        worst.ok_or_else(|| f.not_run_or("inclusion", "no TetraGrid build times at 16³–64³"))?;
     let how = if reps > 0 { format!("; interval: each of {reps} builds fitted") } else { String::new() };
     Ok(Found::from((
         format!("steepest slope {} in n ({m}{how})", fr(k, lo, hi, false)),
@@ -1223,7 +1222,7 @@ fn crossover(f: &Facts, rival: &str) -> Measure {
     let (model, _) = sweep
         .iter()
         .find(|(m, _)| f.find("subdivide", m, "level:5:gpu-path").is_some())
-        .ok_or_else(|| f.why_not_run("subdivide").unwrap_or("no level sweep was measured").to_string())?;
+        .ok_or_else(|| f.not_run_or("subdivide", "no level sweep was measured"))?;
     // "Beats" is faster in every repetition: equal speed (a ratio of 1.00×, or an
     // interval across 1) beats nothing.
     let mut from = None;
@@ -1287,7 +1286,7 @@ fn real_time_cube(f: &Facts) -> Measure {
         .models_of("subdivide")
         .into_iter()
         .find(|(m, _)| m.contains("cube"))
-        .ok_or_else(|| f.why_not_run("subdivide").unwrap_or("no cube among the models").to_string())?;
+        .ok_or_else(|| f.not_run_or("subdivide", "no cube among the models"))?;
     let t = f.get("subdivide", &cube.0, "time:tgpu")?;
     let ms = |v: f64| format!("{:.2}", v * 1e3);
     let shown = if t.runs > 1 && ms(t.min) != ms(t.max) {

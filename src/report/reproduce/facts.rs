@@ -72,11 +72,38 @@ pub struct Fact {
     pub runs: Vec<f64>,
 }
 
+/// Why an experiment has no facts at all.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NotRun {
+    /// `--only` left it out.
+    LeftOut,
+    /// Its command does not exist yet: why.
+    NoCommand(String),
+    /// The device lacks a feature it needs: which.
+    Unsupported(String),
+    /// It failed: the error.
+    Failed(String),
+}
+
+impl std::fmt::Display for NotRun {
+    /// The words a claim that needs the experiment shows.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NotRun::LeftOut => f.write_str("not run: left out by --only"),
+            NotRun::NoCommand(why) => f.write_str(why),
+            NotRun::Unsupported(why) => write!(f, "not measurable on this device: {why}"),
+            NotRun::Failed(err) => write!(f, "the experiment failed: {err}"),
+        }
+    }
+}
+
 /// Why a number is missing, said in words a reader of the report understands (never
 /// the store's keys).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Missing {
-    /// The experiment did not run, or this device could not measure it: the reason.
+    /// The experiment did not run.
+    NotRun(NotRun),
+    /// This device could not measure the number: the reason.
     Why(String),
     /// No model of the source has the quantity (key).
     NoModel(String),
@@ -89,6 +116,7 @@ pub enum Missing {
 impl std::fmt::Display for Missing {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Missing::NotRun(why) => why.fmt(f),
             Missing::Why(why) => f.write_str(why),
             Missing::NoModel(key) => write!(f, "no model has {}", describe(key)),
             Missing::NotFor { key, model } => write!(f, "{} was not measured on {model}", describe(key)),
@@ -162,7 +190,7 @@ pub struct Facts {
     /// (experiment, model, size, thesis model it stands for or "–").
     pub models: Vec<(&'static str, String, f64, String)>,
     /// Experiments that did not run, and why.
-    pub not_run: Vec<(&'static str, String)>,
+    pub not_run: Vec<(&'static str, NotRun)>,
 }
 
 impl Facts {
@@ -218,13 +246,19 @@ impl Facts {
         });
     }
 
-    pub fn skipped(&mut self, experiment: &'static str, why: &str) {
-        self.not_run.push((experiment, why.to_string()));
+    pub fn skipped(&mut self, experiment: &'static str, why: NotRun) {
+        self.not_run.push((experiment, why));
     }
 
     /// Why nothing of `experiment` can be found, if it did not run.
-    pub fn why_not_run(&self, experiment: &str) -> Option<&str> {
-        self.not_run.iter().find(|n| n.0 == experiment).map(|n| n.1.as_str())
+    pub fn why_not_run(&self, experiment: &str) -> Option<&NotRun> {
+        self.not_run.iter().find(|n| n.0 == experiment).map(|n| &n.1)
+    }
+
+    /// [`Facts::why_not_run`] in words, else `otherwise`: why a claim on `experiment`
+    /// has no number.
+    pub fn not_run_or(&self, experiment: &str, otherwise: &str) -> String {
+        self.why_not_run(experiment).map_or_else(|| otherwise.to_string(), NotRun::to_string)
     }
 
     /// The models of `experiment`, smallest first: (name, size).
@@ -254,7 +288,7 @@ impl Facts {
     /// The value, or why there is none.
     pub fn get(&self, experiment: &str, model: &str, key: &str) -> Result<Stat, Missing> {
         if let Some(why) = self.why_not_run(experiment) {
-            return Err(Missing::Why(why.to_string()));
+            return Err(Missing::NotRun(why.clone()));
         }
         match self.find(experiment, model, key) {
             Some(f) => f.value.clone().map_err(Missing::Why),
@@ -266,7 +300,7 @@ impl Facts {
     /// Err: the reason, when no model has it.
     pub fn series(&self, experiment: &str, key: &str) -> Result<Vec<(String, f64, Stat)>, Missing> {
         if let Some(why) = self.why_not_run(experiment) {
-            return Err(Missing::Why(why.to_string()));
+            return Err(Missing::NotRun(why.clone()));
         }
         let mut out = Vec::new();
         let mut why = None;
@@ -448,8 +482,13 @@ mod tests {
         let none = f.series("voxelize", "time:fang@64").unwrap_err();
         assert_eq!(none, Missing::NoModel("time:fang@64".into()));
         assert_eq!(none.to_string(), "no model has the time of fang at 64³");
-        f.skipped("boolean", "not run");
-        assert_eq!(f.series("boolean", "reduction").unwrap_err(), why("not run"));
+        f.skipped("boolean", NotRun::NoCommand("not run".into()));
+        let not_run = f.series("boolean", "reduction").unwrap_err();
+        assert_eq!(not_run, Missing::NotRun(NotRun::NoCommand("not run".into())));
+        assert_eq!(not_run.to_string(), "not run");
+        f.skipped("voxelize2", NotRun::Unsupported("logic_op".into()));
+        assert_eq!(f.not_run_or("voxelize2", "–"), "not measurable on this device: logic_op");
+        assert_eq!(f.not_run_or("voxelize3", "nothing measured"), "nothing measured");
         f.model("boolean2", "torus", 10.0, "–");
         let e = f.pairs("boolean2", "time:phase2-cpu", "time:phase2-gpu").unwrap_err().to_string();
         assert_eq!(e, "no model has the time of phase 2 with CPU point tests");

@@ -33,7 +33,7 @@ use std::time::{Duration, Instant};
 pub use claims::{Claim, Decision, Found, Value, Verdict};
 pub use compare::compare;
 pub use experiments::{EXPERIMENTS, Experiment, Figure};
-pub use facts::{Facts, Stat};
+pub use facts::{Facts, NotRun, Stat};
 pub use figures::{FigureRecord, valence_model};
 pub use files::{check_writable, write_atomic};
 pub use page::regenerate as results_page;
@@ -258,21 +258,18 @@ impl Run<'_> {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Status {
     Ran,
-    /// Left out by `--only`, or its command does not exist yet: why.
-    NotRun(String),
-    /// The device lacks a feature it needs: which.
-    NotMeasurable(String),
-    /// It failed: the error.
-    Failed(String),
+    /// It did not run, or ran into an error: why.
+    Skipped(NotRun),
 }
 
 impl std::fmt::Display for Status {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Status::Ran => f.write_str("ran"),
-            Status::NotRun(why) => write!(f, "not run: {why}"),
-            Status::NotMeasurable(why) => write!(f, "not measurable on this device: {why}"),
-            Status::Failed(err) => write!(f, "FAILED: {err}"),
+            Status::Skipped(NotRun::LeftOut) => f.write_str("not run: left out by --only"),
+            Status::Skipped(NotRun::NoCommand(why)) => write!(f, "not run: {why}"),
+            Status::Skipped(NotRun::Unsupported(why)) => write!(f, "not measurable on this device: {why}"),
+            Status::Skipped(NotRun::Failed(err)) => write!(f, "FAILED: {err}"),
         }
     }
 }
@@ -315,7 +312,7 @@ pub fn run(ctx: &Context, config: &Config, monitor: &mut dyn Monitor) -> Result<
     let mut sections = Vec::new();
     for e in EXPERIMENTS {
         if !config.selected(e.key) {
-            c.today.skipped(e.key, "not run: left out by --only");
+            c.today.skipped(e.key, NotRun::LeftOut);
             continue;
         }
         let t = Instant::now();
@@ -347,10 +344,7 @@ fn run_experiment(
     c: &mut Collected,
 ) -> (Vec<Block>, Status) {
     let runner = match e.runner {
-        Err(why) => {
-            c.today.skipped(e.key, why);
-            return (vec![Block::Para(format!("**Not run:** {why}."))], Status::NotRun(why.to_string()));
-        }
+        Err(why) => return skip(c, e, NotRun::NoCommand(why.to_string())),
         Ok(runner) => runner,
     };
     let mut r = Run {
@@ -371,21 +365,29 @@ fn run_experiment(
             draw_figures(&mut r, e, &mut blocks, &mut c.failures);
             (blocks, Status::Ran)
         }
-        Err(err) => match err.unsupported() {
-            Some(why) => {
-                c.today.skipped(e.key, &format!("not measurable on this device: {why}"));
-                (
-                    vec![Block::Para(format!("**Not measurable on this device:** {why}."))],
-                    Status::NotMeasurable(why.to_string()),
-                )
-            }
-            None => {
-                c.today.skipped(e.key, &format!("the experiment failed: {err}"));
-                c.failures.push((e.key.to_string(), err.to_string()));
-                (vec![Block::Para(format!("**Failed:** {err}"))], Status::Failed(err.to_string()))
-            }
-        },
+        Err(err) => {
+            let why = match err.unsupported() {
+                Some(why) => NotRun::Unsupported(why.to_string()),
+                None => {
+                    c.failures.push((e.key.to_string(), err.to_string()));
+                    NotRun::Failed(err.to_string())
+                }
+            };
+            skip(c, e, why)
+        }
     }
+}
+
+/// Records why `e` has no facts; its section says so in one paragraph.
+fn skip(c: &mut Collected, e: &'static Experiment, why: NotRun) -> (Vec<Block>, Status) {
+    let para = match &why {
+        NotRun::LeftOut => "**Not run:** left out by --only.".to_string(),
+        NotRun::NoCommand(why) => format!("**Not run:** {why}."),
+        NotRun::Unsupported(why) => format!("**Not measurable on this device:** {why}."),
+        NotRun::Failed(err) => format!("**Failed:** {err}"),
+    };
+    c.today.skipped(e.key, why.clone());
+    (vec![Block::Para(para)], Status::Skipped(why))
 }
 
 /// Draws the figures of `e` after its tables; a figure the device cannot draw says so,

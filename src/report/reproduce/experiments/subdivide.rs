@@ -57,7 +57,7 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
         f.add(EXP, name, "fragments", "", Stat::exact(m.fragments as f64));
         f.add(EXP, name, "passes", "", Stat::exact(m.passes as f64));
         f.add(EXP, name, "gpu-levels", "", Stat::exact(f64::from(m.gpu_levels)));
-        if !m.verdict.starts_with("match") {
+        if m.verdict != subdiv::Agreement::Match {
             wrong.push(format!("{name}: {}", m.verdict));
         }
     }
