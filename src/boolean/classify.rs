@@ -139,108 +139,139 @@ pub fn classify(
     for (side, refined, on, (group, count), other) in
         [(Side::A, &r.a, &on_a, (&groups_a, count_a), b), (Side::B, &r.b, &on_b, (&groups_b, count_b), a)]
     {
-        // Grouped: one probe per group. Plain: one per off-surface triangle.
-        // The other mesh's triangles by their sorted vertex ids, built when first asked.
-        let by_vertices: OnceLock<Vec<([u32; 3], u32)>> = OnceLock::new();
-        let faces = |s: [u32; 3]| -> Option<u32> {
-            let list = by_vertices.get_or_init(|| {
-                let mut v: Vec<([u32; 3], u32)> = (0..other.triangles.len() as u32)
-                    .map(|u| {
-                        let mut k = other.triangles[u as usize];
-                        k.sort_unstable();
-                        (k, u)
-                    })
-                    .collect();
-                v.par_sort_unstable();
-                v
-            });
-            let i = list.partition_point(|x| x.0 < s);
-            // One triangle over these vertices (two would be coincident faces).
-            match list.get(i..i + 2) {
-                Some([x, y]) if x.0 == s && y.0 == s => None,
-                _ => list.get(i).filter(|x| x.0 == s).map(|x| x.1),
-            }
-        };
-        let probes: Vec<(u32, Probe)> = match grouping {
-            Grouping::Grouped => group_probes(r, refined, group, count, other, side, &faces),
-            Grouping::Plain => (0..refined.triangles.len() as u32)
-                .into_par_iter()
-                .with_min_len(1024)
-                .filter(|&t| on[t as usize].is_none())
-                .map(|t| (t, probe(r, refined, t, other, side, &faces).unwrap_or(Probe::Centroid(t))))
-                .collect(),
-        };
-        let mut tested: Vec<u32> = Vec::new();
-        let mut points: Vec<DVec3> = Vec::new();
-        let mut known: Vec<(u32, Class)> = Vec::new();
-        for &(t, p) in &probes {
-            match p {
-                Probe::Vertex(v) => {
-                    tested.push(t);
-                    points.push(r.points[v as usize]);
-                }
-                Probe::Centroid(c) => {
-                    stats.rounded_probes += 1;
-                    tested.push(t);
-                    points.push(centroid(refined, &r.points, c));
-                }
-                Probe::Known(class) => known.push((t, class)),
-            }
-        }
-        stats.local_sides += known.len();
-        stats.point_tests += points.len();
-        let other_side = if side == Side::A { Side::B } else { Side::A };
-        let answers = if points.is_empty() { Vec::new() } else { test(other_side, &points)? };
-        let decisive = |c: &inclusion::Class| match c {
-            inclusion::Class::Inside => Some(Class::In),
-            inclusion::Class::Outside => Some(Class::Out),
-            inclusion::Class::OnBoundary => None,
-        };
-        // A group takes the class of its probe (all its triangles lie on one side). Plain
-        // mode keeps each triangle's own answer.
-        let mut group_class: Vec<Option<Class>> = vec![None; count];
-        let mut own: Vec<Option<Class>> = vec![None; refined.triangles.len()];
-        let mut pending_points: Vec<(usize, Option<DVec3>)> = Vec::new();
-        for ((&t, c), &p) in tested.iter().zip(&answers).zip(&points) {
-            let g = group[t as usize] as usize;
-            match decisive(c) {
-                Some(c) => {
-                    group_class[g].get_or_insert(c);
-                    own[t as usize] = Some(c);
-                }
-                None => pending_points.push((g, Some(p))),
-            }
-        }
-        for &(t, c) in &known {
-            group_class[group[t as usize] as usize].get_or_insert(c);
-            own[t as usize] = Some(c);
-        }
-        if grouping == Grouping::Grouped {
-            own.iter_mut().for_each(|o| *o = None);
-        }
-        // A probe within the method's tolerance of the other surface: decided by exact
-        // ray parity, trying the group's other triangles after it.
-        stats.exact_fallbacks += pending_points.len();
-        let mut pending: Vec<(usize, Option<DVec3>)> =
-            pending_points.into_iter().filter(|&(g, _)| group_class[g].is_none()).collect();
-        pending.sort_by_key(|x| x.0);
-        pending.dedup_by_key(|x| x.0);
-        if !pending.is_empty() {
-            let decided = decide_exactly(refined, &r.points, group, &pending, other, side)?;
-            for ((g, _), c) in pending.into_iter().zip(decided) {
-                group_class[g] = Some(c);
-            }
-        }
-        let group_class: Vec<Class> = group_class.into_iter().map(|c| c.unwrap_or(Class::Out)).collect();
-        let cls: Vec<Class> = (0..refined.triangles.len())
-            .map(|t| on[t].or(own[t]).unwrap_or_else(|| group_class[group[t] as usize]))
-            .collect();
-        classes.push(cls);
+        let view = SideView { side, refined, on, group, count, other };
+        classes.push(classify_side(r, &view, grouping, test, &mut stats)?);
     }
     stats.exact_signs = implicit::exact_signs() - exact_before;
     let b_classes = classes.pop().unwrap_or_default();
     let a_classes = classes.pop().unwrap_or_default();
     Ok(Classification { a: a_classes, b: b_classes, stats })
+}
+
+/// One refined mesh with what [`classify`] knows of it: its triangles on the other
+/// surface (`on`), its groups (`group` per triangle, `count` of them), and the other
+/// input mesh.
+struct SideView<'a> {
+    side: Side,
+    refined: &'a Refined,
+    on: &'a [Option<Class>],
+    group: &'a [u32],
+    count: usize,
+    other: &'a TriangleSoup,
+}
+
+/// The class of every triangle of one side: the probes (one per group, or one per
+/// off-surface triangle), their point tests against the other solid, and exact ray
+/// parity for the probes the test leaves on the boundary.
+fn classify_side(
+    r: &Refinement,
+    v: &SideView,
+    grouping: Grouping,
+    test: &mut PointTest,
+    stats: &mut ClassifyStats,
+) -> Result<Vec<Class>, ClassifyError> {
+    let (side, refined, on, group, count, other) = (v.side, v.refined, v.on, v.group, v.count, v.other);
+    let probes = probes(r, v, grouping);
+    let mut tested: Vec<u32> = Vec::new();
+    let mut points: Vec<DVec3> = Vec::new();
+    let mut known: Vec<(u32, Class)> = Vec::new();
+    for &(t, p) in &probes {
+        match p {
+            Probe::Vertex(v) => {
+                tested.push(t);
+                points.push(r.points[v as usize]);
+            }
+            Probe::Centroid(c) => {
+                stats.rounded_probes += 1;
+                tested.push(t);
+                points.push(centroid(refined, &r.points, c));
+            }
+            Probe::Known(class) => known.push((t, class)),
+        }
+    }
+    stats.local_sides += known.len();
+    stats.point_tests += points.len();
+    let other_side = if side == Side::A { Side::B } else { Side::A };
+    let answers = if points.is_empty() { Vec::new() } else { test(other_side, &points)? };
+    let decisive = |c: &inclusion::Class| match c {
+        inclusion::Class::Inside => Some(Class::In),
+        inclusion::Class::Outside => Some(Class::Out),
+        inclusion::Class::OnBoundary => None,
+    };
+    // A group takes the class of its probe (all its triangles lie on one side). Plain
+    // mode keeps each triangle's own answer.
+    let mut group_class: Vec<Option<Class>> = vec![None; count];
+    let mut own: Vec<Option<Class>> = vec![None; refined.triangles.len()];
+    let mut pending_points: Vec<(usize, Option<DVec3>)> = Vec::new();
+    for ((&t, c), &p) in tested.iter().zip(&answers).zip(&points) {
+        let g = group[t as usize] as usize;
+        match decisive(c) {
+            Some(c) => {
+                group_class[g].get_or_insert(c);
+                own[t as usize] = Some(c);
+            }
+            None => pending_points.push((g, Some(p))),
+        }
+    }
+    for &(t, c) in &known {
+        group_class[group[t as usize] as usize].get_or_insert(c);
+        own[t as usize] = Some(c);
+    }
+    if grouping == Grouping::Grouped {
+        own.iter_mut().for_each(|o| *o = None);
+    }
+    // A probe within the method's tolerance of the other surface: decided by exact ray
+    // parity, trying the group's other triangles after it.
+    stats.exact_fallbacks += pending_points.len();
+    let mut pending: Vec<(usize, Option<DVec3>)> =
+        pending_points.into_iter().filter(|&(g, _)| group_class[g].is_none()).collect();
+    pending.sort_by_key(|x| x.0);
+    pending.dedup_by_key(|x| x.0);
+    if !pending.is_empty() {
+        let decided = decide_exactly(refined, &r.points, group, &pending, other, side)?;
+        for ((g, _), c) in pending.into_iter().zip(decided) {
+            group_class[g] = Some(c);
+        }
+    }
+    let group_class: Vec<Class> = group_class.into_iter().map(|c| c.unwrap_or(Class::Out)).collect();
+    Ok((0..refined.triangles.len())
+        .map(|t| on[t].or(own[t]).unwrap_or_else(|| group_class[group[t] as usize]))
+        .collect())
+}
+
+/// Grouped: one probe per group. Plain: one per off-surface triangle.
+fn probes(r: &Refinement, v: &SideView, grouping: Grouping) -> Vec<(u32, Probe)> {
+    let (side, refined, other) = (v.side, v.refined, v.other);
+    // The other mesh's triangles by their sorted vertex ids, built when first asked.
+    let by_vertices: OnceLock<Vec<([u32; 3], u32)>> = OnceLock::new();
+    let faces = |s: [u32; 3]| -> Option<u32> {
+        let list = by_vertices.get_or_init(|| {
+            let mut v: Vec<([u32; 3], u32)> = (0..other.triangles.len() as u32)
+                .map(|u| {
+                    let mut k = other.triangles[u as usize];
+                    k.sort_unstable();
+                    (k, u)
+                })
+                .collect();
+            v.par_sort_unstable();
+            v
+        });
+        let i = list.partition_point(|x| x.0 < s);
+        // One triangle over these vertices (two would be coincident faces).
+        match list.get(i..i + 2) {
+            Some([x, y]) if x.0 == s && y.0 == s => None,
+            _ => list.get(i).filter(|x| x.0 == s).map(|x| x.1),
+        }
+    };
+    match grouping {
+        Grouping::Grouped => group_probes(r, refined, v.group, v.count, other, side, &faces),
+        Grouping::Plain => (0..refined.triangles.len() as u32)
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&t| v.on[t as usize].is_none())
+            .map(|t| (t, probe(r, refined, t, other, side, &faces).unwrap_or(Probe::Centroid(t))))
+            .collect(),
+    }
 }
 
 /// How a group (or a triangle) is classified.

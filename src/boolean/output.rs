@@ -191,6 +191,11 @@ pub struct Finished {
 /// Checks (and repairs) the result triangles `tris` over `points`, whose ids from
 /// `first_new` on are intersection points. `changed[t]` is false for uncut input
 /// triangles; `diagonal` is the operands' bounding-box diagonal.
+///
+/// Points are welded by position; then, round by round until no triangle crosses
+/// another or has no area: snaps of nearby points, splits of neighbours across flat
+/// triangles, rebuilt pockets around crossings, collapses of short edges, and past the
+/// last round ulp moves. Flat shells are dropped at the end.
 pub fn finish(
     points: &[DVec3],
     first_new: u32,
@@ -198,8 +203,8 @@ pub fn finish(
     changed: &[bool],
     diagonal: f64,
 ) -> Result<Finished, InvalidResult> {
-    let mut repair = Repair::default();
     if tris.is_empty() {
+        let repair = Repair::default();
         return Ok(Finished {
             positions: points.to_vec(),
             triangles: Vec::new(),
@@ -207,171 +212,259 @@ pub fn finish(
             repair,
         });
     }
-    // Points are identified by position, as when the file is read back.
-    let weld = weld_by_position(points);
-    let mut soup = TriangleSoup {
-        positions: points.to_vec(),
-        triangles: tris.iter().map(|t| t.map(|v| weld[v as usize])).collect(),
-        face_of: (0..tris.len() as u32).collect(),
-        failed: Vec::new(),
-    };
-    let mut origin: Vec<u32> = (0..tris.len() as u32).collect();
-    let mut changed = changed.to_vec();
-    repair.tested = changed.iter().filter(|&&c| c).count();
-    let limit = COLLAPSE * diagonal;
-    let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-    let thickness = flat_thickness(max_abs, diagonal);
-    let is_new = |v: u32| v >= first_new;
-    let snap = snap_distance(max_abs);
+    let mut c = Cleanup::new(points, first_new, tris, changed, diagonal);
     // Welding is a collapse of edges of length zero: the same clean-up.
-    collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), &mut repair);
+    c.collapse(&HashMap::new());
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
     let mut nudges = 0;
     for round in 0.. {
-        let crossings = soup_self_intersections_near(&soup, &changed, usize::MAX);
-        let flat: Vec<usize> = (0..soup.triangles.len())
-            .into_par_iter()
-            .filter(|&t| changed[t] && is_degenerate(soup.triangle(t)))
-            .collect();
+        let (crossings, flat) = c.defects();
         if round == 0 {
-            repair.crossings = crossings.len();
-            repair.flat_triangles = flat.len();
+            c.repair.crossings = crossings.len();
+            c.repair.flat_triangles = flat.len();
         }
         if crossings.is_empty() && flat.is_empty() {
             break;
         }
-        if round < ROUNDS {
-            let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
-            let map = snap_map(&soup, corners, snap);
-            if !map.is_empty() {
-                for (&gone, &keep) in &map {
-                    let d = soup.positions[gone as usize].distance(soup.positions[keep as usize]);
-                    repair.moved = repair.moved.max(d);
-                }
-                repair.snapped += map.len();
-                collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
-                continue;
-            }
+        let more = round < ROUNDS;
+        if more && c.snap(&crossings, &flat) {
+            continue;
         }
-        // Per defect, the shortest collapsible edge of its triangles: (length, keep, gone).
-        let shortest = |faces: &[usize]| -> Option<(f64, u32, u32)> {
-            faces
-                .iter()
-                .flat_map(|&f| {
-                    let t = soup.triangles[f];
-                    (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
-                })
-                .filter(|&(p, q)| is_new(p) || is_new(q))
-                .map(|(p, q)| {
-                    let (keep, gone) = if !is_new(p) {
-                        (p, q)
-                    } else if !is_new(q) {
-                        (q, p)
-                    } else {
-                        (p.min(q), p.max(q))
-                    };
-                    (soup.positions[p as usize].distance(soup.positions[q as usize]), keep, gone)
-                })
-                .filter(|e| e.0 <= limit)
-                .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
-        };
-        let crossing = |&(a, b): &(usize, usize)| InvalidResult::Crossing {
-            a,
-            b,
-            near: soup.triangle(a).iter().sum::<DVec3>() / 3.0,
-        };
-        let flat_face = |&face: &usize| InvalidResult::Flat {
-            face,
-            near: soup.triangle(face).iter().sum::<DVec3>() / 3.0,
-        };
-        let mut edges = Vec::new();
-        let mut stuck = None;
-        let mut wide = Vec::new();
-        for c in &crossings {
-            match shortest(&[c.0, c.1]) {
-                Some(e) => edges.push(e),
-                None => {
-                    stuck = stuck.or_else(|| Some(crossing(c)));
-                    wide.push(*c);
-                }
-            }
+        let plan = c.plan(&crossings, &flat);
+        if more && (c.split_neighbours(&plan.long_flat) || c.rebuild_pockets(&plan.wide)) {
+            continue;
         }
-        let mut long_flat = Vec::new();
-        for &f in &flat {
-            match shortest(&[f]) {
-                Some(e) => edges.push(e),
-                None => long_flat.push(f),
-            }
-        }
-        // Flat triangles without a short edge: one corner lies on the opposite edge once
-        // rounded; the neighbour across that edge is split there instead, which covers the
-        // same area, and everything is checked again.
-        if !long_flat.is_empty() && round < ROUNDS {
-            let by_edge = edge_faces(&soup);
-            let mut gone = vec![false; soup.triangles.len()];
-            let mut added = Vec::new();
-            for &f in &long_flat {
-                if let Some((g, pieces)) =
-                    split_neighbour(&soup, &by_edge, f).filter(|x| !gone[f] && !gone[x.0])
-                {
-                    gone[f] = true;
-                    gone[g] = true;
-                    added.extend(pieces.map(|t| (t, origin[g])));
-                    repair.flipped += 1;
-                }
-            }
-            if gone.iter().any(|&g| g) {
-                replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
-                continue;
-            }
-        }
-        // Crossings without a short edge: the flat region around them is rebuilt without
-        // its sliver, and everything is checked again.
-        if !wide.is_empty() && round < ROUNDS {
-            let by_edge = edge_faces(&soup);
-            let mut gone = vec![false; soup.triangles.len()];
-            let mut added = Vec::new();
-            for &(a, b) in &wide {
-                if gone[a] || gone[b] {
-                    continue;
-                }
-                let Some(f) = flatten(&soup, &by_edge, &origin, a, thickness) else { continue };
-                if f.removed.iter().any(|&t| gone[t]) || !(f.removed.contains(&a) && f.removed.contains(&b)) {
-                    continue;
-                }
-                for &t in &f.removed {
-                    gone[t] = true;
-                }
-                repair.pockets += 1;
-                repair.pocket_triangles += f.removed.len();
-                added.extend(f.added);
-            }
-            if gone.iter().any(|&g| g) {
-                replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
-                continue;
-            }
-        }
-        // Shortest first; each point takes part in one collapse per round, and goes
-        // the way (onto either end when both are intersection points) after which the
-        // triangles around it cross the fewest others — if that is fewer than before.
         // Past the last round no collapse is planned: the ulp moves get their turn below.
-        if round >= ROUNDS {
-            edges.clear();
+        let map = if more { c.choose_collapses(plan.edges) } else { HashMap::new() };
+        if map.is_empty() {
+            let err = plan
+                .stuck
+                .or_else(|| crossings.first().map(|x| c.crossing(x)))
+                .unwrap_or_else(|| c.flat_face(flat[0]));
+            if nudges < ROUNDS && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.repair) {
+                nudges += 1;
+                continue;
+            }
+            return Err(err);
         }
+        c.collapse(&map);
+    }
+    c.finished()
+}
+
+/// The result triangles while [`finish`] repairs them: the soup, each triangle's origin
+/// and whether it changed, what was done, and the distances the repairs work within.
+struct Cleanup {
+    soup: TriangleSoup,
+    origin: Vec<u32>,
+    changed: Vec<bool>,
+    repair: Repair,
+    /// Ids from here on are intersection points (they may move; input points may not).
+    first_new: u32,
+    /// The longest edge a collapse may remove.
+    limit: f64,
+    /// How far from its plane a corner of a flat region may lie.
+    thickness: f64,
+    /// Points within this distance (per coordinate) of a defect's corner snap together.
+    snap: f64,
+}
+
+/// What one round found to do about the defects: short edges to collapse (length,
+/// keep, gone), crossings and flat triangles without one, and the error to give if
+/// nothing helps.
+struct Plan {
+    edges: Vec<(f64, u32, u32)>,
+    wide: Vec<(usize, usize)>,
+    long_flat: Vec<usize>,
+    stuck: Option<InvalidResult>,
+}
+
+impl Cleanup {
+    fn new(points: &[DVec3], first_new: u32, tris: &[[u32; 3]], changed: &[bool], diagonal: f64) -> Cleanup {
+        // Points are identified by position, as when the file is read back.
+        let weld = weld_by_position(points);
+        let soup = TriangleSoup {
+            positions: points.to_vec(),
+            triangles: tris.iter().map(|t| t.map(|v| weld[v as usize])).collect(),
+            face_of: (0..tris.len() as u32).collect(),
+            failed: Vec::new(),
+        };
+        let changed = changed.to_vec();
+        let repair = Repair { tested: changed.iter().filter(|&&c| c).count(), ..Repair::default() };
+        let max_abs = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        Cleanup {
+            soup,
+            origin: (0..tris.len() as u32).collect(),
+            changed,
+            repair,
+            first_new,
+            limit: COLLAPSE * diagonal,
+            thickness: flat_thickness(max_abs, diagonal),
+            snap: snap_distance(max_abs),
+        }
+    }
+
+    fn is_new(&self, v: u32) -> bool {
+        v >= self.first_new
+    }
+
+    /// The changed triangles that cross another, and those without area.
+    fn defects(&self) -> (Vec<(usize, usize)>, Vec<usize>) {
+        let crossings = soup_self_intersections_near(&self.soup, &self.changed, usize::MAX);
+        let flat: Vec<usize> = (0..self.soup.triangles.len())
+            .into_par_iter()
+            .filter(|&t| self.changed[t] && is_degenerate(self.soup.triangle(t)))
+            .collect();
+        (crossings, flat)
+    }
+
+    fn crossing(&self, &(a, b): &(usize, usize)) -> InvalidResult {
+        InvalidResult::Crossing { a, b, near: self.soup.triangle(a).iter().sum::<DVec3>() / 3.0 }
+    }
+
+    fn flat_face(&self, face: usize) -> InvalidResult {
+        InvalidResult::Flat { face, near: self.soup.triangle(face).iter().sum::<DVec3>() / 3.0 }
+    }
+
+    /// Snaps the points near the defects' corners together; true when any moved.
+    fn snap(&mut self, crossings: &[(usize, usize)], flat: &[usize]) -> bool {
+        let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
+        let map = snap_map(&self.soup, corners, self.snap);
+        if map.is_empty() {
+            return false;
+        }
+        for (&gone, &keep) in &map {
+            let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
+            self.repair.moved = self.repair.moved.max(d);
+        }
+        self.repair.snapped += map.len();
+        self.collapse(&map);
+        true
+    }
+
+    /// The shortest collapsible edge of `faces` (one end an intersection point, at most
+    /// `limit` long): (length, the end kept, the end that goes).
+    fn shortest_edge(&self, faces: &[usize]) -> Option<(f64, u32, u32)> {
+        faces
+            .iter()
+            .flat_map(|&f| {
+                let t = self.soup.triangles[f];
+                (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
+            })
+            .filter(|&(p, q)| self.is_new(p) || self.is_new(q))
+            .map(|(p, q)| {
+                let (keep, gone) = if !self.is_new(p) {
+                    (p, q)
+                } else if !self.is_new(q) {
+                    (q, p)
+                } else {
+                    (p.min(q), p.max(q))
+                };
+                (self.soup.positions[p as usize].distance(self.soup.positions[q as usize]), keep, gone)
+            })
+            .filter(|e| e.0 <= self.limit)
+            .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
+    }
+
+    /// Per defect, the shortest collapsible edge of its triangles, or the defect set
+    /// aside (with the first such crossing as the error to give).
+    fn plan(&self, crossings: &[(usize, usize)], flat: &[usize]) -> Plan {
+        let mut plan = Plan { edges: Vec::new(), wide: Vec::new(), long_flat: Vec::new(), stuck: None };
+        for c in crossings {
+            match self.shortest_edge(&[c.0, c.1]) {
+                Some(e) => plan.edges.push(e),
+                None => {
+                    plan.stuck = plan.stuck.or_else(|| Some(self.crossing(c)));
+                    plan.wide.push(*c);
+                }
+            }
+        }
+        for &f in flat {
+            match self.shortest_edge(&[f]) {
+                Some(e) => plan.edges.push(e),
+                None => plan.long_flat.push(f),
+            }
+        }
+        plan
+    }
+
+    /// Flat triangles without a short edge: one corner lies on the opposite edge once
+    /// rounded; the neighbour across that edge is split there instead, which covers the
+    /// same area. True when any was split (everything is checked again).
+    fn split_neighbours(&mut self, long_flat: &[usize]) -> bool {
+        if long_flat.is_empty() {
+            return false;
+        }
+        let by_edge = edge_faces(&self.soup);
+        let mut gone = vec![false; self.soup.triangles.len()];
+        let mut added = Vec::new();
+        for &f in long_flat {
+            if let Some((g, pieces)) =
+                split_neighbour(&self.soup, &by_edge, f).filter(|x| !gone[f] && !gone[x.0])
+            {
+                gone[f] = true;
+                gone[g] = true;
+                added.extend(pieces.map(|t| (t, self.origin[g])));
+                self.repair.flipped += 1;
+            }
+        }
+        self.replace(&gone, added)
+    }
+
+    /// Crossings without a short edge: the flat region around them is rebuilt without
+    /// its sliver. True when any was (everything is checked again).
+    fn rebuild_pockets(&mut self, wide: &[(usize, usize)]) -> bool {
+        if wide.is_empty() {
+            return false;
+        }
+        let by_edge = edge_faces(&self.soup);
+        let mut gone = vec![false; self.soup.triangles.len()];
+        let mut added = Vec::new();
+        for &(a, b) in wide {
+            if gone[a] || gone[b] {
+                continue;
+            }
+            let Some(f) = flatten(&self.soup, &by_edge, &self.origin, a, self.thickness) else { continue };
+            if f.removed.iter().any(|&t| gone[t]) || !(f.removed.contains(&a) && f.removed.contains(&b)) {
+                continue;
+            }
+            for &t in &f.removed {
+                gone[t] = true;
+            }
+            self.repair.pockets += 1;
+            self.repair.pocket_triangles += f.removed.len();
+            added.extend(f.added);
+        }
+        self.replace(&gone, added)
+    }
+
+    /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
+    fn replace(&mut self, gone: &[bool], added: Vec<([u32; 3], u32)>) -> bool {
+        if !gone.iter().any(|&g| g) {
+            return false;
+        }
+        replace_marked(&mut self.soup, &mut self.origin, &mut self.changed, gone, added);
+        true
+    }
+
+    /// The collapses of one round, shortest edge first: each point takes part in one,
+    /// and goes the way (onto either end when both are intersection points) after which
+    /// the triangles around it cross the fewest others — if that is fewer than before.
+    fn choose_collapses(&mut self, mut edges: Vec<(f64, u32, u32)>) -> HashMap<u32, u32> {
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         let mut map: HashMap<u32, u32> = HashMap::new();
         let mut busy = std::collections::HashSet::new();
-        let boxes = if edges.is_empty() { Vec::new() } else { soup.boxes() };
+        let boxes = if edges.is_empty() { Vec::new() } else { self.soup.boxes() };
         for (length, keep, gone) in edges {
             if busy.contains(&keep) || busy.contains(&gone) {
                 continue;
             }
             let ways: &[(u32, u32)] =
-                if is_new(keep) { &[(keep, gone), (gone, keep)] } else { &[(keep, gone)] };
+                if self.is_new(keep) { &[(keep, gone), (gone, keep)] } else { &[(keep, gone)] };
             let Some((_, keep, gone)) = ways
                 .iter()
                 .filter_map(|&(keep, gone)| {
-                    let (before, after) = local_crossings(&soup, &boxes, keep, gone);
+                    let (before, after) = local_crossings(&self.soup, &boxes, keep, gone);
                     (after < before).then_some((after, keep, gone))
                 })
                 .min_by_key(|w| w.0)
@@ -381,29 +474,33 @@ pub fn finish(
             busy.insert(keep);
             busy.insert(gone);
             map.insert(gone, keep);
-            repair.collapsed_edges += 1;
-            repair.moved = repair.moved.max(length);
+            self.repair.collapsed_edges += 1;
+            self.repair.moved = self.repair.moved.max(length);
         }
-        if map.is_empty() {
-            let err =
-                stuck.or_else(|| crossings.first().map(crossing)).unwrap_or_else(|| flat_face(&flat[0]));
-            if nudges < ROUNDS && nudge(&mut soup, &crossings, &flat, first_new, &mut repair) {
-                nudges += 1;
-                continue;
-            }
-            return Err(err);
+        map
+    }
+
+    fn collapse(&mut self, map: &HashMap<u32, u32>) {
+        collapse(&mut self.soup, &mut self.origin, &mut self.changed, map, &mut self.repair);
+    }
+
+    /// The repaired triangles in their origins' order, flat shells dropped.
+    fn finished(mut self) -> Result<Finished, InvalidResult> {
+        if self.repair.pockets > 0 {
+            // Rebuilt triangles go back among those of their origin: A's faces first.
+            let mut order: Vec<usize> = (0..self.origin.len()).collect();
+            order.sort_by_key(|&k| self.origin[k]);
+            self.soup.triangles = order.iter().map(|&k| self.soup.triangles[k]).collect();
+            self.origin = order.iter().map(|&k| self.origin[k]).collect();
         }
-        collapse(&mut soup, &mut origin, &mut changed, &map, &mut repair);
+        drop_flat_shells(&mut self.soup, &mut self.origin, &mut self.repair)?;
+        Ok(Finished {
+            positions: self.soup.positions,
+            triangles: self.soup.triangles,
+            origin: self.origin,
+            repair: self.repair,
+        })
     }
-    if repair.pockets > 0 {
-        // Rebuilt triangles go back among those of their origin: A's faces first.
-        let mut order: Vec<usize> = (0..origin.len()).collect();
-        order.sort_by_key(|&k| origin[k]);
-        soup.triangles = order.iter().map(|&k| soup.triangles[k]).collect();
-        origin = order.iter().map(|&k| origin[k]).collect();
-    }
-    drop_flat_shells(&mut soup, &mut origin, &mut repair)?;
-    Ok(Finished { positions: soup.positions, triangles: soup.triangles, origin, repair })
 }
 
 /// The snaps for the corners of `faces`: every point of the soup within `snap` (per

@@ -237,7 +237,10 @@ impl EdgePoints {
     }
 }
 
-/// Refines the triangles of A and B against each other (§6.4).
+/// Refines the triangles of A and B against each other (§6.4): the pairs that meet
+/// (step 1), one id per intersection key (step 2) and its exact point, the points on
+/// each mesh's edges and inside its triangles, the segments per triangle and the cut
+/// curve, then each side re-triangulated.
 pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineError> {
     let exact_before = implicit::exact_signs();
     let ops = Operands {
@@ -246,76 +249,14 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
         b_positions: &b.positions,
         b_triangles: &b.triangles,
     };
-    let (a_boxes, b_boxes) = rayon::join(|| a.boxes(), || b.boxes());
-    let pairs = candidate_pairs(&a_boxes, &b_boxes);
-    let meetings: Vec<(u32, u32, Meeting)> = pairs
-        .par_iter()
-        .with_min_len(512)
-        .filter_map(|&(t, u)| match meet(&ops, t, u) {
-            Meeting::Apart => None,
-            m => Some((t, u, m)),
-        })
-        .collect();
-    let mut stats = RefineStats {
-        candidate_pairs: pairs.len(),
-        meeting_pairs: meetings.len(),
-        coplanar_pairs: meetings.iter().filter(|m| matches!(m.2, Meeting::Coplanar { .. })).count(),
-        ..RefineStats::default()
-    };
-    drop(pairs);
-
-    // Step 2: one id per key.
-    let mut keys: Vec<Key> = Vec::with_capacity(2 * meetings.len());
-    for (_, _, m) in &meetings {
-        match m {
-            Meeting::Apart => {}
-            Meeting::Point(k) => keys.push(*k),
-            Meeting::Segment(s) => keys.extend_from_slice(s),
-            Meeting::Coplanar { in_a, in_b, points, .. } => {
-                keys.extend(in_a.iter().flatten());
-                keys.extend(in_b.iter().flatten());
-                keys.extend_from_slice(points);
-            }
-        }
-    }
-    keys.par_sort_unstable();
-    keys.dedup();
-    let na = a.positions.len() as u32;
-    let nb = b.positions.len() as u32;
-    let mut b_alias: Vec<u32> = (0..nb).map(|v| na + v).collect();
-    let mut ids = Vec::with_capacity(keys.len());
-    let mut new_keys = Vec::new();
-    let mut vertex_keys = Vec::new();
-    // Keys naming a vertex of A come first (`Simplex` orders vertices first), so a vertex
-    // of B exactly at a vertex of A is aliased before any other key names it.
-    for k in &keys {
-        let id = match (k.a, k.b) {
-            (Simplex::Vertex(va), Simplex::Vertex(vb)) => {
-                b_alias[vb as usize] = va;
-                va
-            }
-            (Simplex::Vertex(va), _) => va,
-            (_, Simplex::Vertex(vb)) => b_alias[vb as usize],
-            _ => {
-                new_keys.push(*k);
-                na + nb + new_keys.len() as u32 - 1
-            }
-        };
-        if id < na + nb {
-            vertex_keys.push((id, *k));
-        }
-        ids.push(id);
-    }
-    vertex_keys.sort_unstable_by_key(|x| x.0);
-    vertex_keys.dedup_by_key(|x| x.0);
+    let (meetings, mut stats) = meetings(&ops, a, b);
+    let keys = meeting_keys(&meetings);
+    let (na, nb) = (a.positions.len() as u32, b.positions.len() as u32);
+    let KeyIds { ids, new_keys, vertex_keys, b_alias } = KeyIds::assign(&keys, na, nb);
     // B's welded ids → point ids (aliased onto A's coincident vertices).
     let b_id = |v: u32| b_alias[v as usize];
     let first = na + nb;
-    let implicit: Vec<Option<Point>> = new_keys.par_iter().with_min_len(256).map(|k| k.point(&ops)).collect();
-    if let Some(k) = implicit.iter().position(Option::is_none) {
-        return Err(RefineError::Point { key: new_keys[k] });
-    }
-    let implicit: Vec<Point> = implicit.into_iter().flatten().collect();
+    let implicit = implicit_points(&ops, &new_keys)?;
     stats.new_points = implicit.len();
     let mut points = Vec::with_capacity(first as usize + implicit.len());
     points.extend_from_slice(&a.positions);
@@ -326,63 +267,16 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     let point = |id: u32| point_of(&points, first, &implicit, id);
 
     // Points on edges and inside triangles, per mesh: exactly where their keys say.
-    let mut a_edge_entries = Vec::new();
-    let mut b_edge_entries = Vec::new();
-    let mut a_inside: Vec<(u32, u32)> = Vec::new();
-    let mut b_inside: Vec<(u32, u32)> = Vec::new();
-    for (k, &id) in keys.iter().zip(&ids) {
-        match k.a {
-            Simplex::Edge(p, q) => a_edge_entries.push(((p, q), id)),
-            Simplex::Face(t) => a_inside.push((t, id)),
-            Simplex::Vertex(_) => {}
-        }
-        match k.b {
-            Simplex::Edge(p, q) => b_edge_entries.push(((p, q), id)),
-            Simplex::Face(u) => b_inside.push((u, id)),
-            Simplex::Vertex(_) => {}
-        }
-    }
-    a_inside.sort_unstable();
-    b_inside.par_sort_unstable();
+    let (a_edge_entries, a_inside) = on_simplices(&keys, &ids, |k| k.a);
+    let (b_edge_entries, b_inside) = on_simplices(&keys, &ids, |k| k.b);
     let (a_edges, b_edges) = rayon::join(
         || EdgePoints::build(a_edge_entries, &a.positions, &point),
         || EdgePoints::build(b_edge_entries, &b.positions, &point),
     );
-
     let id_of =
         |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
-
-    // Segments per triangle, and the cut curve.
-    let mut a_segments = Vec::new();
-    let mut b_segments = Vec::new();
-    let mut coplanar = Vec::new();
-    for (t, u, m) in &meetings {
-        match m {
-            Meeting::Segment(s) => {
-                a_segments.push(TriangleSegment { triangle: *t, ends: *s });
-                b_segments.push(TriangleSegment { triangle: *u, ends: *s });
-            }
-            Meeting::Coplanar { in_a, in_b, same, .. } => {
-                a_segments.extend(in_a.iter().map(|s| TriangleSegment { triangle: *t, ends: *s }));
-                b_segments.extend(in_b.iter().map(|s| TriangleSegment { triangle: *u, ends: *s }));
-                coplanar.push((*t, *u, *same));
-            }
-            _ => {}
-        }
-    }
-    drop(meetings);
-    coplanar.sort_unstable_by_key(|c| (c.0, c.1));
-    let mut curve: Vec<[u32; 2]> = a_segments
-        .iter()
-        .chain(&b_segments)
-        .map(|s| {
-            let (x, y) = (id_of(&s.ends[0]), id_of(&s.ends[1]));
-            [x.min(y), x.max(y)]
-        })
-        .filter(|[x, y]| x != y)
-        .collect();
-    curve.par_sort_unstable();
-    curve.dedup();
+    let (a_segments, b_segments, coplanar) = segments(meetings);
+    let curve = cut_curve(&a_segments, &b_segments, &id_of);
 
     let a_input = SideInput { side: Side::A, soup: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
     let b_input = SideInput { side: Side::B, soup: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
@@ -412,6 +306,169 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
         coplanar,
         stats,
     })
+}
+
+/// Step 1: the candidate pairs of A's and B's triangles (boxes that meet) and how each
+/// pair that does meet meets; the statistics counted so far.
+fn meetings(ops: &Operands, a: &TriangleSoup, b: &TriangleSoup) -> (Vec<(u32, u32, Meeting)>, RefineStats) {
+    let (a_boxes, b_boxes) = rayon::join(|| a.boxes(), || b.boxes());
+    let pairs = candidate_pairs(&a_boxes, &b_boxes);
+    let meetings: Vec<(u32, u32, Meeting)> = pairs
+        .par_iter()
+        .with_min_len(512)
+        .filter_map(|&(t, u)| match meet(ops, t, u) {
+            Meeting::Apart => None,
+            m => Some((t, u, m)),
+        })
+        .collect();
+    let stats = RefineStats {
+        candidate_pairs: pairs.len(),
+        meeting_pairs: meetings.len(),
+        coplanar_pairs: meetings.iter().filter(|m| matches!(m.2, Meeting::Coplanar { .. })).count(),
+        ..RefineStats::default()
+    };
+    (meetings, stats)
+}
+
+/// Every key the meetings name, sorted, once.
+fn meeting_keys(meetings: &[(u32, u32, Meeting)]) -> Vec<Key> {
+    let mut keys: Vec<Key> = Vec::with_capacity(2 * meetings.len());
+    for (_, _, m) in meetings {
+        match m {
+            Meeting::Apart => {}
+            Meeting::Point(k) => keys.push(*k),
+            Meeting::Segment(s) => keys.extend_from_slice(s),
+            Meeting::Coplanar { in_a, in_b, points, .. } => {
+                keys.extend(in_a.iter().flatten());
+                keys.extend(in_b.iter().flatten());
+                keys.extend_from_slice(points);
+            }
+        }
+    }
+    keys.par_sort_unstable();
+    keys.dedup();
+    keys
+}
+
+/// Step 2: one point id per key.
+struct KeyIds {
+    /// The id of each key, in the keys' order.
+    ids: Vec<u32>,
+    /// The keys of new points (neither operand's vertex), id `na + nb + k` for the k-th.
+    new_keys: Vec<Key>,
+    /// Input vertices on the other surface: (point id, its key), sorted by id, once.
+    vertex_keys: Vec<(u32, Key)>,
+    /// B's vertex ids → point ids: `na + v`, or A's vertex at the same place.
+    b_alias: Vec<u32>,
+}
+
+impl KeyIds {
+    /// Keys naming a vertex of A come first (`Simplex` orders vertices first), so a vertex
+    /// of B exactly at a vertex of A is aliased before any other key names it.
+    fn assign(keys: &[Key], na: u32, nb: u32) -> KeyIds {
+        let mut b_alias: Vec<u32> = (0..nb).map(|v| na + v).collect();
+        let mut ids = Vec::with_capacity(keys.len());
+        let mut new_keys = Vec::new();
+        let mut vertex_keys = Vec::new();
+        for k in keys {
+            let id = match (k.a, k.b) {
+                (Simplex::Vertex(va), Simplex::Vertex(vb)) => {
+                    b_alias[vb as usize] = va;
+                    va
+                }
+                (Simplex::Vertex(va), _) => va,
+                (_, Simplex::Vertex(vb)) => b_alias[vb as usize],
+                _ => {
+                    new_keys.push(*k);
+                    na + nb + new_keys.len() as u32 - 1
+                }
+            };
+            if id < na + nb {
+                vertex_keys.push((id, *k));
+            }
+            ids.push(id);
+        }
+        vertex_keys.sort_unstable_by_key(|x| x.0);
+        vertex_keys.dedup_by_key(|x| x.0);
+        KeyIds { ids, new_keys, vertex_keys, b_alias }
+    }
+}
+
+/// The exact point of every new key.
+fn implicit_points(ops: &Operands, new_keys: &[Key]) -> Result<Vec<Point>, RefineError> {
+    let implicit: Vec<Option<Point>> = new_keys.par_iter().with_min_len(256).map(|k| k.point(ops)).collect();
+    if let Some(k) = implicit.iter().position(Option::is_none) {
+        return Err(RefineError::Point { key: new_keys[k] });
+    }
+    Ok(implicit.into_iter().flatten().collect())
+}
+
+/// (edge, point id) of the points inside a mesh's edges.
+type EdgeEntries = Vec<((u32, u32), u32)>;
+
+/// Where the points lie on one mesh (`simplex`: the key's simplex of that mesh): the
+/// (edge, id) of points inside its edges, and the (triangle, id) of points inside its
+/// triangles, sorted.
+fn on_simplices(
+    keys: &[Key],
+    ids: &[u32],
+    simplex: impl Fn(&Key) -> Simplex,
+) -> (EdgeEntries, Vec<(u32, u32)>) {
+    let mut edge_entries = Vec::new();
+    let mut inside: Vec<(u32, u32)> = Vec::new();
+    for (k, &id) in keys.iter().zip(ids) {
+        match simplex(k) {
+            Simplex::Edge(p, q) => edge_entries.push(((p, q), id)),
+            Simplex::Face(t) => inside.push((t, id)),
+            Simplex::Vertex(_) => {}
+        }
+    }
+    inside.par_sort_unstable();
+    (edge_entries, inside)
+}
+
+/// The segments of A's triangles and of B's where they meet, and the coplanar pairs
+/// (A's triangle, B's, same orientation) sorted.
+#[allow(clippy::type_complexity)]
+fn segments(
+    meetings: Vec<(u32, u32, Meeting)>,
+) -> (Vec<TriangleSegment>, Vec<TriangleSegment>, Vec<(u32, u32, bool)>) {
+    let mut a_segments = Vec::new();
+    let mut b_segments = Vec::new();
+    let mut coplanar = Vec::new();
+    for (t, u, m) in &meetings {
+        match m {
+            Meeting::Segment(s) => {
+                a_segments.push(TriangleSegment { triangle: *t, ends: *s });
+                b_segments.push(TriangleSegment { triangle: *u, ends: *s });
+            }
+            Meeting::Coplanar { in_a, in_b, same, .. } => {
+                a_segments.extend(in_a.iter().map(|s| TriangleSegment { triangle: *t, ends: *s }));
+                b_segments.extend(in_b.iter().map(|s| TriangleSegment { triangle: *u, ends: *s }));
+                coplanar.push((*t, *u, *same));
+            }
+            _ => {}
+        }
+    }
+    drop(meetings);
+    coplanar.sort_unstable_by_key(|c| (c.0, c.1));
+    (a_segments, b_segments, coplanar)
+}
+
+/// The cut curve: every segment as a sorted pair of distinct point ids, once.
+fn cut_curve(a: &[TriangleSegment], b: &[TriangleSegment], id_of: &dyn Fn(&Key) -> u32) -> Vec<[u32; 2]> {
+    let mut curve: Vec<[u32; 2]> = a
+        .iter()
+        .chain(b)
+        .map(|s| {
+            let (x, y) = (id_of(&s.ends[0]), id_of(&s.ends[1]));
+            [x.min(y), x.max(y)]
+        })
+        .filter(|[x, y]| x != y)
+        .collect();
+    curve.par_sort_unstable();
+    curve.dedup();
+    curve
 }
 
 /// What refining one side needs to know about it.

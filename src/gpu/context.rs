@@ -502,6 +502,118 @@ impl Drop for Partial<'_> {
     }
 }
 
+impl<'a> PendingSurface<'a> {
+    /// The surface of `window` on `display`.
+    fn new(
+        inst: &'a Instance,
+        display: raw_window_handle::RawDisplayHandle,
+        window: raw_window_handle::RawWindowHandle,
+    ) -> Result<PendingSurface<'a>> {
+        // SAFETY: the handles come from a live window the caller keeps open while the
+        // surface exists.
+        let raw = unsafe { ash_window::create_surface(&inst.entry, &inst.raw, display, window, None) }
+            .vk("vkCreate…SurfaceKHR")?;
+        Ok(PendingSurface { inst, loader: ash::khr::surface::Instance::new(&inst.entry, &inst.raw), raw })
+    }
+}
+
+/// The first queue family of `physical` with graphics that (with a surface) presents to it.
+fn graphics_queue_family(
+    inst: &Instance,
+    physical: vk::PhysicalDevice,
+    info: &DeviceInfo,
+    surface: Option<&PendingSurface>,
+) -> Result<u32> {
+    // SAFETY: valid physical device.
+    let families = unsafe { inst.raw.get_physical_device_queue_family_properties(physical) };
+    let presents = |i: usize| match surface {
+        // SAFETY: valid physical device, family index and surface.
+        Some(p) => unsafe { p.loader.get_physical_device_surface_support(physical, i as u32, p.raw) }
+            .unwrap_or(false),
+        None => true,
+    };
+    let family = (0..families.len())
+        .find(|&i| families[i].queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
+        .ok_or_else(|| {
+            GpuError::NoDevice(format!(
+                "device '{}' has no graphics queue{}",
+                info.name,
+                if surface.is_some() { " that presents to this window" } else { "" }
+            ))
+        })?;
+    Ok(family as u32)
+}
+
+/// The logical device: one queue of `queue_family`, the features texgeo uses (logic op
+/// and f64 where the device has them, dynamic rendering, synchronization2), push
+/// descriptors, and the swapchain when it presents.
+fn create_device(
+    inst: &Instance,
+    physical: vk::PhysicalDevice,
+    info: &DeviceInfo,
+    queue_family: u32,
+    presents: bool,
+) -> Result<ash::Device> {
+    let priorities = [1.0];
+    let queue_info =
+        [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+    let features = vk::PhysicalDeviceFeatures::default()
+        .logic_op(info.logic_op)
+        .shader_float64(info.float64)
+        .independent_blend(true);
+    let mut f13 =
+        vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+    let mut extensions = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+    if presents {
+        extensions.push(ash::khr::swapchain::NAME.as_ptr());
+    }
+    let device_info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queue_info)
+        .enabled_extension_names(&extensions)
+        .enabled_features(&features)
+        .push_next(&mut f13);
+    // SAFETY: all pointers in device_info outlive the call.
+    unsafe { inst.raw.create_device(physical, &device_info, None) }.vk("vkCreateDevice")
+}
+
+/// The command pool, the nearest-texel sampler and the allocator every pass of the
+/// device `raw` shares; `raw` is destroyed if one of them cannot be made.
+fn shared_objects(
+    inst: &Instance,
+    physical: vk::PhysicalDevice,
+    raw: &ash::Device,
+    queue_family: u32,
+) -> Result<(vk::CommandPool, vk::Sampler, Allocator)> {
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(queue_family)
+        .flags(vk::CommandPoolCreateFlags::TRANSIENT | vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+    let sampler_info = vk::SamplerCreateInfo::default()
+        .mag_filter(vk::Filter::NEAREST)
+        .min_filter(vk::Filter::NEAREST)
+        .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+        .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+    // Leaks are reported by `Device::drop` itself, loudly (gpu-allocator would only log).
+    let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
+    debug_settings.log_leaks_on_shutdown = false;
+    let mut partial = Partial { raw, pool: vk::CommandPool::null(), sampler: vk::Sampler::null() };
+    // SAFETY: valid device and create infos; `partial` destroys what exists if a step fails.
+    partial.pool = unsafe { raw.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+    // SAFETY: as above.
+    partial.sampler = unsafe { raw.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
+    let allocator = Allocator::new(&AllocatorCreateDesc {
+        instance: inst.raw.clone(),
+        device: raw.clone(),
+        physical_device: physical,
+        debug_settings,
+        buffer_device_address: false,
+        allocation_sizes: Default::default(),
+    })?;
+    let (pool, sampler) = partial.keep();
+    Ok((pool, sampler, allocator))
+}
+
 impl Context {
     /// Opens the device `options` ask for (defaults: `TEXGEO_DEVICE`, `TEXGEO_VALIDATION`).
     pub fn new(options: &ContextOptions) -> Result<Context> {
@@ -522,6 +634,10 @@ impl Context {
         Ok((ctx.clone(), super::present::Surface::new(&ctx, loader, raw)))
     }
 
+    /// The instance (with the window's surface extensions), the window's surface, the
+    /// physical device, a graphics queue family (that presents to the surface), the
+    /// logical device and what every pass shares (command pool, sampler, allocator,
+    /// pipeline cache); then the validation messages so far are checked.
     #[allow(clippy::type_complexity)]
     fn create(
         options: &ContextOptions,
@@ -534,90 +650,14 @@ impl Context {
             None => &[],
         };
         let inst = Instance::new(validate, surface_extensions)?;
-        let mut pending = match window {
-            Some((display, handle)) => {
-                // SAFETY: the handles come from a live window the caller keeps open while
-                // the surface exists.
-                let raw =
-                    unsafe { ash_window::create_surface(&inst.entry, &inst.raw, display, handle, None) }
-                        .vk("vkCreate…SurfaceKHR")?;
-                Some(PendingSurface {
-                    inst: &inst,
-                    loader: ash::khr::surface::Instance::new(&inst.entry, &inst.raw),
-                    raw,
-                })
-            }
-            None => None,
-        };
+        let mut pending =
+            window.map(|(display, handle)| PendingSurface::new(&inst, display, handle)).transpose()?;
         let (physical, info) = choose(&inst.raw, &options.device)?;
-
-        // SAFETY: valid physical device.
-        let families = unsafe { inst.raw.get_physical_device_queue_family_properties(physical) };
-        let presents = |i: usize| match &pending {
-            // SAFETY: valid physical device, family index and surface.
-            Some(p) => unsafe { p.loader.get_physical_device_surface_support(physical, i as u32, p.raw) }
-                .unwrap_or(false),
-            None => true,
-        };
-        let queue_family = (0..families.len())
-            .find(|&i| families[i].queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
-            .ok_or_else(|| {
-                GpuError::NoDevice(format!(
-                    "device '{}' has no graphics queue{}",
-                    info.name,
-                    if pending.is_some() { " that presents to this window" } else { "" }
-                ))
-            })? as u32;
-        let priorities = [1.0];
-        let queue_info = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family)
-            .queue_priorities(&priorities)];
-        let features = vk::PhysicalDeviceFeatures::default()
-            .logic_op(info.logic_op)
-            .shader_float64(info.float64)
-            .independent_blend(true);
-        let mut f13 =
-            vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
-        let mut extensions = vec![ash::khr::push_descriptor::NAME.as_ptr()];
-        if pending.is_some() {
-            extensions.push(ash::khr::swapchain::NAME.as_ptr());
-        }
-        let device_info = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&queue_info)
-            .enabled_extension_names(&extensions)
-            .enabled_features(&features)
-            .push_next(&mut f13);
-        // SAFETY: all pointers in device_info outlive the call.
-        let raw = unsafe { inst.raw.create_device(physical, &device_info, None) }.vk("vkCreateDevice")?;
+        let queue_family = graphics_queue_family(&inst, physical, &info, pending.as_ref())?;
+        let raw = create_device(&inst, physical, &info, queue_family, pending.is_some())?;
         // SAFETY: the queue family and index exist (created above).
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::TRANSIENT | vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let sampler_info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::NEAREST)
-            .min_filter(vk::Filter::NEAREST)
-            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
-            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
-        // Leaks are reported by `Device::drop` itself, loudly (gpu-allocator would only log).
-        let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
-        debug_settings.log_leaks_on_shutdown = false;
-        let mut partial = Partial { raw: &raw, pool: vk::CommandPool::null(), sampler: vk::Sampler::null() };
-        // SAFETY: valid device and create infos; `partial` destroys what exists if a step fails.
-        partial.pool = unsafe { raw.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
-        // SAFETY: as above.
-        partial.sampler = unsafe { raw.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: inst.raw.clone(),
-            device: raw.clone(),
-            physical_device: physical,
-            debug_settings,
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        })?;
-        let (command_pool, sampler) = partial.keep();
+        let (command_pool, sampler, allocator) = shared_objects(&inst, physical, &raw, queue_family)?;
         let push_descriptor = ash::khr::push_descriptor::Device::new(&inst.raw, &raw);
         // SAFETY: valid physical device.
         let props = unsafe { inst.raw.get_physical_device_properties(physical) };

@@ -357,6 +357,48 @@ impl<'d> Recorder<'d> {
         let first = targets.colour.first().ok_or(GpuError::Internal("a render pass without a target"))?;
         let area = area.unwrap_or([0, 0, first.texture.width(), first.texture.height()]);
         let samples = first.texture.samples();
+        self.check_targets(&targets, area, reads)?;
+        for r in reads {
+            self.check(r)?;
+            self.use_texture(r, Use::Sampled);
+        }
+        let infos = self.colour_attachments(&targets)?;
+        let depth_info = match &targets.depth {
+            Some(d) => Some(self.depth_attachment(d)?),
+            None => None,
+        };
+        let rect = vk::Rect2D {
+            offset: vk::Offset2D { x: area[0] as i32, y: area[1] as i32 },
+            extent: vk::Extent2D { width: area[2], height: area[3] },
+        };
+        let mut info =
+            vk::RenderingInfo::default().render_area(rect).layer_count(1).color_attachments(&infos);
+        if let Some(d) = &depth_info {
+            info = info.depth_attachment(d);
+        }
+        // SAFETY: attachments transitioned above; they outlive the submission.
+        unsafe { self.dev.raw.cmd_begin_rendering(self.cmd, &info) };
+        let mut scope = RenderScope {
+            dev: self.dev,
+            cmd: self.cmd,
+            area,
+            targets: targets.colour,
+            depth: targets.depth.map(|d| d.texture.format()),
+            samples,
+            reads,
+            pipeline: None,
+        };
+        let result = draw(&mut scope);
+        // SAFETY: matches the begin above, also when `draw` failed.
+        unsafe { self.dev.raw.cmd_end_rendering(self.cmd) };
+        result
+    }
+
+    /// Refuses targets a pass cannot render into: each must belong to this device, fit
+    /// `area` and not be read in the pass; colour targets share one sample count, resolve
+    /// targets match them one to one, the depth target has their sample count.
+    fn check_targets(&self, targets: &Targets, area: Rect, reads: &[&Texture]) -> Result<()> {
+        let samples = targets.colour.first().map_or(1, |a| a.texture.samples());
         let fits = |t: &Texture| {
             let [x, y, w, h] = area;
             if x + w > t.width() || y + h > t.height() || w == 0 || h == 0 {
@@ -412,17 +454,11 @@ impl<'d> Recorder<'d> {
                 )));
             }
         }
-        for r in reads {
-            self.check(r)?;
-            self.use_texture(r, Use::Sampled);
-        }
-        let load_op = |load: Load| match load {
-            Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearColorValue::default()),
-            Load::Zero => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: [0; 4] }),
-            Load::Float(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { float32: v }),
-            Load::Uint(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: v }),
-            Load::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ClearColorValue::default()),
-        };
+        Ok(())
+    }
+
+    /// The colour attachments, each resolved into its resolve target if it has one.
+    fn colour_attachments(&mut self, targets: &Targets) -> Result<Vec<vk::RenderingAttachmentInfo<'static>>> {
         let mut infos = Vec::with_capacity(targets.colour.len());
         for (i, a) in targets.colour.iter().enumerate() {
             self.use_texture(a.texture, Use::Attachment);
@@ -442,50 +478,34 @@ impl<'d> Recorder<'d> {
             }
             infos.push(info);
         }
-        let depth_info = match &targets.depth {
-            Some(d) => {
-                self.use_texture(d.texture, Use::Depth);
-                let (op, clear) = load_op(d.load);
-                // SAFETY: every Load variant writes the first four bytes of the union.
-                let value = unsafe { clear.float32[0] };
-                Some(
-                    vk::RenderingAttachmentInfo::default()
-                        .image_view(d.texture.target_view(0)?)
-                        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                        .load_op(op)
-                        .store_op(vk::AttachmentStoreOp::STORE)
-                        .clear_value(vk::ClearValue {
-                            depth_stencil: vk::ClearDepthStencilValue { depth: value, stencil: 0 },
-                        }),
-                )
-            }
-            None => None,
-        };
-        let rect = vk::Rect2D {
-            offset: vk::Offset2D { x: area[0] as i32, y: area[1] as i32 },
-            extent: vk::Extent2D { width: area[2], height: area[3] },
-        };
-        let mut info =
-            vk::RenderingInfo::default().render_area(rect).layer_count(1).color_attachments(&infos);
-        if let Some(d) = &depth_info {
-            info = info.depth_attachment(d);
-        }
-        // SAFETY: attachments transitioned above; they outlive the submission.
-        unsafe { self.dev.raw.cmd_begin_rendering(self.cmd, &info) };
-        let mut scope = RenderScope {
-            dev: self.dev,
-            cmd: self.cmd,
-            area,
-            targets: targets.colour,
-            depth: targets.depth.map(|d| d.texture.format()),
-            samples,
-            reads,
-            pipeline: None,
-        };
-        let result = draw(&mut scope);
-        // SAFETY: matches the begin above, also when `draw` failed.
-        unsafe { self.dev.raw.cmd_end_rendering(self.cmd) };
-        result
+        Ok(infos)
+    }
+
+    /// The depth attachment (`Load::Float([d, ..])` clears it to d).
+    fn depth_attachment(&mut self, d: &Attachment) -> Result<vk::RenderingAttachmentInfo<'static>> {
+        self.use_texture(d.texture, Use::Depth);
+        let (op, clear) = load_op(d.load);
+        // SAFETY: every Load variant writes the first four bytes of the union.
+        let value = unsafe { clear.float32[0] };
+        Ok(vk::RenderingAttachmentInfo::default()
+            .image_view(d.texture.target_view(0)?)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(op)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue { depth: value, stencil: 0 },
+            }))
+    }
+}
+
+/// The load operation and clear value of `load`.
+fn load_op(load: Load) -> (vk::AttachmentLoadOp, vk::ClearColorValue) {
+    match load {
+        Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearColorValue::default()),
+        Load::Zero => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: [0; 4] }),
+        Load::Float(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { float32: v }),
+        Load::Uint(v) => (vk::AttachmentLoadOp::CLEAR, vk::ClearColorValue { uint32: v }),
+        Load::Discard => (vk::AttachmentLoadOp::DONT_CARE, vk::ClearColorValue::default()),
     }
 }
 

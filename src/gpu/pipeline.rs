@@ -225,95 +225,107 @@ fn vertex_inputs(shader: &Shader, r: &Reflection) -> Result<Vec<VertexInput>> {
     Ok(inputs)
 }
 
-impl Pipeline {
-    pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<Pipeline> {
-        Pipeline::with_raster(ctx, desc, &Raster::default())
+/// Descriptor bindings of set 0: binding → (kind, stages that use it).
+type Bindings = BTreeMap<u32, (BindingKind, vk::ShaderStageFlags)>;
+
+/// Refuses a target list the device or the blend cannot serve: XOR needs the logicOp
+/// feature and integer targets; the count must be within the device's colour attachments.
+fn check_targets(dev: &Device, desc: &PipelineDesc, name: &str) -> Result<()> {
+    if desc.blend == Blend::Xor {
+        if !dev.info.logic_op {
+            return Err(GpuError::Unsupported(format!("device '{}' has no logicOp feature", dev.info.name)));
+        }
+        if let Some(f) = desc.targets.iter().find(|f| !f.is_integer()) {
+            return Err(GpuError::Usage(format!("{name}: logic op XOR needs integer targets, not {f:?}")));
+        }
     }
+    if desc.targets.is_empty() || desc.targets.len() > dev.info.max_color_attachments as usize {
+        return Err(GpuError::Usage(format!(
+            "{name}: {} targets (the device allows 1..={})",
+            desc.targets.len(),
+            dev.info.max_color_attachments
+        )));
+    }
+    Ok(())
+}
 
-    /// A pipeline with a depth test and/or multisampling (see [`Raster`]).
-    pub fn with_raster(ctx: &Context, desc: &PipelineDesc, state: &Raster) -> Result<Pipeline> {
-        let dev = ctx.dev.clone();
-        let name = format!("{} + {}", desc.vertex.path, desc.fragment.path);
-        if desc.blend == Blend::Xor {
-            if !dev.info.logic_op {
-                return Err(GpuError::Unsupported(format!(
-                    "device '{}' has no logicOp feature",
-                    dev.info.name
-                )));
+/// The descriptor bindings of both stages (`mods` and `refl`: vertex, fragment): set 0
+/// only, pushed per draw; textures and uniform blocks only — storage resources would
+/// break the texture-era model (SPEC §0). A binding both stages use must agree in kind.
+fn descriptor_bindings(
+    desc: &PipelineDesc,
+    mods: [&Reflection; 2],
+    refl: [&Reflected; 2],
+) -> Result<Bindings> {
+    let mut bindings = Bindings::new();
+    for (stage, refl, shader) in [
+        (vk::ShaderStageFlags::VERTEX, refl[0], desc.vertex),
+        (vk::ShaderStageFlags::FRAGMENT, refl[1], desc.fragment),
+    ] {
+        for (&set, set_bindings) in &refl.sets {
+            let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
+            if set != 0 {
+                return Err(err(format!("uses descriptor set {set}; texgeo shaders use set 0 only")));
             }
-            if let Some(f) = desc.targets.iter().find(|f| !f.is_integer()) {
-                return Err(GpuError::Usage(format!(
-                    "{name}: logic op XOR needs integer targets, not {f:?}"
-                )));
+            for (&b, info) in set_bindings {
+                let kind = match info.ty {
+                    DescriptorType::COMBINED_IMAGE_SAMPLER => BindingKind::Texture {
+                        arrayed: texture_is_arrayed(shader, refl_module(&mods, stage), b)?,
+                    },
+                    DescriptorType::UNIFORM_BUFFER => BindingKind::Uniform,
+                    other => {
+                        return Err(err(format!(
+                            "binding {b} is {other:?}; only sampled textures and uniform blocks are allowed"
+                        )));
+                    }
+                };
+                if info.binding_count != BindingCount::One {
+                    return Err(err(format!("binding {b} is an array; bind textures one by one")));
+                }
+                let entry = bindings.entry(b).or_insert((kind, vk::ShaderStageFlags::empty()));
+                if entry.0 != kind {
+                    return Err(err(format!("binding {b} has different types in the two stages")));
+                }
+                entry.1 |= stage;
             }
         }
-        if desc.targets.is_empty() || desc.targets.len() > dev.info.max_color_attachments as usize {
-            return Err(GpuError::Usage(format!(
-                "{name}: {} targets (the device allows 1..={})",
-                desc.targets.len(),
-                dev.info.max_color_attachments
-            )));
+    }
+    Ok(bindings)
+}
+
+/// One push-constant range over both stages' (offset, size): (stages, offset, size).
+fn push_range(
+    vertex: Option<(u32, u32)>,
+    fragment: Option<(u32, u32)>,
+) -> Option<(vk::ShaderStageFlags, u32, u32)> {
+    if vertex.is_none() && fragment.is_none() {
+        return None;
+    }
+    let mut stages = vk::ShaderStageFlags::empty();
+    let (mut lo, mut hi) = (u32::MAX, 0);
+    for (s, r) in [(vk::ShaderStageFlags::VERTEX, vertex), (vk::ShaderStageFlags::FRAGMENT, fragment)] {
+        if let Some((off, size)) = r {
+            stages |= s;
+            lo = lo.min(off);
+            hi = hi.max(off + size);
         }
+    }
+    Some((stages, lo, hi - lo))
+}
 
-        let (vr, v) = reflect(desc.vertex)?;
-        let (fr, f) = reflect(desc.fragment)?;
-        let refl_mods = [&vr, &fr];
+/// The vertex buffers' layout: binding 0 per vertex, binding 1 per instance (the
+/// locations in `per_instance`), attributes packed in location order.
+struct VertexLayout {
+    strides: [u32; 2],
+    attributes: Vec<vk::VertexInputAttributeDescription>,
+    bindings: Vec<vk::VertexInputBindingDescription>,
+}
 
-        // Descriptors: set 0 only, pushed per draw; textures and uniform blocks only —
-        // storage resources would break the texture-era model (SPEC §0).
-        let mut bindings: BTreeMap<u32, (BindingKind, vk::ShaderStageFlags)> = BTreeMap::new();
-        for (stage, refl, shader) in [
-            (vk::ShaderStageFlags::VERTEX, &v, desc.vertex),
-            (vk::ShaderStageFlags::FRAGMENT, &f, desc.fragment),
-        ] {
-            for (&set, set_bindings) in &refl.sets {
-                let err = |m: String| GpuError::Shader { shader: shader.path.to_string(), message: m };
-                if set != 0 {
-                    return Err(err(format!("uses descriptor set {set}; texgeo shaders use set 0 only")));
-                }
-                for (&b, info) in set_bindings {
-                    let kind = match info.ty {
-                        DescriptorType::COMBINED_IMAGE_SAMPLER => BindingKind::Texture {
-                            arrayed: texture_is_arrayed(shader, refl_module(&refl_mods, stage), b)?,
-                        },
-                        DescriptorType::UNIFORM_BUFFER => BindingKind::Uniform,
-                        other => {
-                            return Err(err(format!(
-                                "binding {b} is {other:?}; only sampled textures and uniform blocks are allowed"
-                            )));
-                        }
-                    };
-                    if info.binding_count != BindingCount::One {
-                        return Err(err(format!("binding {b} is an array; bind textures one by one")));
-                    }
-                    let entry = bindings.entry(b).or_insert((kind, vk::ShaderStageFlags::empty()));
-                    if entry.0 != kind {
-                        return Err(err(format!("binding {b} has different types in the two stages")));
-                    }
-                    entry.1 |= stage;
-                }
-            }
-        }
-        let push = match (v.push, f.push) {
-            (None, None) => None,
-            (a, b) => {
-                let mut stages = vk::ShaderStageFlags::empty();
-                let (mut lo, mut hi) = (u32::MAX, 0);
-                for (s, r) in [(vk::ShaderStageFlags::VERTEX, a), (vk::ShaderStageFlags::FRAGMENT, b)] {
-                    if let Some((off, size)) = r {
-                        stages |= s;
-                        lo = lo.min(off);
-                        hi = hi.max(off + size);
-                    }
-                }
-                Some((stages, lo, hi - lo))
-            }
-        };
-
-        let inputs = vertex_inputs(desc.vertex, &vr)?;
+impl VertexLayout {
+    fn new(desc: &PipelineDesc, inputs: &[VertexInput]) -> VertexLayout {
         let mut strides = [0u32; 2];
         let mut attributes = Vec::new();
-        for i in &inputs {
+        for i in inputs {
             let binding = u32::from(desc.per_instance.contains(&i.location));
             attributes.push(
                 vk::VertexInputAttributeDescription::default()
@@ -324,11 +336,11 @@ impl Pipeline {
             );
             strides[binding as usize] += i.bytes;
         }
-        let mut vbindings = Vec::new();
+        let mut bindings = Vec::new();
         for (b, rate) in [vk::VertexInputRate::VERTEX, vk::VertexInputRate::INSTANCE].into_iter().enumerate()
         {
             if strides[b] > 0 {
-                vbindings.push(
+                bindings.push(
                     vk::VertexInputBindingDescription::default()
                         .binding(b as u32)
                         .stride(strides[b])
@@ -336,7 +348,72 @@ impl Pipeline {
                 );
             }
         }
+        VertexLayout { strides, attributes, bindings }
+    }
+}
 
+/// One blend state per target: additive for [`Blend::Add`], none otherwise (XOR is the
+/// logic op, set on the whole blend state).
+fn blend_attachments(desc: &PipelineDesc) -> Vec<vk::PipelineColorBlendAttachmentState> {
+    desc.targets
+        .iter()
+        .map(|_| {
+            let a = vk::PipelineColorBlendAttachmentState::default()
+                .color_write_mask(vk::ColorComponentFlags::RGBA);
+            match desc.blend {
+                Blend::Add => a
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ONE)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(vk::BlendOp::ADD),
+                Blend::Replace | Blend::Xor => a,
+            }
+        })
+        .collect()
+}
+
+impl Pipeline {
+    pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<Pipeline> {
+        Pipeline::with_raster(ctx, desc, &Raster::default())
+    }
+
+    /// A pipeline with a depth test and/or multisampling (see [`Raster`]): the targets
+    /// checked, the shaders reflected (descriptor bindings, push constants, vertex
+    /// inputs), then the layouts and the pipeline created.
+    pub fn with_raster(ctx: &Context, desc: &PipelineDesc, state: &Raster) -> Result<Pipeline> {
+        let dev = ctx.dev.clone();
+        let name = format!("{} + {}", desc.vertex.path, desc.fragment.path);
+        check_targets(&dev, desc, &name)?;
+        let (vr, v) = reflect(desc.vertex)?;
+        let (fr, f) = reflect(desc.fragment)?;
+        let bindings = descriptor_bindings(desc, [&vr, &fr], [&v, &f])?;
+        let push = push_range(v.push, f.push);
+        let vertex = VertexLayout::new(desc, &vertex_inputs(desc.vertex, &vr)?);
+        let mut pipeline = Pipeline {
+            dev: dev.clone(),
+            raw: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            bindings: bindings.iter().map(|(&b, &(k, _))| (b, k)).collect(),
+            push,
+            targets: desc.targets.to_vec(),
+            depth: (state.depth != DepthTest::Off).then_some(TexFormat::Depth32F),
+            samples: state.samples,
+            strides: vertex.strides,
+            topology: desc.topology,
+            name,
+        };
+        // From here on, Drop of `pipeline` destroys whatever was created if a step fails.
+        pipeline.create_layouts(&bindings)?;
+        pipeline.create_raw(desc, state, &vertex)?;
+        Ok(pipeline)
+    }
+
+    /// The descriptor set layout (set 0, pushed per draw) and the pipeline layout.
+    fn create_layouts(&mut self, bindings: &Bindings) -> Result<()> {
         let layout_bindings: Vec<_> = bindings
             .iter()
             .map(|(&b, &(kind, stages))| {
@@ -350,38 +427,31 @@ impl Pipeline {
                     .stage_flags(stages)
             })
             .collect();
-        let mut pipeline = Pipeline {
-            dev: dev.clone(),
-            raw: vk::Pipeline::null(),
-            layout: vk::PipelineLayout::null(),
-            set_layout: vk::DescriptorSetLayout::null(),
-            bindings: bindings.iter().map(|(&b, &(k, _))| (b, k)).collect(),
-            push,
-            targets: desc.targets.to_vec(),
-            depth: (state.depth != DepthTest::Off).then_some(TexFormat::Depth32F),
-            samples: state.samples,
-            strides,
-            topology: desc.topology,
-            name,
-        };
-        // From here on, Drop of `pipeline` destroys whatever was created if a step fails.
         let set_info = vk::DescriptorSetLayoutCreateInfo::default()
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&layout_bindings);
-        // SAFETY: valid device and create infos; handles are owned by `pipeline`.
-        pipeline.set_layout = unsafe { dev.raw.create_descriptor_set_layout(&set_info, None) }
+        let dev = &self.dev;
+        // SAFETY: valid device and create infos; handles are owned by `self`.
+        self.set_layout = unsafe { dev.raw.create_descriptor_set_layout(&set_info, None) }
             .vk("vkCreateDescriptorSetLayout")?;
-        let ranges: Vec<_> = push
+        let ranges: Vec<_> = self
+            .push
             .iter()
             .map(|&(stages, offset, size)| vk::PushConstantRange { stage_flags: stages, offset, size })
             .collect();
-        let set_layouts = [pipeline.set_layout];
+        let set_layouts = [self.set_layout];
         let layout_info =
             vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges);
         // SAFETY: as above.
-        pipeline.layout =
+        self.layout =
             unsafe { dev.raw.create_pipeline_layout(&layout_info, None) }.vk("vkCreatePipelineLayout")?;
+        Ok(())
+    }
 
+    /// The graphics pipeline itself: shader stages, fixed-function state (after checking
+    /// the device offers the samples asked for), dynamic rendering formats.
+    fn create_raw(&mut self, desc: &PipelineDesc, state: &Raster, vertex: &VertexLayout) -> Result<()> {
+        let dev = self.dev.clone();
         let vmod = ShaderModule::new(&dev, desc.vertex)?;
         let fmod = ShaderModule::new(&dev, desc.fragment)?;
         let stages = [
@@ -395,8 +465,8 @@ impl Pipeline {
                 .name(c"main"),
         ];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-            .vertex_binding_descriptions(&vbindings)
-            .vertex_attribute_descriptions(&attributes);
+            .vertex_binding_descriptions(&vertex.bindings)
+            .vertex_attribute_descriptions(&vertex.attributes);
         let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(match desc.topology {
             Topology::Points => vk::PrimitiveTopology::POINT_LIST,
             Topology::Triangles => vk::PrimitiveTopology::TRIANGLE_LIST,
@@ -410,7 +480,7 @@ impl Pipeline {
         if !state.samples.is_power_of_two() || dev.info.colour_samples & state.samples == 0 {
             return Err(GpuError::Unsupported(format!(
                 "{}: device '{}' offers no {}-sample targets",
-                pipeline.name, dev.info.name, state.samples
+                self.name, dev.info.name, state.samples
             )));
         }
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
@@ -422,25 +492,7 @@ impl Pipeline {
                 DepthTest::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
                 _ => vk::CompareOp::LESS,
             });
-        let attachments: Vec<_> = desc
-            .targets
-            .iter()
-            .map(|_| {
-                let a = vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA);
-                match desc.blend {
-                    Blend::Add => a
-                        .blend_enable(true)
-                        .src_color_blend_factor(vk::BlendFactor::ONE)
-                        .dst_color_blend_factor(vk::BlendFactor::ONE)
-                        .color_blend_op(vk::BlendOp::ADD)
-                        .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                        .alpha_blend_op(vk::BlendOp::ADD),
-                    Blend::Replace | Blend::Xor => a,
-                }
-            })
-            .collect();
+        let attachments = blend_attachments(desc);
         let blend = vk::PipelineColorBlendStateCreateInfo::default()
             .logic_op_enable(desc.blend == Blend::Xor)
             .logic_op(vk::LogicOp::XOR)
@@ -449,7 +501,7 @@ impl Pipeline {
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let formats: Vec<_> = desc.targets.iter().map(|f| f.vk()).collect();
         let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
-        if let Some(d) = pipeline.depth {
+        if let Some(d) = self.depth {
             rendering = rendering.depth_attachment_format(d.vk());
         }
         let info = vk::GraphicsPipelineCreateInfo::default()
@@ -462,7 +514,7 @@ impl Pipeline {
             .depth_stencil_state(&depth_state)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(pipeline.layout)
+            .layout(self.layout)
             .push_next(&mut rendering);
         // SAFETY: every pointer in `info` outlives the call; modules are alive until after it.
         // The device's cache (kept between runs); locked, as Vulkan wants a cache used by
@@ -470,9 +522,9 @@ impl Pipeline {
         let cache = super::error::lock(&dev.pipeline_cache, "pipeline cache")?;
         let created = unsafe { dev.raw.create_graphics_pipelines(cache.raw, &[info], None) };
         drop(cache);
-        pipeline.raw =
+        self.raw =
             created.map_err(|(_, e)| GpuError::Vk { call: "vkCreateGraphicsPipelines", result: e })?[0];
-        Ok(pipeline)
+        Ok(())
     }
 
     /// A full-target quad pass: the built-in quad vertex shader and `fragment`, which runs

@@ -484,47 +484,8 @@ impl FastWinding {
         let off_plane = |p: DVec3| nrm.dot(p - a).abs() > (eps * (1.0 + 1e-9) + 1e-12 * p.distance(a)) * len;
         let js = index_range(grid.min.y, h, n, lo.y, hi.y);
         let ks = index_range(grid.min.z, h, n, lo.z, hi.z);
-        // Every centre reported below lies in the box [lo, hi] and passes `off_plane`. Most
-        // triangles have no such centre (ε is far below a voxel), and a pass over the few
-        // centres of the box shows it before the rows are walked: whatever their distance
-        // to a, those centres' `off_plane` thresholds are at most `threshold` (rounding is
-        // monotone), so a centre whose |n·(p − a)|, computed as `off_plane` computes it,
-        // exceeds `threshold` is off the plane.
-        let inner = |axis: usize, r: std::ops::Range<usize>| {
-            let (min, mut r) = (grid.min[axis], r);
-            while r.start < r.end && grid.centre_coord(min, r.start) < lo[axis] {
-                r.start += 1;
-            }
-            while r.start < r.end && grid.centre_coord(min, r.end - 1) > hi[axis] {
-                r.end -= 1;
-            }
-            r
-        };
-        let box_is = inner(0, index_range(grid.min.x, h, n, lo.x, hi.x));
-        let box_js = inner(1, js.start.max(slices.start)..js.end.min(slices.end));
-        let box_ks = inner(2, ks.clone());
-        if box_is.is_empty() || box_js.is_empty() || box_ks.is_empty() {
-            return;
-        }
-        let reach = |axis: usize, r: &std::ops::Range<usize>| {
-            let at = |i: usize| (grid.centre_coord(grid.min[axis], i) - a[axis]).abs();
-            at(r.start).max(at(r.end - 1))
-        };
-        let far = DVec3::new(reach(0, &box_is), reach(1, &box_js), reach(2, &box_ks)).length();
-        let threshold = (eps * (1.0 + 1e-9) + 1e-12 * far) * len;
-        // NaN counts as near.
-        let near_plane = threshold.is_nan()
-            || box_js.clone().any(|j| {
-                let y = grid.centre_coord(grid.min.y, j);
-                box_ks.clone().any(|k| {
-                    let z = grid.centre_coord(grid.min.z, k);
-                    box_is.clone().any(|i| {
-                        let d = nrm.dot(DVec3::new(grid.centre_coord(grid.min.x, i), y, z) - a).abs();
-                        d.is_nan() || d <= threshold
-                    })
-                })
-            });
-        if !near_plane {
+        let plane = Plane { a, normal: nrm, len, eps };
+        if !plane.near_box(grid, (lo, hi), js.start.max(slices.start)..js.end.min(slices.end), ks.clone()) {
             return;
         }
         let face = covering.face_of[t] as usize;
@@ -536,26 +497,7 @@ impl FastWinding {
             if y < lo.y || y > hi.y {
                 continue;
             }
-            // A centre within ε of the triangle has its (y, z) within ε of the triangle's
-            // (y, z) projection: z within the projection's z extent over y ± ε, grown by ε
-            // (the extent's ends are convex and concave in y, so the slices at y ± ε and the
-            // corners between them bound it), with room for rounding.
-            let ey = 2.0 * eps + 1e-9 * (y.abs() + h);
-            let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for (l, u) in [y - ey, y + ey].into_iter().filter_map(|yy| z_extent_at(&[a, b, c], yy)) {
-                (zlo, zhi) = (zlo.min(l), zhi.max(u));
-            }
-            for v in [a, b, c].into_iter().filter(|v| (v.y - y).abs() <= ey) {
-                (zlo, zhi) = (zlo.min(v.z), zhi.max(v.z));
-            }
-            if zlo > zhi {
-                continue;
-            }
-            let margin = ey + 1e-9 * (zlo.abs() + zhi.abs() + h);
-            let (zlo, zhi) = ((zlo - margin).max(lo.z), (zhi + margin).min(hi.z));
-            if zlo > zhi {
-                continue;
-            }
+            let Some((zlo, zhi)) = z_window([a, b, c], y, eps, h, (lo.z, hi.z)) else { continue };
             let row_ks = index_range(grid.min.z, h, n, zlo, zhi);
             for k in row_ks.start.max(ks.start)..row_ks.end.min(ks.end) {
                 let z = grid.centre_coord(grid.min.z, k);
@@ -598,6 +540,91 @@ impl FastWinding {
             }
         }
     }
+}
+
+/// A triangle's plane through its corner `a` with (unnormalized) `normal` of length
+/// `len`, and the distance ε of the boundary test.
+struct Plane {
+    a: DVec3,
+    normal: DVec3,
+    len: f64,
+    eps: f64,
+}
+
+impl Plane {
+    /// Whether any voxel centre of the box `[lo, hi]` (rows `js` and `ks` of `grid`) may
+    /// pass the near-plane test. Most triangles have no such centre (ε is far below a
+    /// voxel), and a pass over the few centres of the box shows it before the rows are
+    /// walked: whatever their distance to a, those centres' thresholds are at most the
+    /// box's (rounding is monotone), so a centre whose |n·(p − a)| exceeds it is off the
+    /// plane. NaN counts as near.
+    fn near_box(
+        &self,
+        grid: &Grid,
+        (lo, hi): (DVec3, DVec3),
+        js: std::ops::Range<usize>,
+        ks: std::ops::Range<usize>,
+    ) -> bool {
+        let (n, h, a) = (grid.n, grid.h(), self.a);
+        let inner = |axis: usize, r: std::ops::Range<usize>| {
+            let (min, mut r) = (grid.min[axis], r);
+            while r.start < r.end && grid.centre_coord(min, r.start) < lo[axis] {
+                r.start += 1;
+            }
+            while r.start < r.end && grid.centre_coord(min, r.end - 1) > hi[axis] {
+                r.end -= 1;
+            }
+            r
+        };
+        let box_is = inner(0, index_range(grid.min.x, h, n, lo.x, hi.x));
+        let box_js = inner(1, js);
+        let box_ks = inner(2, ks);
+        if box_is.is_empty() || box_js.is_empty() || box_ks.is_empty() {
+            return false;
+        }
+        let reach = |axis: usize, r: &std::ops::Range<usize>| {
+            let at = |i: usize| (grid.centre_coord(grid.min[axis], i) - a[axis]).abs();
+            at(r.start).max(at(r.end - 1))
+        };
+        let far = DVec3::new(reach(0, &box_is), reach(1, &box_js), reach(2, &box_ks)).length();
+        let threshold = (self.eps * (1.0 + 1e-9) + 1e-12 * far) * self.len;
+        threshold.is_nan()
+            || box_js.clone().any(|j| {
+                let y = grid.centre_coord(grid.min.y, j);
+                box_ks.clone().any(|k| {
+                    let z = grid.centre_coord(grid.min.z, k);
+                    box_is.clone().any(|i| {
+                        let d = self.normal.dot(DVec3::new(grid.centre_coord(grid.min.x, i), y, z) - a).abs();
+                        d.is_nan() || d <= threshold
+                    })
+                })
+            })
+    }
+}
+
+/// The z range of the row at `y` where a centre may lie within ε of the triangle
+/// `corners`, clipped to `z_box`; `None` if empty. Such a centre has its (y, z) within ε
+/// of the triangle's (y, z) projection: z within the projection's z extent over y ± ε,
+/// grown by ε (the extent's ends are convex and concave in y, so the slices at y ± ε and
+/// the corners between them bound it), with room for rounding (`h`: the voxel size).
+fn z_window(corners: [DVec3; 3], y: f64, eps: f64, h: f64, z_box: (f64, f64)) -> Option<(f64, f64)> {
+    let ey = 2.0 * eps + 1e-9 * (y.abs() + h);
+    let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (l, u) in [y - ey, y + ey].into_iter().filter_map(|yy| z_extent_at(&corners, yy)) {
+        (zlo, zhi) = (zlo.min(l), zhi.max(u));
+    }
+    for v in corners.into_iter().filter(|v| (v.y - y).abs() <= ey) {
+        (zlo, zhi) = (zlo.min(v.z), zhi.max(v.z));
+    }
+    if zlo > zhi {
+        return None;
+    }
+    let margin = ey + 1e-9 * (zlo.abs() + zhi.abs() + h);
+    let (zlo, zhi) = ((zlo - margin).max(z_box.0), (zhi + margin).min(z_box.1));
+    if zlo > zhi {
+        return None;
+    }
+    Some((zlo, zhi))
 }
 
 /// Whether the segment q→p crosses the triangle abc: 0 (no), +1 from the side its normal

@@ -136,6 +136,23 @@ fn log_ticks(range: &Range<f64>) -> (Vec<f64>, Vec<f64>) {
 const MOST_TICKS: usize = 8;
 
 impl Chart {
+    /// A chart with both axes logarithmic.
+    pub fn loglog(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+        series: Vec<Series>,
+    ) -> Chart {
+        Chart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            x_log: true,
+            y_log: true,
+            series,
+        }
+    }
+
     /// This chart, or when it holds more than [`MOST_SERIES`] curves, several charts
     /// ("(1 of 2)", …) that split it between colours: a thesis curve stays with today's
     /// curve of its colour.

@@ -177,6 +177,177 @@ impl Sharp {
     }
 }
 
+/// The sharpness the features tag: each edge's (creases), each vertex's (corners), and
+/// the faces that are holes (`None`: none).
+#[allow(clippy::type_complexity)]
+fn tagged(topo: &Topology, features: &Features) -> Result<(Vec<f32>, Vec<f32>, Option<Vec<bool>>)> {
+    let (nv, ne, nf) = (topo.num_vertices(), topo.num_edges(), topo.num_faces());
+    let feature = |m: String| SubdivError::Feature(m);
+    let mut edge_sharp = vec![0.0f32; ne];
+    if !features.creases.is_empty() {
+        // The first edge of each vertex pair (OpenSubdiv's findEdge).
+        let mut first = std::collections::HashMap::with_capacity(ne);
+        for (e, &[a, b]) in topo.edge_verts().iter().enumerate().rev() {
+            first.insert((a.min(b), a.max(b)), e as u32);
+        }
+        for (i, c) in features.creases.iter().enumerate() {
+            let [a, b] = c.vertices;
+            check_sharpness(c.sharpness).map_err(|m| feature(format!("crease {i}: {m}")))?;
+            let e = first.get(&(a.min(b), a.max(b))).ok_or_else(|| {
+                feature(format!("crease {i}: vertices {a} and {b} are not joined by an edge"))
+            })?;
+            edge_sharp[*e as usize] = c.sharpness;
+        }
+    }
+    let mut vertex_sharp = vec![0.0f32; nv];
+    for (i, c) in features.corners.iter().enumerate() {
+        check_sharpness(c.sharpness).map_err(|m| feature(format!("corner {i}: {m}")))?;
+        let slot = vertex_sharp.get_mut(c.vertex as usize).ok_or_else(|| {
+            feature(format!("corner {i}: vertex {} is out of range ({nv} vertices)", c.vertex))
+        })?;
+        *slot = c.sharpness;
+    }
+    let mut holes = None;
+    for &f in &features.holes {
+        if f as usize >= nf {
+            return Err(feature(format!("hole: face {f} is out of range ({nf} faces)")));
+        }
+        holes.get_or_insert_with(|| vec![false; nf])[f as usize] = true;
+    }
+    Ok((edge_sharp, vertex_sharp, holes))
+}
+
+/// The incident edges of every vertex in edge order (a degenerate edge twice), each as
+/// `edge << 1 | end`: the order OpenSubdiv keeps for non-manifold vertices.
+struct VertexEdges {
+    offsets: Vec<u32>,
+    edges: Vec<u32>,
+}
+
+impl VertexEdges {
+    fn new(topo: &Topology) -> VertexEdges {
+        let nv = topo.num_vertices();
+        let mut offsets = vec![0u32; nv + 1];
+        for &[a, b] in topo.edge_verts() {
+            offsets[a as usize + 1] += 1;
+            offsets[b as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut fill = offsets.clone();
+        let mut edges = vec![0u32; offsets[nv] as usize];
+        for (e, &[a, b]) in topo.edge_verts().iter().enumerate() {
+            for (v, end) in [(a, 0), (b, 1)] {
+                edges[fill[v as usize] as usize] = ((e as u32) << 1) | end;
+                fill[v as usize] += 1;
+            }
+        }
+        VertexEdges { offsets, edges }
+    }
+
+    fn of(&self, v: usize) -> &[u32] {
+        &self.edges[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+    }
+}
+
+/// Without boundary interpolation: the faces at a boundary vertex with a boundary edge
+/// not tagged infinitely sharp are holes (decided before boundary edges are sharpened).
+fn boundary_holes(
+    topo: &Topology,
+    indices: &[u32],
+    vertex_edges: &VertexEdges,
+    edge_sharp: &[f32],
+    holes: &mut Option<Vec<bool>>,
+) {
+    let (nv, nf) = (topo.num_vertices(), topo.num_faces());
+    let mut excluded = vec![false; nv];
+    for (v, out) in excluded.iter_mut().enumerate() {
+        let manifold_interior = topo.valence(v as u32) == topo.num_vertex_faces(v as u32)
+            && !topo.is_non_manifold_vertex(v as u32);
+        if !manifold_interior {
+            *out = vertex_edges.of(v).iter().any(|&x| {
+                topo.num_edge_faces(x >> 1) < 2 && !crease::is_infinite(edge_sharp[(x >> 1) as usize])
+            });
+        }
+    }
+    for (h, &v) in indices.iter().enumerate() {
+        if excluded[v as usize] {
+            holes.get_or_insert_with(|| vec![false; nf])[topo.face(h as u32) as usize] = true;
+        }
+    }
+}
+
+/// OpenSubdiv's rules: boundary and non-manifold edges infinitely sharp, then corners
+/// (with corner interpolation) and non-manifold vertices not along a crease.
+fn sharpen(
+    topo: &Topology,
+    options: &Options,
+    vertex_edges: &VertexEdges,
+    edge_sharp: &mut [f32],
+    vertex_sharp: &mut [f32],
+) {
+    let one_face = |e: u32| topo.num_edge_faces(e) < 2;
+    for (e, s) in edge_sharp.iter_mut().enumerate() {
+        if one_face(e as u32) || topo.is_non_manifold_edge(e as u32) {
+            *s = INFINITE;
+        }
+    }
+    for (v, s) in vertex_sharp.iter_mut().enumerate() {
+        let (faces, edges) = (topo.num_vertex_faces(v as u32), topo.valence(v as u32));
+        let (mut boundary, mut non_manifold) = (0, 0);
+        for &x in vertex_edges.of(v) {
+            boundary += usize::from(one_face(x >> 1));
+            non_manifold += usize::from(topo.is_non_manifold_edge(x >> 1));
+        }
+        let corner = faces == 1 && edges == 2;
+        if corner && options.boundary == Boundary::EdgeAndCorner {
+            *s = INFINITE;
+        } else if topo.is_non_manifold_vertex(v as u32) {
+            // Not along a non-manifold crease: two non-manifold edges, no boundary, more
+            // faces than edges (the fins of a crease).
+            let crease_line = non_manifold == 2 && boundary == 0 && faces > edges;
+            if !crease_line {
+                *s = INFINITE;
+            }
+        }
+    }
+}
+
+impl Sharp {
+    /// The sharp vertices with their sharp edges in OpenSubdiv's order: around the fan of
+    /// a manifold vertex (from its start), in edge order at a non-manifold one.
+    fn ordered(topo: &Topology, vertex_edges: &VertexEdges, edge: Vec<f32>, vertex: Vec<f32>) -> Sharp {
+        let mut sharp = Sharp { edge, vertex, verts: Vec::new(), offsets: vec![0], edges: Vec::new() };
+        let mut ordered = Vec::new();
+        for v in 0..topo.num_vertices() as u32 {
+            let any_edge = vertex_edges.of(v as usize).iter().any(|&x| sharp.edge[(x >> 1) as usize] > 0.0);
+            if !any_edge && sharp.vertex[v as usize] <= 0.0 {
+                continue;
+            }
+            ordered.clear();
+            match topo.vertex_fans(v) {
+                (Some(fan), 1) if !topo.is_non_manifold_vertex(v) => {
+                    let fan = topo.fans()[fan as usize];
+                    let corners = topo.fan_corners(&fan);
+                    for &h in corners {
+                        ordered.push((topo.edge(h) << 1) | u32::from(topo.is_reversed(h)));
+                    }
+                    if !fan.closed {
+                        let p = topo.prev(corners[corners.len() - 1]);
+                        ordered.push((topo.edge(p) << 1) | u32::from(!topo.is_reversed(p)));
+                    }
+                }
+                _ => ordered.extend_from_slice(vertex_edges.of(v as usize)),
+            }
+            sharp.verts.push(v);
+            sharp.edges.extend(ordered.iter().filter(|&&x| sharp.edge[(x >> 1) as usize] > 0.0));
+            sharp.offsets.push(sharp.edges.len() as u32);
+        }
+        sharp
+    }
+}
+
 /// One subdivision level: positions plus the topology and sharpness needed to refine it
 /// once more.
 pub(crate) struct Level {
@@ -212,150 +383,21 @@ impl Level {
         options: &Options,
     ) -> Result<(Level, Vec<SharpOrigin>)> {
         let (offsets, indices) = mesh.face_parts();
-        let (nv, ne, nf) = (topo.num_vertices(), topo.num_edges(), topo.num_faces());
-        let feature = |m: String| SubdivError::Feature(m);
-
-        let mut edge_sharp = vec![0.0f32; ne];
-        if !features.creases.is_empty() {
-            // The first edge of each vertex pair (OpenSubdiv's findEdge).
-            let mut first = std::collections::HashMap::with_capacity(ne);
-            for (e, &[a, b]) in topo.edge_verts().iter().enumerate().rev() {
-                first.insert((a.min(b), a.max(b)), e as u32);
-            }
-            for (i, c) in features.creases.iter().enumerate() {
-                let [a, b] = c.vertices;
-                check_sharpness(c.sharpness).map_err(|m| feature(format!("crease {i}: {m}")))?;
-                let e = first.get(&(a.min(b), a.max(b))).ok_or_else(|| {
-                    feature(format!("crease {i}: vertices {a} and {b} are not joined by an edge"))
-                })?;
-                edge_sharp[*e as usize] = c.sharpness;
-            }
-        }
-        let mut vertex_sharp = vec![0.0f32; nv];
-        for (i, c) in features.corners.iter().enumerate() {
-            check_sharpness(c.sharpness).map_err(|m| feature(format!("corner {i}: {m}")))?;
-            let slot = vertex_sharp.get_mut(c.vertex as usize).ok_or_else(|| {
-                feature(format!("corner {i}: vertex {} is out of range ({nv} vertices)", c.vertex))
-            })?;
-            *slot = c.sharpness;
-        }
-        let mut holes = None;
-        for &f in &features.holes {
-            if f as usize >= nf {
-                return Err(feature(format!("hole: face {f} is out of range ({nf} faces)")));
-            }
-            holes.get_or_insert_with(|| vec![false; nf])[f as usize] = true;
-        }
-
-        // Incident edges of every vertex in edge order (a degenerate edge twice): the
-        // order OpenSubdiv keeps for non-manifold vertices.
-        let mut vedge_offsets = vec![0u32; nv + 1];
-        for &[a, b] in topo.edge_verts() {
-            vedge_offsets[a as usize + 1] += 1;
-            vedge_offsets[b as usize + 1] += 1;
-        }
-        for v in 0..nv {
-            vedge_offsets[v + 1] += vedge_offsets[v];
-        }
-        let mut fill = vedge_offsets.clone();
-        let mut vedges = vec![0u32; vedge_offsets[nv] as usize];
-        for (e, &[a, b]) in topo.edge_verts().iter().enumerate() {
-            for (v, end) in [(a, 0), (b, 1)] {
-                vedges[fill[v as usize] as usize] = ((e as u32) << 1) | end;
-                fill[v as usize] += 1;
-            }
-        }
-        let vertex_edges = |v: usize| &vedges[vedge_offsets[v] as usize..vedge_offsets[v + 1] as usize];
-        let one_face = |e: u32| topo.num_edge_faces(e) < 2;
-
+        let (mut edge_sharp, mut vertex_sharp, mut holes) = tagged(topo, features)?;
+        let vertex_edges = VertexEdges::new(topo);
         if options.boundary == Boundary::None {
-            // Faces at a boundary vertex with a boundary edge not tagged infinitely sharp are
-            // holes (decided before boundary edges are sharpened).
-            let mut excluded = vec![false; nv];
-            for (v, out) in excluded.iter_mut().enumerate() {
-                let manifold_interior = topo.valence(v as u32) == topo.num_vertex_faces(v as u32)
-                    && !topo.is_non_manifold_vertex(v as u32);
-                if !manifold_interior {
-                    *out = vertex_edges(v)
-                        .iter()
-                        .any(|&x| one_face(x >> 1) && !crease::is_infinite(edge_sharp[(x >> 1) as usize]));
-                }
-            }
-            for (h, &v) in indices.iter().enumerate() {
-                if excluded[v as usize] {
-                    holes.get_or_insert_with(|| vec![false; nf])[topo.face(h as u32) as usize] = true;
-                }
-            }
+            boundary_holes(topo, indices, &vertex_edges, &edge_sharp, &mut holes);
         }
-
-        // Sharpen boundary and non-manifold edges, then corners and non-manifold vertices.
-        for (e, s) in edge_sharp.iter_mut().enumerate() {
-            if one_face(e as u32) || topo.is_non_manifold_edge(e as u32) {
-                *s = INFINITE;
-            }
-        }
-        for (v, s) in vertex_sharp.iter_mut().enumerate() {
-            let (faces, edges) = (topo.num_vertex_faces(v as u32), topo.valence(v as u32));
-            let (mut boundary, mut non_manifold) = (0, 0);
-            for &x in vertex_edges(v) {
-                boundary += usize::from(one_face(x >> 1));
-                non_manifold += usize::from(topo.is_non_manifold_edge(x >> 1));
-            }
-            let corner = faces == 1 && edges == 2;
-            if corner && options.boundary == Boundary::EdgeAndCorner {
-                *s = INFINITE;
-            } else if topo.is_non_manifold_vertex(v as u32) {
-                // Not along a non-manifold crease: two non-manifold edges, no boundary, more
-                // faces than edges (the fins of a crease).
-                let crease_line = non_manifold == 2 && boundary == 0 && faces > edges;
-                if !crease_line {
-                    *s = INFINITE;
-                }
-            }
-        }
-
-        // Sharp vertices with their sharp edges in OpenSubdiv's order: around the fan of a
-        // manifold vertex (from its start), in edge order at a non-manifold one.
-        let mut sharp = Sharp {
-            edge: edge_sharp,
-            vertex: vertex_sharp,
-            verts: Vec::new(),
-            offsets: vec![0],
-            edges: Vec::new(),
-        };
-        let mut ordered = Vec::new();
-        for v in 0..nv as u32 {
-            let any_edge = vertex_edges(v as usize).iter().any(|&x| sharp.edge[(x >> 1) as usize] > 0.0);
-            if !any_edge && sharp.vertex[v as usize] <= 0.0 {
-                continue;
-            }
-            ordered.clear();
-            match topo.vertex_fans(v) {
-                (Some(fan), 1) if !topo.is_non_manifold_vertex(v) => {
-                    let fan = topo.fans()[fan as usize];
-                    let corners = topo.fan_corners(&fan);
-                    for &h in corners {
-                        ordered.push((topo.edge(h) << 1) | u32::from(topo.is_reversed(h)));
-                    }
-                    if !fan.closed {
-                        let p = topo.prev(corners[corners.len() - 1]);
-                        ordered.push((topo.edge(p) << 1) | u32::from(!topo.is_reversed(p)));
-                    }
-                }
-                _ => ordered.extend_from_slice(vertex_edges(v as usize)),
-            }
-            sharp.verts.push(v);
-            sharp.edges.extend(ordered.iter().filter(|&&x| sharp.edge[(x >> 1) as usize] > 0.0));
-            sharp.offsets.push(sharp.edges.len() as u32);
-        }
-
+        sharpen(topo, options, &vertex_edges, &mut edge_sharp, &mut vertex_sharp);
+        let sharp = Sharp::ordered(topo, &vertex_edges, edge_sharp, vertex_sharp);
+        let ne = topo.num_edges();
         let mut base_sharp = Vec::new();
         let mut edge_origin = vec![NONE; ne];
         for (e, origin) in edge_origin.iter_mut().enumerate() {
             let s = sharp.edge[e];
             if s > 0.0 {
                 *origin = base_sharp.len() as u32;
-                base_sharp.push((s, one_face(e as u32), topo.is_non_manifold_edge(e as u32)));
+                base_sharp.push((s, topo.num_edge_faces(e as u32) < 2, topo.is_non_manifold_edge(e as u32)));
             }
         }
         let edge_triangles = (options.triangles == Triangles::Smooth).then(|| {

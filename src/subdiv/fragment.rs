@@ -299,8 +299,7 @@ impl FragmentMesh {
         // only sharp features can ask for).
         refiner.step(p.has_sharpness())?;
         let b = refiner.level();
-        let (nv, nf, nc) =
-            (coarse.num_vertices() as u32, coarse.num_faces() as u32, coarse.num_half_edges() as u32);
+        let (nv, nf) = (coarse.num_vertices() as u32, coarse.num_faces() as u32);
         // B's sharp vertices: semi-sharp sums (Chaikin) and sharp edge lists by vertex.
         let mut sharp_list: std::collections::HashMap<u32, &[u32]> = std::collections::HashMap::new();
         for (v, list) in b.sharp_vertices() {
@@ -315,67 +314,14 @@ impl FragmentMesh {
             });
             (s.count as f32, s.sum)
         };
-        // The B half of coarse corner h's leaving edge at its origin / at its target.
-        let half_at_origin = |h: u32| nc + 2 * coarse.edge(h) + u32::from(coarse.is_reversed(h));
-        let half_at_target = |h: u32| nc + 2 * coarse.edge(h) + u32::from(!coarse.is_reversed(h));
-
         let isolated_flags: Vec<bool> = (0..nv).map(|v| coarse.vertex_fans(v).0.is_none()).collect();
         let coarse_ref_isolated = |v: u32| isolated_flags[v as usize];
-        let mut fragments = Vec::new();
-        let mut first_corner = Vec::new();
-        let mut centre_sharpness = Vec::new();
-        let mut spokes_at = Vec::new();
-        for (f, fan) in coarse.fans().iter().enumerate() {
-            let c = fan.centre;
-            let corners = coarse.fan_corners(fan);
-            // The B halves of the fan's spokes at the centre.
-            spokes_at.clear();
-            spokes_at.extend(corners.iter().map(|&h| half_at_origin(h)));
-            if !fan.closed {
-                spokes_at.push(half_at_target(coarse.prev(corners[corners.len() - 1])));
-            }
-            let list: &[u32] = sharp_list.get(&c).copied().unwrap_or(&[]);
-            let mut vs = b.vertex_sharpness(c);
-            let outside: Vec<f32> = list
-                .iter()
-                .filter(|&&x| !spokes_at.contains(&(x >> 1)))
-                .map(|&x| b.edge_sharpness(x >> 1))
-                .collect();
-            if !outside.is_empty() {
-                let infinite =
-                    list.iter().filter(|&&x| crease::is_infinite(b.edge_sharpness(x >> 1))).count();
-                let corner_for_good = crease::is_infinite(vs) || infinite >= 3;
-                let semi_outside = outside.iter().any(|&s| crease::is_semi_sharp(s));
-                if corner_for_good && (method == Method::Uniform || !semi_outside) {
-                    vs = INFINITE;
-                } else {
-                    return Ok(Err(format!(
-                        "the sharp edges around non-manifold vertex {c} are not all in one of its fans \
-                         (semi-sharp ones decay on the CPU first)"
-                    )));
-                }
-            }
-            // A closed fan starts at the first sharp edge of the centre's list: its f32 sums
-            // then run in OpenSubdiv's order.
-            let mut start = 0;
-            if fan.closed
-                && let Some(&x) = list.first()
-            {
-                start = spokes_at.iter().position(|&h| h == x >> 1).unwrap_or(0);
-            }
-            let class = Class { boundary: !fan.closed, valence: corners.len() as u32 };
-            fragments.push(Fragment { centre: c, fan: f as u32, class, horizon: 0, run: 0 });
-            first_corner.push(corners[start]);
-            centre_sharpness.push(vs);
-        }
-        for f in 0..coarse.num_faces() as u32 {
-            let sides = coarse.face_half_edges(f).len();
-            if sides != 4 {
-                return Err(SubdivError::Fragment(format!(
-                    "coarse face {f} has {sides} sides; fragment meshes need an all-quad coarse mesh"
-                )));
-            }
-        }
+        let (fragments, first_corner, centre_sharpness) = match fan_fragments(&coarse, b, &sharp_list, method)
+        {
+            Ok(f) => f,
+            Err(reason) => return Ok(Err(reason)),
+        };
+        all_quads(&coarse)?;
 
         let mut mesh = FragmentMesh {
             coarse,
@@ -398,17 +344,7 @@ impl FragmentMesh {
                 .collect(),
         };
         // Sectors in each fragment's order, then the base texels and horizons.
-        let coarse = &mesh.coarse;
-        let mut sector_of = vec![NONE; coarse.num_half_edges()];
-        for (i, frag) in mesh.fragments.iter().enumerate() {
-            let fan = coarse.fans()[frag.fan as usize];
-            let corners = coarse.fan_corners(&fan);
-            let start = corners.iter().position(|&h| h == mesh.first_corner[i]).unwrap_or(0);
-            for (s, &h) in corners[start..].iter().chain(&corners[..start]).enumerate() {
-                sector_of[h as usize] = s as u32;
-            }
-        }
-        mesh.sector_of = sector_of;
+        mesh.sector_of = mesh.sector_order();
         let sharp = b.has_sharpness() || centre_sharpness.iter().any(|&s| s > 0.0);
         let entries: Vec<(Vec<u32>, Vec<[f32; 4]>, u32)> = (0..mesh.fragments.len())
             .map(|i| mesh.base_entries(i, b, sharp, centre_sharpness[i], nv, nf, &semi))
@@ -419,6 +355,21 @@ impl FragmentMesh {
         mesh.base_positions = b.positions().to_vec();
         mesh.sort_and_stream(entries);
         Ok(Ok(mesh))
+    }
+
+    /// Each coarse corner's sector in its fragment's order.
+    fn sector_order(&self) -> Vec<u32> {
+        let coarse = &self.coarse;
+        let mut sector_of = vec![NONE; coarse.num_half_edges()];
+        for (i, frag) in self.fragments.iter().enumerate() {
+            let fan = coarse.fans()[frag.fan as usize];
+            let corners = coarse.fan_corners(&fan);
+            let start = corners.iter().position(|&h| h == self.first_corner[i]).unwrap_or(0);
+            for (s, &h) in corners[start..].iter().chain(&corners[..start]).enumerate() {
+                sector_of[h as usize] = s as u32;
+            }
+        }
+        sector_of
     }
 
     /// The corners of fragment `i`, sector 0 first.
@@ -995,6 +946,83 @@ pub fn sharp_edges(fragments: &FragmentMesh, levels: u32) -> Vec<SharpEdge> {
         }
     }
     out
+}
+
+/// One fragment per fan of `coarse`, with the corner its sector 0 starts at and its
+/// centre's sharpness at B (`b`; `sharp_list`: its sharp vertices' sharp edges).
+/// `Err(reason)` when the sharp edges around a non-manifold vertex are not all in one of
+/// its fans (and semi-sharp ones must decay on the CPU first).
+#[allow(clippy::type_complexity)]
+fn fan_fragments(
+    coarse: &Topology,
+    b: &cpu::Level,
+    sharp_list: &std::collections::HashMap<u32, &[u32]>,
+    method: Method,
+) -> std::result::Result<(Vec<Fragment>, Vec<u32>, Vec<f32>), String> {
+    let nc = coarse.num_half_edges() as u32;
+    // The B half of coarse corner h's leaving edge at its origin / at its target.
+    let half_at_origin = |h: u32| nc + 2 * coarse.edge(h) + u32::from(coarse.is_reversed(h));
+    let half_at_target = |h: u32| nc + 2 * coarse.edge(h) + u32::from(!coarse.is_reversed(h));
+    let mut fragments = Vec::new();
+    let mut first_corner = Vec::new();
+    let mut centre_sharpness = Vec::new();
+    let mut spokes_at = Vec::new();
+    for (f, fan) in coarse.fans().iter().enumerate() {
+        let c = fan.centre;
+        let corners = coarse.fan_corners(fan);
+        // The B halves of the fan's spokes at the centre.
+        spokes_at.clear();
+        spokes_at.extend(corners.iter().map(|&h| half_at_origin(h)));
+        if !fan.closed {
+            spokes_at.push(half_at_target(coarse.prev(corners[corners.len() - 1])));
+        }
+        let list: &[u32] = sharp_list.get(&c).copied().unwrap_or(&[]);
+        let mut vs = b.vertex_sharpness(c);
+        let outside: Vec<f32> = list
+            .iter()
+            .filter(|&&x| !spokes_at.contains(&(x >> 1)))
+            .map(|&x| b.edge_sharpness(x >> 1))
+            .collect();
+        if !outside.is_empty() {
+            let infinite = list.iter().filter(|&&x| crease::is_infinite(b.edge_sharpness(x >> 1))).count();
+            let corner_for_good = crease::is_infinite(vs) || infinite >= 3;
+            let semi_outside = outside.iter().any(|&s| crease::is_semi_sharp(s));
+            if corner_for_good && (method == Method::Uniform || !semi_outside) {
+                vs = INFINITE;
+            } else {
+                return Err(format!(
+                    "the sharp edges around non-manifold vertex {c} are not all in one of its fans \
+                     (semi-sharp ones decay on the CPU first)"
+                ));
+            }
+        }
+        // A closed fan starts at the first sharp edge of the centre's list: its f32 sums
+        // then run in OpenSubdiv's order.
+        let mut start = 0;
+        if fan.closed
+            && let Some(&x) = list.first()
+        {
+            start = spokes_at.iter().position(|&h| h == x >> 1).unwrap_or(0);
+        }
+        let class = Class { boundary: !fan.closed, valence: corners.len() as u32 };
+        fragments.push(Fragment { centre: c, fan: f as u32, class, horizon: 0, run: 0 });
+        first_corner.push(corners[start]);
+        centre_sharpness.push(vs);
+    }
+    Ok((fragments, first_corner, centre_sharpness))
+}
+
+/// Fragment meshes need an all-quad coarse mesh.
+fn all_quads(coarse: &Topology) -> Result<()> {
+    for f in 0..coarse.num_faces() as u32 {
+        let sides = coarse.face_half_edges(f).len();
+        if sides != 4 {
+            return Err(SubdivError::Fragment(format!(
+                "coarse face {f} has {sides} sides; fragment meshes need an all-quad coarse mesh"
+            )));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

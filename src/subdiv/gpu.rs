@@ -285,6 +285,20 @@ impl Subdivider {
         Ok(run)
     }
 
+    /// Render targets of at least `width` × `height` texels and a readback buffer of at
+    /// least `readback_bytes`, kept from earlier runs when they are large enough.
+    fn reserve(&mut self, ctx: &Context, width: u32, height: u32, readback_bytes: u64) -> Result<()> {
+        if !self.targets.as_ref().is_some_and(|t| t.width() == width && t.height() >= height) {
+            self.targets = None;
+            self.targets = Some(PingPong::new(ctx, TexFormat::Rgba32F, width, height, "subdiv")?);
+        }
+        if self.readback.as_ref().is_none_or(|b| b.size() < readback_bytes) {
+            self.readback = None;
+            self.readback = Some(Buffer::readback_for(ctx, readback_bytes)?);
+        }
+        Ok(())
+    }
+
     /// Runs `gpu_levels` fragment passes over `fragments` and assembles the result.
     /// `fragments_started` is when fragment building began (for [`Times::fragments`]).
     pub fn refine_fragments(
@@ -305,68 +319,19 @@ impl Subdivider {
         );
         let rows0 = packing.rows(0);
         stream.resize((rows0 * width) as usize, [0.0; 4]);
-        // One run table per pass: (valence, flags, first input texel, first output texel),
-        // flags 1 half-fan, 2 data in the input, 4 in the output; then (first input data
-        // texel, first output data texel or -1, 0, 0).
-        let tables = packing
-            .layouts
-            .windows(2)
-            .map(|pair| {
-                let (lin, lout) = (&pair[0], &pair[1]);
-                let mut table = vec![[0i32; 4]; 2 * MAX_RUNS];
-                for (r, run) in fragments.runs().iter().enumerate() {
-                    let c = run.class;
-                    let flags =
-                        i32::from(c.boundary) | i32::from(lin.data[r]) << 1 | i32::from(lout.data[r]) << 2;
-                    table[r] = [c.valence as i32, flags, lin.starts[r] as i32, lout.starts[r] as i32];
-                    table[MAX_RUNS + r] = [
-                        if lin.data[r] { lin.data_starts[r] as i32 } else { 0 },
-                        if lout.data[r] { lout.data_starts[r] as i32 } else { -1 },
-                        0,
-                        0,
-                    ];
-                }
-                Buffer::with_data(ctx, &table, "subdiv runs")
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let tables = run_tables(ctx, fragments, &packing)?;
         let fragments_time = fragments_started.elapsed();
 
         let last = packing.layouts.len() - 1;
         let readback_bytes = u64::from(width) * u64::from(packing.rows(last)) * 16;
-        if !self.targets.as_ref().is_some_and(|t| t.width() == width && t.height() >= packing.height) {
-            self.targets = None;
-            self.targets = Some(PingPong::new(ctx, TexFormat::Rgba32F, width, packing.height, "subdiv")?);
-        }
-        if self.readback.as_ref().is_none_or(|b| b.size() < readback_bytes) {
-            self.readback = None;
-            self.readback = Some(Buffer::readback_for(ctx, readback_bytes)?);
-        }
+        self.reserve(ctx, width, packing.height, readback_bytes)?;
         let (Some(targets), Some(readback)) = (self.targets.as_mut(), self.readback.as_ref()) else {
             return Err(SubdivError::GpuLimit("render targets were not created".into()));
         };
         let chaikin = usize::from(fragments.crease_method() == Method::Chaikin);
         let (smooth, sharp, data) = (&self.smooth, &self.sharp[chaikin], &self.data[chaikin]);
         let timer = Timestamps::new(ctx, gpu_levels + 3)?;
-        // The row ranges of each output stream and the variant that draws each: the runs
-        // without input data (first: runs are sorted by horizon, `fragment`) with the
-        // smooth variant, the other positions with the sharp one, the data block with the
-        // data one.
-        let w = u64::from(width);
-        let draws: Vec<[(&Pipeline, u32, u32); 3]> = (0..gpu_levels as usize)
-            .map(|j| {
-                let (lin, lout) = (&packing.layouts[j], &packing.layouts[j + 1]);
-                let position_rows = lout.positions.div_ceil(w) as u32;
-                let first_sharp = lin.data.iter().position(|&d| d);
-                let split = match first_sharp {
-                    _ if options.single_shader => 0,
-                    Some(r) => (lout.starts[r] / w) as u32,
-                    None => position_rows,
-                };
-                let data_row = (lout.data_start / w) as u32;
-                let data_rows = if lout.data.contains(&true) { packing.rows(j + 1) - data_row } else { 0 };
-                [(smooth, 0, split), (sharp, split, position_rows - split), (data, data_row, data_rows)]
-            })
-            .collect();
+        let draws = draw_ranges(&packing, gpu_levels, options, [smooth, sharp, data]);
         let t = Instant::now();
         ctx.submit(|rec| {
             rec.reset_timestamps(&timer);
@@ -439,6 +404,62 @@ impl Subdivider {
             times,
         })
     }
+}
+
+/// One run table per pass: (valence, flags, first input texel, first output texel),
+/// flags 1 half-fan, 2 data in the input, 4 in the output; then (first input data texel,
+/// first output data texel or -1, 0, 0).
+fn run_tables(ctx: &Context, fragments: &FragmentMesh, packing: &Packing) -> Result<Vec<Buffer>> {
+    let tables = packing
+        .layouts
+        .windows(2)
+        .map(|pair| {
+            let (lin, lout) = (&pair[0], &pair[1]);
+            let mut table = vec![[0i32; 4]; 2 * MAX_RUNS];
+            for (r, run) in fragments.runs().iter().enumerate() {
+                let c = run.class;
+                let flags =
+                    i32::from(c.boundary) | i32::from(lin.data[r]) << 1 | i32::from(lout.data[r]) << 2;
+                table[r] = [c.valence as i32, flags, lin.starts[r] as i32, lout.starts[r] as i32];
+                table[MAX_RUNS + r] = [
+                    if lin.data[r] { lin.data_starts[r] as i32 } else { 0 },
+                    if lout.data[r] { lout.data_starts[r] as i32 } else { -1 },
+                    0,
+                    0,
+                ];
+            }
+            Buffer::with_data(ctx, &table, "subdiv runs")
+        })
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    Ok(tables)
+}
+
+/// The row ranges of each output stream and the variant (`[smooth, sharp, data]`) that
+/// draws each: the runs without input data (first: runs are sorted by horizon,
+/// `fragment`) with the smooth variant, the other positions with the sharp one, the data
+/// block with the data one.
+fn draw_ranges<'p>(
+    packing: &Packing,
+    gpu_levels: u32,
+    options: &Options,
+    [smooth, sharp, data]: [&'p Pipeline; 3],
+) -> Vec<[(&'p Pipeline, u32, u32); 3]> {
+    let w = u64::from(packing.width);
+    (0..gpu_levels as usize)
+        .map(|j| {
+            let (lin, lout) = (&packing.layouts[j], &packing.layouts[j + 1]);
+            let position_rows = lout.positions.div_ceil(w) as u32;
+            let first_sharp = lin.data.iter().position(|&d| d);
+            let split = match first_sharp {
+                _ if options.single_shader => 0,
+                Some(r) => (lout.starts[r] / w) as u32,
+                None => position_rows,
+            };
+            let data_row = (lout.data_start / w) as u32;
+            let data_rows = if lout.data.contains(&true) { packing.rows(j + 1) - data_row } else { 0 };
+            [(smooth, 0, split), (sharp, split, position_rows - split), (data, data_row, data_rows)]
+        })
+        .collect()
 }
 
 /// Refines `mesh` `level` times on the GPU with a fresh pipeline and targets (see

@@ -99,27 +99,22 @@ struct Parser<'a> {
     ignored: Vec<Ignored>,
 }
 
-impl<'a> Parser<'a> {
-    fn new(path: &'a Path, mesh: &'a Mesh, map: &'a [u32]) -> Parser<'a> {
-        Parser {
-            path,
-            mesh,
-            map,
-            edges: HashSet::new(),
-            features: Features::default(),
-            options: TaggedOptions::default(),
-            ignored: Vec::new(),
-        }
-    }
+/// One `t` line: its name and its integer, float (sharpness) and string arguments.
+struct Tag<'w> {
+    path: &'w Path,
+    line: usize,
+    name: &'w str,
+    ints: Vec<u32>,
+    floats: Vec<f32>,
+    strings: Vec<&'w str>,
+}
 
-    fn error(&self, line: usize, message: String) -> SubdivError {
-        MeshError::parse(self.path, Location::Line(line), message).into()
-    }
-
-    fn tag(&mut self, line: usize, words: Vec<&str>) -> Result<()> {
-        let path = self.path;
+impl<'w> Tag<'w> {
+    /// `NAME nint/nfloat/nstring ARGS…`: the counts must match the arguments, the
+    /// integers be indices and the floats sharpnesses.
+    fn parse(path: &'w Path, line: usize, words: &[&'w str]) -> Result<Tag<'w>> {
         let err = |m: String| -> SubdivError { MeshError::parse(path, Location::Line(line), m).into() };
-        let [name, counts, args @ ..] = words.as_slice() else {
+        let [name, counts, args @ ..] = words else {
             return Err(err("a tag needs a name and 'nint/nfloat/nstring' counts".into()));
         };
         let counts: Vec<usize> = counts.split('/').map(|c| c.parse().unwrap_or(usize::MAX)).collect();
@@ -147,99 +142,84 @@ impl<'a> Parser<'a> {
                 _ => Err(err(format!("tag '{name}': '{a}' is not a sharpness (a finite number ≥ 0)"))),
             })
             .collect::<Result<_>>()?;
-        let strings = &args[nint + nfloat..];
-        // One sharpness for all items or one each.
-        let sharpness = |i: usize, items: usize| match floats.len() {
-            1 => Ok(floats[0]),
-            n if n == items => Ok(floats[i]),
-            n => {
-                Err(err(format!("tag '{name}': {n} sharpness values for {items} items (give 1 or {items})")))
-            }
-        };
-        let one_int = |what: &str| match ints.as_slice() {
-            [i] if floats.is_empty() && strings.is_empty() => Ok(*i),
-            _ => Err(err(format!("tag '{name}' takes one integer ({what})"))),
-        };
-        let one_string = |what: &str| match strings {
-            [s] if ints.is_empty() && floats.is_empty() => Ok(*s),
-            _ => Err(err(format!("tag '{name}' takes one string ({what})"))),
-        };
-        match *name {
-            "crease" => {
-                if ints.is_empty() || ints.len() % 2 != 0 {
-                    return Err(err("tag 'crease' takes vertex pairs".into()));
-                }
-                if self.edges.is_empty() {
-                    self.edges = mesh_edges(self.mesh);
-                }
-                let pairs = ints.len() / 2;
-                for i in 0..pairs {
-                    let [a, b] = [self.vertex(line, ints[2 * i])?, self.vertex(line, ints[2 * i + 1])?];
-                    let (Some(a), Some(b)) = (a, b) else {
-                        return Err(err(format!(
-                            "tag 'crease': vertices {} and {} are not joined by an edge (no face uses one of them)",
-                            ints[2 * i],
-                            ints[2 * i + 1]
-                        )));
-                    };
-                    if !self.edges.contains(&(a.min(b), a.max(b))) {
-                        return Err(err(format!(
-                            "tag 'crease': vertices {} and {} are not joined by an edge",
-                            ints[2 * i],
-                            ints[2 * i + 1]
-                        )));
-                    }
-                    let sharpness = sharpness(i, pairs)?;
-                    self.features.creases.push(Crease { vertices: [a, b], sharpness });
-                }
-            }
-            "corner" => {
-                if ints.is_empty() {
-                    return Err(err("tag 'corner' takes vertices".into()));
-                }
-                for (i, &v) in ints.iter().enumerate() {
-                    let sharpness = sharpness(i, ints.len())?;
-                    match self.vertex(line, v)? {
-                        Some(vertex) => self.features.corners.push(Corner { vertex, sharpness }),
-                        None => self.ignored.push(Ignored {
-                            line,
-                            name: "corner".into(),
-                            why: format!("vertex {v} is used by no face (texgeo drops it)"),
-                        }),
-                    }
-                }
-            }
-            "hole" => {
-                if !floats.is_empty() || !strings.is_empty() {
-                    return Err(err("tag 'hole' takes only face indices".into()));
-                }
-                for &f in &ints {
-                    if f as usize >= self.mesh.num_faces() {
-                        return Err(err(format!(
-                            "tag 'hole': face {f} is out of range ({} faces)",
-                            self.mesh.num_faces()
-                        )));
-                    }
-                    self.features.holes.push(f);
-                }
-            }
+        let strings = args[nint + nfloat..].to_vec();
+        Ok(Tag { path, line, name, ints, floats, strings })
+    }
+
+    fn error(&self, message: String) -> SubdivError {
+        MeshError::parse(self.path, Location::Line(self.line), message).into()
+    }
+
+    /// The sharpness of item `i` of `items`: one for all items or one each.
+    fn sharpness(&self, i: usize, items: usize) -> Result<f32> {
+        let name = self.name;
+        match self.floats.len() {
+            1 => Ok(self.floats[0]),
+            n if n == items => Ok(self.floats[i]),
+            n => Err(self
+                .error(format!("tag '{name}': {n} sharpness values for {items} items (give 1 or {items})"))),
+        }
+    }
+
+    /// The one integer argument (`what` it means).
+    fn one_int(&self, what: &str) -> Result<u32> {
+        match self.ints.as_slice() {
+            [i] if self.floats.is_empty() && self.strings.is_empty() => Ok(*i),
+            _ => Err(self.error(format!("tag '{}' takes one integer ({what})", self.name))),
+        }
+    }
+
+    /// The one string argument (`what` it may be).
+    fn one_string(&self, what: &str) -> Result<&'w str> {
+        match self.strings.as_slice() {
+            [s] if self.ints.is_empty() && self.floats.is_empty() => Ok(*s),
+            _ => Err(self.error(format!("tag '{}' takes one string ({what})", self.name))),
+        }
+    }
+}
+
+impl<'a> Parser<'a> {
+    fn new(path: &'a Path, mesh: &'a Mesh, map: &'a [u32]) -> Parser<'a> {
+        Parser {
+            path,
+            mesh,
+            map,
+            edges: HashSet::new(),
+            features: Features::default(),
+            options: TaggedOptions::default(),
+            ignored: Vec::new(),
+        }
+    }
+
+    fn error(&self, line: usize, message: String) -> SubdivError {
+        MeshError::parse(self.path, Location::Line(line), message).into()
+    }
+
+    fn tag(&mut self, line: usize, words: Vec<&str>) -> Result<()> {
+        let tag = Tag::parse(self.path, line, &words)?;
+        let err = |m: String| tag.error(m);
+        match tag.name {
+            "crease" => self.crease(&tag)?,
+            "corner" => self.corner(&tag)?,
+            "hole" => self.hole(&tag)?,
             "interpolateboundary" => {
-                self.options.boundary = Some(match one_int("0 none, 1 edge-and-corner, 2 edge-only")? {
-                    0 => Boundary::None,
-                    1 => Boundary::EdgeAndCorner,
-                    2 => Boundary::EdgeOnly,
-                    n => return Err(err(format!("tag 'interpolateboundary': {n} is not 0, 1 or 2"))),
-                });
+                self.options.boundary =
+                    Some(match tag.one_int("0 none, 1 edge-and-corner, 2 edge-only")? {
+                        0 => Boundary::None,
+                        1 => Boundary::EdgeAndCorner,
+                        2 => Boundary::EdgeOnly,
+                        n => return Err(err(format!("tag 'interpolateboundary': {n} is not 0, 1 or 2"))),
+                    });
             }
             "creasemethod" => {
-                self.options.crease_method = Some(match one_string("normal or chaikin")? {
+                self.options.crease_method = Some(match tag.one_string("normal or chaikin")? {
                     "normal" | "uniform" => CreaseMethod::Uniform,
                     "chaikin" => CreaseMethod::Chaikin,
                     s => return Err(err(format!("tag 'creasemethod': '{s}' is not normal or chaikin"))),
                 });
             }
             "smoothtriangles" => {
-                self.options.triangles = Some(match one_string("catmark or smooth")? {
+                self.options.triangles = Some(match tag.one_string("catmark or smooth")? {
                     "catmark" => Triangles::Catmark,
                     "smooth" => Triangles::Smooth,
                     s => return Err(err(format!("tag 'smoothtriangles': '{s}' is not catmark or smooth"))),
@@ -250,6 +230,74 @@ impl<'a> Parser<'a> {
                 name: other.to_string(),
                 why: "does not change vertex positions".into(),
             }),
+        }
+        Ok(())
+    }
+
+    /// `t crease 2n/1/0 a b …`: each vertex pair an edge of the mesh.
+    fn crease(&mut self, tag: &Tag) -> Result<()> {
+        let ints = &tag.ints;
+        if ints.is_empty() || ints.len() % 2 != 0 {
+            return Err(tag.error("tag 'crease' takes vertex pairs".into()));
+        }
+        if self.edges.is_empty() {
+            self.edges = mesh_edges(self.mesh);
+        }
+        let pairs = ints.len() / 2;
+        for i in 0..pairs {
+            let [a, b] = [self.vertex(tag.line, ints[2 * i])?, self.vertex(tag.line, ints[2 * i + 1])?];
+            let (Some(a), Some(b)) = (a, b) else {
+                return Err(tag.error(format!(
+                    "tag 'crease': vertices {} and {} are not joined by an edge (no face uses one of them)",
+                    ints[2 * i],
+                    ints[2 * i + 1]
+                )));
+            };
+            if !self.edges.contains(&(a.min(b), a.max(b))) {
+                return Err(tag.error(format!(
+                    "tag 'crease': vertices {} and {} are not joined by an edge",
+                    ints[2 * i],
+                    ints[2 * i + 1]
+                )));
+            }
+            let sharpness = tag.sharpness(i, pairs)?;
+            self.features.creases.push(Crease { vertices: [a, b], sharpness });
+        }
+        Ok(())
+    }
+
+    /// `t corner n/1/0 v …`: a vertex no face uses is ignored (the mesh drops it).
+    fn corner(&mut self, tag: &Tag) -> Result<()> {
+        if tag.ints.is_empty() {
+            return Err(tag.error("tag 'corner' takes vertices".into()));
+        }
+        for (i, &v) in tag.ints.iter().enumerate() {
+            let sharpness = tag.sharpness(i, tag.ints.len())?;
+            match self.vertex(tag.line, v)? {
+                Some(vertex) => self.features.corners.push(Corner { vertex, sharpness }),
+                None => self.ignored.push(Ignored {
+                    line: tag.line,
+                    name: "corner".into(),
+                    why: format!("vertex {v} is used by no face (texgeo drops it)"),
+                }),
+            }
+        }
+        Ok(())
+    }
+
+    /// `t hole n/0/0 f …`: faces of the mesh.
+    fn hole(&mut self, tag: &Tag) -> Result<()> {
+        if !tag.floats.is_empty() || !tag.strings.is_empty() {
+            return Err(tag.error("tag 'hole' takes only face indices".into()));
+        }
+        for &f in &tag.ints {
+            if f as usize >= self.mesh.num_faces() {
+                return Err(tag.error(format!(
+                    "tag 'hole': face {f} is out of range ({} faces)",
+                    self.mesh.num_faces()
+                )));
+            }
+            self.features.holes.push(f);
         }
         Ok(())
     }

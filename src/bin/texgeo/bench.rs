@@ -354,17 +354,9 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             runs,
             out,
         } => {
-            use bench::scale::{Config, Model};
+            use bench::scale::Config;
             use texgeo::inclusion::{Choice, Method};
-            let mesh = mesh.unwrap_or_else(|| {
-                let armadillo = models_dir.join("armadillo.off");
-                if armadillo.exists() { armadillo.into() } else { "builtin:knot".into() }
-            });
-            let inclusion = Model { name: mesh.to_string(), mesh: solid_in_its_units(&mesh)? };
-            let voxel = match voxel_mesh {
-                Some(v) => Model { name: v.to_string(), mesh: solid_in_its_units(&v)? },
-                None => Model { name: inclusion.name.clone(), mesh: inclusion.mesh.clone() },
-            };
+            let (inclusion, voxel) = scale_models(mesh, voxel_mesh, &models_dir)?;
             anyhow::ensure!(points.iter().all(|&n| n > 0), "--points takes counts ≥ 1");
             for &n in &sizes {
                 texgeo::voxel::grid::check_resolution(n)?;
@@ -392,7 +384,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             write_scaling,
             common,
         } => {
-            use bench::boolean::{Config, Pair, STAND_INS, scaling_pair};
+            use bench::boolean::{Config, Pair, STAND_INS};
             anyhow::ensure!(
                 cpu_method.is_cpu(),
                 "--method takes a CPU inclusion method (the GPU one always runs)"
@@ -407,15 +399,7 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
                     .collect::<anyhow::Result<Vec<_>>>()?
             };
             if let Some(dir) = &write_scaling {
-                texgeo::output::check_dir(dir)?;
-                for &n in scaling.iter().filter(|&&n| n > 0) {
-                    let pair = scaling_pair(n)?;
-                    for (side, mesh) in [("a", &pair.a), ("b", &pair.b)] {
-                        let path = dir.join(format!("sphere-{n}-{side}.off"));
-                        texgeo::mesh::formats::write(&path, mesh)
-                            .with_context(|| format!("writing {}", path.display()))?;
-                    }
-                }
+                write_scaling_pairs(dir, &scaling)?;
             }
             let cfg = Config {
                 runs: common.runs,
@@ -439,14 +423,11 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
             finish(around.run(|| bench::reduce::run(ctx, &sizes, common.runs))?, &common)
         }
         Command::Subdivide { level, meshes, models, only, validate, creases, crease_angle, common } => {
-            use bench::subdiv::{CreaseSettings, Model, Settings, crease_models, default_models};
+            use bench::subdiv::{CreaseSettings, Settings, crease_models, default_models};
             if creases {
                 anyhow::ensure!((0.0..=180.0).contains(&crease_angle), "--crease-angle must be in 0..=180");
-                let mut list = if only { Vec::new() } else { crease_models(&models)? };
-                for m in &meshes {
-                    list.push(Model { name: m.to_string(), mesh: crate::mesh::load(m)? });
-                }
-                anyhow::ensure!(!list.is_empty(), "no models to measure");
+                let list =
+                    subdivide_models(if only { Vec::new() } else { crease_models(&models)? }, &meshes)?;
                 let settings = CreaseSettings {
                     level,
                     runs: common.runs,
@@ -455,15 +436,58 @@ fn measure(ctx: &texgeo::gpu::Context, cmd: Command, around: &Around) -> anyhow:
                 };
                 return finish(around.run(|| bench::subdiv::run_creases(ctx, &list, settings))?, &common);
             }
-            let mut list = if only { Vec::new() } else { default_models(&models)? };
-            for m in &meshes {
-                list.push(Model { name: m.to_string(), mesh: crate::mesh::load(m)? });
-            }
-            anyhow::ensure!(!list.is_empty(), "no models to measure");
+            let list = subdivide_models(if only { Vec::new() } else { default_models(&models)? }, &meshes)?;
             let settings = Settings { level, runs: common.runs, validate };
             finish(around.run(|| bench::subdiv::run(ctx, &list, settings))?, &common)
         }
     }
+}
+
+/// The meshes of `bench scale`: the inclusion mesh (`--mesh`, else the armadillo when
+/// fetched, else the knot) and the voxelization mesh (`--voxel-mesh`, else the same).
+fn scale_models(
+    mesh: Option<MeshArg>,
+    voxel_mesh: Option<MeshArg>,
+    models_dir: &std::path::Path,
+) -> anyhow::Result<(bench::scale::Model, bench::scale::Model)> {
+    use bench::scale::Model;
+    let mesh = mesh.unwrap_or_else(|| {
+        let armadillo = models_dir.join("armadillo.off");
+        if armadillo.exists() { armadillo.into() } else { "builtin:knot".into() }
+    });
+    let inclusion = Model { name: mesh.to_string(), mesh: solid_in_its_units(&mesh)? };
+    let voxel = match voxel_mesh {
+        Some(v) => Model { name: v.to_string(), mesh: solid_in_its_units(&v)? },
+        None => Model { name: inclusion.name.clone(), mesh: inclusion.mesh.clone() },
+    };
+    Ok((inclusion, voxel))
+}
+
+/// `--write-scaling DIR`: both operands of every scaling size as `sphere-N-a.off` and
+/// `sphere-N-b.off`.
+fn write_scaling_pairs(dir: &std::path::Path, scaling: &[usize]) -> anyhow::Result<()> {
+    texgeo::output::check_dir(dir)?;
+    for &n in scaling.iter().filter(|&&n| n > 0) {
+        let pair = bench::boolean::scaling_pair(n)?;
+        for (side, mesh) in [("a", &pair.a), ("b", &pair.b)] {
+            let path = dir.join(format!("sphere-{n}-{side}.off"));
+            texgeo::mesh::formats::write(&path, mesh)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// The models of `bench subdivide`: `list` and then the `--mesh` ones; at least one.
+fn subdivide_models(
+    mut list: Vec<bench::subdiv::Model>,
+    meshes: &[MeshArg],
+) -> anyhow::Result<Vec<bench::subdiv::Model>> {
+    for m in meshes {
+        list.push(bench::subdiv::Model { name: m.to_string(), mesh: crate::mesh::load(m)? });
+    }
+    anyhow::ensure!(!list.is_empty(), "no models to measure");
+    Ok(list)
 }
 
 /// A mesh that must be a solid, in its own units (the benchmark writes its voxels and

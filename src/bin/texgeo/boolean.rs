@@ -388,27 +388,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     // Everything a user can get wrong is checked before any work.
     let method = args.evaluate.method;
     let (arg_a, arg_b) = (&args.operands[0], &args.operands[1]);
-    let op: Option<Operation> = args.op.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
-    let outputs: Vec<(Operation, PathBuf)> = match (&args.output, &args.all) {
-        (Some(path), _) => {
-            check_mesh_output(path, &[arg_a, arg_b])?;
-            let op = op.context("--op is needed with -o")?;
-            vec![(op, path.clone())]
-        }
-        (None, Some(dir)) => {
-            let probe = dir.join(format!("union.{}", args.format));
-            Format::from_path(&probe).with_context(|| format!("--format {}", args.format))?;
-            texgeo::output::check_dir(dir)?;
-            let ops: Vec<Operation> = op.map_or(Operation::ALL.to_vec(), |o| vec![o]);
-            let paths: Vec<(Operation, PathBuf)> =
-                ops.into_iter().map(|o| (o, dir.join(format!("{}.{}", o.name(), args.format)))).collect();
-            for (_, path) in &paths {
-                texgeo::output::check_not_input(path, &MeshArg::files([arg_a, arg_b]))?;
-            }
-            paths
-        }
-        (None, None) => anyhow::bail!("give -o OUT or --all DIR"),
-    };
+    let outputs = planned_outputs(&args)?;
     if let Some(dir) = &args.pictures {
         texgeo::output::check_dir(dir)?;
     }
@@ -429,7 +409,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
 
     let assemble = Instant::now();
     let regularized = !args.non_regularized;
-    let results: Vec<(Operation, PathBuf, boolean::Output)> = outputs
+    let results: Vec<Written> = outputs
         .into_iter()
         .map(|(op, path)| Ok((op, path, ev.output(op, regularized)?)))
         .collect::<anyhow::Result<_>>()?;
@@ -462,65 +442,133 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             path.display()
         );
     }
+    let run =
+        Finished { names: [&a_name, &b_name], ev: &ev, results: &results, regularized, ctx: ctx.as_ref() };
+    let phases = Phases { read, assemble, write, total };
     if args.evaluate.json {
-        let operations: Vec<serde_json::Value> = results
+        texgeo::json::print(&run.json(args.evaluate.stats, &phases));
+    }
+    if args.evaluate.stats {
+        run.print_stats(&phases);
+    }
+    Ok(())
+}
+
+/// One operation's result and where it was written.
+type Written = (Operation, PathBuf, boolean::Output);
+
+/// The outputs asked for: `-o OUT` (with `--op`), or one file per operation under `--all
+/// DIR`; checked before any work (format, folder, not an input).
+fn planned_outputs(args: &Args) -> anyhow::Result<Vec<(Operation, PathBuf)>> {
+    let (arg_a, arg_b) = (&args.operands[0], &args.operands[1]);
+    let op: Option<Operation> = args.op.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
+    Ok(match (&args.output, &args.all) {
+        (Some(path), _) => {
+            check_mesh_output(path, &[arg_a, arg_b])?;
+            let op = op.context("--op is needed with -o")?;
+            vec![(op, path.clone())]
+        }
+        (None, Some(dir)) => {
+            let probe = dir.join(format!("union.{}", args.format));
+            Format::from_path(&probe).with_context(|| format!("--format {}", args.format))?;
+            texgeo::output::check_dir(dir)?;
+            let ops: Vec<Operation> = op.map_or(Operation::ALL.to_vec(), |o| vec![o]);
+            let paths: Vec<(Operation, PathBuf)> =
+                ops.into_iter().map(|o| (o, dir.join(format!("{}.{}", o.name(), args.format)))).collect();
+            for (_, path) in &paths {
+                texgeo::output::check_not_input(path, &MeshArg::files([arg_a, arg_b]))?;
+            }
+            paths
+        }
+        (None, None) => anyhow::bail!("give -o OUT or --all DIR"),
+    })
+}
+
+/// The times of a run's steps around the evaluation (its own are in its timings).
+struct Phases {
+    read: Duration,
+    assemble: Duration,
+    write: Duration,
+    /// When the run started.
+    total: Instant,
+}
+
+/// A finished two-operand run, for its summaries.
+struct Finished<'a> {
+    names: [&'a str; 2],
+    ev: &'a Evaluation,
+    results: &'a [Written],
+    regularized: bool,
+    ctx: Option<&'a Context>,
+}
+
+impl Finished<'_> {
+    /// `--json`: every operation's result; with `--stats`, the evaluation's counts, the
+    /// times and the device.
+    fn json(&self, stats: bool, phases: &Phases) -> serde_json::Value {
+        let [a_name, b_name] = self.names;
+        let operations: Vec<serde_json::Value> = self
+            .results
             .iter()
             .map(|(op, path, out)| {
                 let mut o = serde_json::json!({
                     "op": op.name(),
-                    "regularized": regularized,
+                    "regularized": self.regularized,
                     "triangles": out.mesh.num_faces(),
                     "volume": volume(&out.mesh),
                     "output": path.display().to_string(),
                 });
-                if args.evaluate.stats && regularized {
+                if stats && self.regularized {
                     o["repair"] = repair_json(&out.repair);
                 }
                 o
             })
             .collect();
         let mut object = serde_json::json!({ "operations": operations });
-        if args.evaluate.stats {
-            let t = &ev.timings;
-            object["stats"] = evaluation_json(&a_name, &b_name, &ev);
+        if stats {
+            let t = &self.ev.timings;
+            object["stats"] = evaluation_json(a_name, b_name, self.ev);
             object["time"] = serde_json::json!({
-                "read_ms": ms(read),
+                "read_ms": ms(phases.read),
                 "check_ms": ms(t.check),
                 "refine_ms": ms(t.refine),
                 "classifiers_ms": ms(t.classifiers),
                 "classify_ms": ms(t.classify),
-                "assemble_ms": ms(assemble),
-                "write_ms": ms(write),
-                "total_ms": ms(total.elapsed()),
+                "assemble_ms": ms(phases.assemble),
+                "write_ms": ms(phases.write),
+                "total_ms": ms(phases.total.elapsed()),
             });
-            object["device"] = ctx.as_ref().map(|c| c.info().label()).into();
+            object["device"] = self.ctx.map(|c| c.info().label()).into();
         }
-        texgeo::json::print(&object);
+        object
     }
-    if args.evaluate.stats {
-        let t = &ev.timings;
-        for line in evaluation_lines(&a_name, &b_name, &ev) {
+
+    /// `--stats` for a person: the evaluation's counts, each result's repair, the times
+    /// of both phases and the device.
+    fn print_stats(&self, phases: &Phases) {
+        let [a_name, b_name] = self.names;
+        let t = &self.ev.timings;
+        for line in evaluation_lines(a_name, b_name, self.ev) {
             say!("{line}");
         }
-        for (op, _, out) in results.iter().filter(|_| regularized) {
+        for (op, _, out) in self.results.iter().filter(|_| self.regularized) {
             say!("{op} after rounding to f64: {}", out.repair);
         }
         say!(
             "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms), write {:.1} ms, total {:.1} ms",
-            ms(read),
+            ms(phases.read),
             ms(t.check),
             ms(t.refine),
             ms(t.classifiers),
             ms(t.classify),
-            ms(assemble),
-            ms(write),
-            ms(total.elapsed())
+            ms(phases.assemble),
+            ms(phases.write),
+            ms(phases.total.elapsed())
         );
-        if let Some(ctx) = &ctx {
+        if let Some(ctx) = self.ctx {
             say!("device: {}", ctx.info().label());
         }
     }
-    Ok(())
 }
 
 /// The Fig. 6-9 … 6-12 picture of `op` (800×600, 4 samples per pixel).

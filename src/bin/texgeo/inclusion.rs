@@ -62,29 +62,7 @@ const LABEL_EXTENSIONS: [&str; 5] = ["txt", "dat", "csv", "labels", "npy"];
 const BYTES_PER_POINT: u64 = 64;
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
-    if let Some(out) = &args.output {
-        if out.extension().is_some() {
-            texgeo::output::check_extension(
-                out,
-                &LABEL_EXTENSIONS,
-                "labels are written as text (or NumPy), not in the format that name says",
-            )?;
-        }
-        let mut inputs = crate::mesh::MeshArg::files([&args.mesh]);
-        inputs.extend(args.points.as_deref());
-        texgeo::output::check_output(out, &inputs)?;
-    }
-    // The size of what is held whole, before anything is read or allocated: random points
-    // and `.npy` files (text files are read a block at a time).
-    match (&args.points, args.random) {
-        (Some(file), _) if points::is_npy(file) => {
-            // A point takes 12 bytes of .npy at least.
-            let bytes = std::fs::metadata(file).map_err(|e| texgeo::output::Error::new(file, e))?.len();
-            check_size(bytes / 12 + 1, true, args.output.is_some())?;
-        }
-        (None, Some(n)) => check_size(n as u64, false, args.output.is_some())?,
-        _ => {}
-    }
+    check_request(&args)?;
     let policy =
         Policy { allow_open: args.allow_open, flip_inverted: args.flip_inverted, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--allow-open", "--flip-inverted"])?;
@@ -97,17 +75,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         crate::mesh::warn_non_solid(&args.mesh, defect);
     }
     // Points are given in the mesh's units and classified in its frame.
-    let frame = solid.frame;
-    let mut source = match (&args.points, args.random) {
-        (Some(file), _) => points::PointReader::open(file)?,
-        (_, Some(n)) => {
-            let (lo, hi) = mesh.bounds();
-            let (lo, hi) = (frame.point_out(lo), frame.point_out(hi));
-            points::PointReader::from_points(Rng::new(args.seed).points_in_box(n, lo, hi), "--random")
-        }
-        (None, None) => anyhow::bail!("give --points FILE or --random N"),
-    }
-    .in_frame(frame);
+    let mut source = point_source(&args, mesh, solid.frame)?.in_frame(solid.frame);
     let first = source.next_block()?;
     let ctx = if args.method.is_cpu() { None } else { Some(crate::open_context_for(device, "cpu")?) };
     let options = Options {
@@ -138,30 +106,9 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     let mut solver = Solver::new(method, mesh, &options, ctx.as_ref(), args.batch)
         .with_context(|| format!("preparing {} for {}", method, args.mesh))?;
     let build = t.elapsed();
-    // Block by block: classify, count, write (a text output as it goes; a `.npy` output
-    // needs the count in its header, so its one byte per point waits for the end).
-    let mut out = match &args.output {
-        Some(path) => Some(texgeo::output::AtomicFile::create(path)?),
-        None => None,
-    };
-    let npy_out = args.output.as_deref().is_some_and(points::is_npy);
-    let mut all = Vec::new();
-    let streamed = solver.classify_stream(first, &mut source, |classes| -> anyhow::Result<()> {
-        match &mut out {
-            Some(_) if npy_out => all.extend_from_slice(classes),
-            Some(file) => points::write_classes(file, classes).map_err(|e| file.error(e))?,
-            None => {}
-        }
-        Ok(())
-    })?;
-    if let Some(mut file) = out {
-        if npy_out {
-            points::write_classes_npy(&mut file, &all).map_err(|e| file.error(e))?;
-        }
-        file.commit()?;
-        if !args.json {
-            return Ok(());
-        }
+    let streamed = classify_into(&mut solver, first, &mut source, args.output.as_deref())?;
+    if args.output.is_some() && !args.json {
+        return Ok(());
     }
     if args.json {
         texgeo::json::print(&solver::Summary {
@@ -179,9 +126,100 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         });
         return Ok(());
     }
+    print_summary(&args.mesh, &solver, &streamed, build, ctx.as_ref());
+    Ok(())
+}
+
+/// Refuses, before anything is read or allocated, an output that is not a labels file
+/// or would overwrite an input, and a point count that does not fit in memory (random
+/// points and `.npy` files are held whole; text files are read a block at a time).
+fn check_request(args: &Args) -> anyhow::Result<()> {
+    if let Some(out) = &args.output {
+        if out.extension().is_some() {
+            texgeo::output::check_extension(
+                out,
+                &LABEL_EXTENSIONS,
+                "labels are written as text (or NumPy), not in the format that name says",
+            )?;
+        }
+        let mut inputs = crate::mesh::MeshArg::files([&args.mesh]);
+        inputs.extend(args.points.as_deref());
+        texgeo::output::check_output(out, &inputs)?;
+    }
+    match (&args.points, args.random) {
+        (Some(file), _) if points::is_npy(file) => {
+            // A point takes 12 bytes of .npy at least.
+            let bytes = std::fs::metadata(file).map_err(|e| texgeo::output::Error::new(file, e))?.len();
+            check_size(bytes / 12 + 1, true, args.output.is_some())?;
+        }
+        (None, Some(n)) => check_size(n as u64, false, args.output.is_some())?,
+        _ => {}
+    }
+    Ok(())
+}
+
+/// The points: `--points FILE`, or `--random N` in the mesh's bounding box (in the
+/// mesh's units).
+fn point_source(
+    args: &Args,
+    mesh: &texgeo::mesh::Mesh,
+    frame: texgeo::mesh::frame::Frame,
+) -> anyhow::Result<points::PointReader> {
+    Ok(match (&args.points, args.random) {
+        (Some(file), _) => points::PointReader::open(file)?,
+        (_, Some(n)) => {
+            let (lo, hi) = mesh.bounds();
+            let (lo, hi) = (frame.point_out(lo), frame.point_out(hi));
+            points::PointReader::from_points(Rng::new(args.seed).points_in_box(n, lo, hi), "--random")
+        }
+        (None, None) => anyhow::bail!("give --points FILE or --random N"),
+    })
+}
+
+/// Classifies every point block by block, writing the labels to `output` when given (a
+/// text output as it goes; a `.npy` output needs the count in its header, so its one
+/// byte per point waits for the end).
+fn classify_into(
+    solver: &mut Solver,
+    first: Option<Vec<glam::DVec3>>,
+    source: &mut points::PointReader,
+    output: Option<&std::path::Path>,
+) -> anyhow::Result<solver::Streamed> {
+    let mut out = match output {
+        Some(path) => Some(texgeo::output::AtomicFile::create(path)?),
+        None => None,
+    };
+    let npy_out = output.is_some_and(points::is_npy);
+    let mut all = Vec::new();
+    let streamed = solver.classify_stream(first, source, |classes| -> anyhow::Result<()> {
+        match &mut out {
+            Some(_) if npy_out => all.extend_from_slice(classes),
+            Some(file) => points::write_classes(file, classes).map_err(|e| file.error(e))?,
+            None => {}
+        }
+        Ok(())
+    })?;
+    if let Some(mut file) = out {
+        if npy_out {
+            points::write_classes_npy(&mut file, &all).map_err(|e| file.error(e))?;
+        }
+        file.commit()?;
+    }
+    Ok(streamed)
+}
+
+/// The counts, the method's build and classification times and the GPU's share, for a
+/// person.
+fn print_summary(
+    mesh: &crate::mesh::MeshArg,
+    solver: &Solver,
+    streamed: &solver::Streamed,
+    build: std::time::Duration,
+    ctx: Option<&texgeo::gpu::Context>,
+) {
     say!(
         "{}: {} points, {} inside, {} outside, {} on the boundary",
-        args.mesh,
+        mesh,
         streamed.total(),
         streamed.count(Class::Inside),
         streamed.count(Class::Outside),
@@ -204,11 +242,10 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             gpu.flagged,
             gpu.fallback.as_secs_f64() * 1e3
         );
-        if let Some(ctx) = &ctx {
+        if let Some(ctx) = ctx {
             say!("device: {}", ctx.info().label());
         }
     }
-    Ok(())
 }
 
 /// Refuses, before any work, a point count whose memory exceeds what is available; the

@@ -66,34 +66,8 @@ pub struct Args {
 }
 
 pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
-    // Check the request and every output path before touching the mesh or the device.
-    texgeo::voxel::grid::check_resolution(args.res)?;
-    texgeo::output::check_extension(
-        &args.output,
-        &["binvox", "npy"],
-        "the volume is written as binvox or NumPy",
-    )?;
-    let inputs = crate::mesh::MeshArg::files([&args.mesh]);
-    texgeo::output::check_output(&args.output, &inputs)?;
+    let aspect_dir = check_outputs(&args)?;
     let npy = npy::is_npy(&args.output);
-    if npy {
-        texgeo::output::check_output(npy::sidecar(&args.output), &inputs)?;
-    }
-    if args.json {
-        texgeo::json::text_to_stderr();
-    }
-    if let Some(dir) = &args.slices {
-        texgeo::output::check_dir(dir)?;
-    }
-    let aspect_dir = args.aspect.map(|_| {
-        args.aspect_out.clone().unwrap_or_else(|| {
-            let stem = args.output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            args.output.with_file_name(format!("{stem}-aspect"))
-        })
-    });
-    if let Some(dir) = &aspect_dir {
-        texgeo::output::check_dir(dir)?;
-    }
     let policy =
         Policy { flip_inverted: args.flip_inverted, allow_open: args.allow_open, ..Policy::default() };
     let solid = crate::mesh::load_solid(&args.mesh, policy, &["--flip-inverted", "--allow-open"])?;
@@ -105,25 +79,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     if let Some(defect) = &solid.non_solid {
         texgeo::voxel::check_non_solid(args.method).map_err(|e| anyhow::anyhow!("{}: {e}", args.mesh))?;
         crate::mesh::warn_non_solid(&args.mesh, defect);
-        let t = std::time::Instant::now();
-        let volume = texgeo::voxel::voxelize_non_solid(&mesh, &grid)?;
-        say!(
-            "{}: {}³ voxels, {} occupied, generalized winding number ≥ ½ (fast-winding) in {:.1} ms",
-            args.mesh,
-            args.res,
-            volume.count(),
-            t.elapsed().as_secs_f64() * 1e3
-        );
-        let timings = Timings { total: t.elapsed(), ..Timings::default() };
-        let ctx = match args.aspect {
-            Some(_) => Some(crate::open_context_for(device, "cpu, without --aspect")?),
-            None => None,
-        };
-        write_outputs(&args, &grid, &volume, ctx.as_ref(), aspect_dir.as_deref())?;
-        if args.json {
-            texgeo::json::print(&Summary::new(&grid, volume.count(), "fast-winding", timings, &args.output));
-        }
-        return Ok(());
+        return by_winding_number(device, &args, &mesh, &grid, aspect_dir.as_deref());
     }
     let solid = Solid::new(&mesh)?;
     let chosen = choose_method(args.method, &solid, &grid, args.aspect.is_some(), |fixed| {
@@ -142,28 +98,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         say!("device: {}", ctx.info().label());
     }
     if method == Method::Scanline && args.slices.is_none() && args.aspect.is_none() && !npy {
-        // Only the file is wanted: it is written while the volume is computed, a few x
-        // planes in memory at a time instead of N³ bits.
-        let t = std::time::Instant::now();
-        let streamed = binvox::write_scanline(&args.output, &grid, &solid)?;
-        say!(
-            "{}: {}³ voxels, {} occupied, method scanline in {:.1} ms, written to {} as computed{}",
-            args.mesh,
-            args.res,
-            streamed.occupied,
-            t.elapsed().as_secs_f64() * 1e3,
-            args.output.display(),
-            if streamed.whole_volume {
-                " (a row met the surface an odd number of times: whole volume)"
-            } else {
-                ""
-            }
-        );
-        if args.json {
-            let timings = Timings { total: t.elapsed(), ..Timings::default() };
-            texgeo::json::print(&Summary::new(&grid, streamed.occupied, "scanline", timings, &args.output));
-        }
-        return Ok(());
+        return scanline_to_file(&args, &grid, &solid);
     }
     let mut voxelizer = Voxelizer::new(ctx.clone());
     voxelizer.zone = args.zone;
@@ -197,6 +132,93 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         summary.exact_fallback = (result.band.tolerance > 0.0).then_some(result.band);
         summary.device = ctx.as_ref().map(|c| c.info().label());
         texgeo::json::print(&summary);
+    }
+    Ok(())
+}
+
+/// Checks the request and every output path before touching the mesh or the device;
+/// the folder of the aspect pictures, when asked for.
+fn check_outputs(args: &Args) -> anyhow::Result<Option<PathBuf>> {
+    texgeo::voxel::grid::check_resolution(args.res)?;
+    texgeo::output::check_extension(
+        &args.output,
+        &["binvox", "npy"],
+        "the volume is written as binvox or NumPy",
+    )?;
+    let inputs = crate::mesh::MeshArg::files([&args.mesh]);
+    texgeo::output::check_output(&args.output, &inputs)?;
+    if npy::is_npy(&args.output) {
+        texgeo::output::check_output(npy::sidecar(&args.output), &inputs)?;
+    }
+    if args.json {
+        texgeo::json::text_to_stderr();
+    }
+    if let Some(dir) = &args.slices {
+        texgeo::output::check_dir(dir)?;
+    }
+    let aspect_dir = args.aspect.map(|_| {
+        args.aspect_out.clone().unwrap_or_else(|| {
+            let stem = args.output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            args.output.with_file_name(format!("{stem}-aspect"))
+        })
+    });
+    if let Some(dir) = &aspect_dir {
+        texgeo::output::check_dir(dir)?;
+    }
+    Ok(aspect_dir)
+}
+
+/// A mesh that is not a solid (`--allow-open`): the voxels whose centres are inside by
+/// the generalized winding number.
+fn by_winding_number(
+    device: Option<&str>,
+    args: &Args,
+    mesh: &texgeo::mesh::Mesh,
+    grid: &Grid,
+    aspect_dir: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let t = std::time::Instant::now();
+    let volume = texgeo::voxel::voxelize_non_solid(mesh, grid)?;
+    say!(
+        "{}: {}³ voxels, {} occupied, generalized winding number ≥ ½ (fast-winding) in {:.1} ms",
+        args.mesh,
+        args.res,
+        volume.count(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    let timings = Timings { total: t.elapsed(), ..Timings::default() };
+    let ctx = match args.aspect {
+        Some(_) => Some(crate::open_context_for(device, "cpu, without --aspect")?),
+        None => None,
+    };
+    write_outputs(args, grid, &volume, ctx.as_ref(), aspect_dir)?;
+    if args.json {
+        texgeo::json::print(&Summary::new(grid, volume.count(), "fast-winding", timings, &args.output));
+    }
+    Ok(())
+}
+
+/// Only the file is wanted: it is written while the volume is computed, a few x planes
+/// in memory at a time instead of N³ bits.
+fn scanline_to_file(args: &Args, grid: &Grid, solid: &Solid) -> anyhow::Result<()> {
+    let t = std::time::Instant::now();
+    let streamed = binvox::write_scanline(&args.output, grid, solid)?;
+    say!(
+        "{}: {}³ voxels, {} occupied, method scanline in {:.1} ms, written to {} as computed{}",
+        args.mesh,
+        args.res,
+        streamed.occupied,
+        t.elapsed().as_secs_f64() * 1e3,
+        args.output.display(),
+        if streamed.whole_volume {
+            " (a row met the surface an odd number of times: whole volume)"
+        } else {
+            ""
+        }
+    );
+    if args.json {
+        let timings = Timings { total: t.elapsed(), ..Timings::default() };
+        texgeo::json::print(&Summary::new(grid, streamed.occupied, "scanline", timings, &args.output));
     }
     Ok(())
 }

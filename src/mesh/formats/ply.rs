@@ -176,76 +176,19 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 if encoding.is_some() {
                     return Err(err(line_no, "a second 'format' line".into()));
                 }
-                encoding = Some(match words.next() {
-                    Some("ascii") => Encoding::Ascii,
-                    Some("binary_little_endian") => Encoding::Binary { big_endian: false },
-                    Some("binary_big_endian") => Encoding::Binary { big_endian: true },
-                    other => {
-                        return Err(err(
-                            line_no,
-                            format!(
-                                "unknown format '{}' (expected ascii, binary_little_endian or \
-                                 binary_big_endian)",
-                                other.unwrap_or("")
-                            ),
-                        ));
-                    }
-                });
-                if !matches!(words.next(), Some("1.0" | "1")) {
-                    return Err(err(line_no, "only PLY version 1.0 is supported".into()));
-                }
+                encoding = Some(format_line(&mut words).map_err(|m| err(line_no, m))?);
             }
             "element" => {
-                let (Some(name), Some(count), None) = (words.next(), words.next(), words.next()) else {
-                    return Err(err(line_no, "expected 'element <name> <count>'".into()));
-                };
-                let count = count.parse::<u64>().map_err(|_| {
-                    err(line_no, format!("element count '{count}' is not a non-negative integer"))
-                })?;
-                if let Some(prev) = elements.last()
-                    && prev.props.is_empty()
-                    && prev.count > 0
-                {
-                    return Err(err(prev.line, format!("element '{}' has no properties", prev.name)));
-                }
-                if elements.iter().any(|e| e.name == name) {
-                    return Err(err(line_no, format!("a second element '{name}'")));
-                }
-                elements.push(Element { name: name.to_string(), count, line: line_no, props: Vec::new() });
+                let element = element_line(&mut words, &elements, line_no).map_err(|(l, m)| err(l, m))?;
+                elements.push(element);
             }
             "property" => {
                 let Some(element) = elements.last_mut() else {
                     return Err(err(line_no, "a property before any element".into()));
                 };
                 let words: Vec<&str> = words.collect();
-                let ty = |name: &str| {
-                    Scalar::parse(name).ok_or_else(|| err(line_no, format!("unknown property type '{name}'")))
-                };
-                let (kind, name) = match words.as_slice() {
-                    ["list", count, item, name] => {
-                        let (count, item) = (ty(count)?, ty(item)?);
-                        if !count.is_integer() {
-                            return Err(err(line_no, "a list count type must be an integer type".into()));
-                        }
-                        (Kind::List { count, item }, *name)
-                    }
-                    [t, name] if *t != "list" => (Kind::Scalar(ty(t)?), *name),
-                    _ => {
-                        return Err(err(
-                            line_no,
-                            "expected 'property <type> <name>' or 'property list <count type> <item type> \
-                             <name>'"
-                                .into(),
-                        ));
-                    }
-                };
-                if element.props.iter().any(|p| p.name == name) {
-                    return Err(err(
-                        line_no,
-                        format!("a second property '{name}' in element '{}'", element.name),
-                    ));
-                }
-                element.props.push(Property { name: name.to_string(), kind });
+                let property = property_line(&words, element).map_err(|m| err(line_no, m))?;
+                element.props.push(property);
             }
             "end_header" => break,
             other => return Err(err(line_no, format!("unknown header keyword '{other}'"))),
@@ -261,6 +204,76 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         return Err(err(last.line, format!("element '{}' has no properties", last.name)));
     }
     Ok(Header { encoding, elements, data_start: pos, lines: line_no })
+}
+
+/// `format <encoding> 1.0`: the encoding (the words after `format`).
+fn format_line(words: &mut std::str::SplitWhitespace) -> std::result::Result<Encoding, String> {
+    let encoding = match words.next() {
+        Some("ascii") => Encoding::Ascii,
+        Some("binary_little_endian") => Encoding::Binary { big_endian: false },
+        Some("binary_big_endian") => Encoding::Binary { big_endian: true },
+        other => {
+            return Err(format!(
+                "unknown format '{}' (expected ascii, binary_little_endian or binary_big_endian)",
+                other.unwrap_or("")
+            ));
+        }
+    };
+    if !matches!(words.next(), Some("1.0" | "1")) {
+        return Err("only PLY version 1.0 is supported".into());
+    }
+    Ok(encoding)
+}
+
+/// `element <name> <count>` on line `line_no` (the words after `element`), after
+/// `elements`: the element before must have properties, and no two share a name.
+/// `Err`: (line, message).
+fn element_line(
+    words: &mut std::str::SplitWhitespace,
+    elements: &[Element],
+    line_no: usize,
+) -> std::result::Result<Element, (usize, String)> {
+    let (Some(name), Some(count), None) = (words.next(), words.next(), words.next()) else {
+        return Err((line_no, "expected 'element <name> <count>'".into()));
+    };
+    let count = count
+        .parse::<u64>()
+        .map_err(|_| (line_no, format!("element count '{count}' is not a non-negative integer")))?;
+    if let Some(prev) = elements.last()
+        && prev.props.is_empty()
+        && prev.count > 0
+    {
+        return Err((prev.line, format!("element '{}' has no properties", prev.name)));
+    }
+    if elements.iter().any(|e| e.name == name) {
+        return Err((line_no, format!("a second element '{name}'")));
+    }
+    Ok(Element { name: name.to_string(), count, line: line_no, props: Vec::new() })
+}
+
+/// `property <type> <name>` or `property list <count type> <item type> <name>` (the
+/// words after `property`) of `element`, whose properties' names differ.
+fn property_line(words: &[&str], element: &Element) -> std::result::Result<Property, String> {
+    let ty = |name: &str| Scalar::parse(name).ok_or_else(|| format!("unknown property type '{name}'"));
+    let (kind, name) = match words {
+        ["list", count, item, name] => {
+            let (count, item) = (ty(count)?, ty(item)?);
+            if !count.is_integer() {
+                return Err("a list count type must be an integer type".into());
+            }
+            (Kind::List { count, item }, *name)
+        }
+        [t, name] if *t != "list" => (Kind::Scalar(ty(t)?), *name),
+        _ => {
+            return Err(
+                "expected 'property <type> <name>' or 'property list <count type> <item type> <name>'".into(),
+            );
+        }
+    };
+    if element.props.iter().any(|p| p.name == name) {
+        return Err(format!("a second property '{name}' in element '{}'", element.name));
+    }
+    Ok(Property { name: name.to_string(), kind })
 }
 
 /// A value read from the data.

@@ -161,8 +161,19 @@ pub const PHASE_COLUMNS: [&str; 15] = [
 /// hold milliseconds.
 pub const PHASE_MS: [usize; 4] = [8, 10, 12, 14];
 
-/// Runs the benchmark.
+/// Runs the benchmark: Table 6-1 over `pairs`, and the growth with size when asked.
 pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Report> {
+    let table = table6_1(ctx, pairs, cfg)?;
+    // No pairs (only the scaling series asked for): no empty Table 6-1.
+    let mut tables = if pairs.is_empty() { Vec::new() } else { vec![table] };
+    if !cfg.scaling.is_empty() {
+        tables.push(scaling_table(cfg)?);
+    }
+    Ok(Report { name: "boolean".into(), environment: Environment::new(ctx.info().label()), tables })
+}
+
+/// Table 6-1: every pair's operations, phase by phase, beside CGAL and the thesis.
+fn table6_1(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Table> {
     let columns = [
         &["pair (stand-in)"][..],
         &PHASE_COLUMNS,
@@ -176,71 +187,9 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
         .unit("s", 18..=19);
     let mut refused = Vec::new();
     for pair in pairs {
-        let triangles = pair.a.num_faces() + pair.b.num_faces();
-        // The CPU and GPU point tests in turn, run after run.
-        let (cpu, gpu) =
-            (sequential(cfg.cpu_method, Grouping::Grouped), sequential(Method::Gpu, Grouping::Grouped));
-        let grouped = measure_interleaved(pair, &[(&cpu, None), (&gpu, Some(ctx))], cfg.runs);
-        let mut both = match grouped {
-            Err(e @ boolean::BooleanError::Input { .. }) => {
-                crate::note!("texgeo: skipping {}: {e}", pair.name);
-                refused.push(format!("{} ({e})", pair.name));
-                continue;
-            }
-            r => r?,
-        };
-        let (_, p2_gpu, _, ev_gpu) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
-        let (p1, p2, asm, ev) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
-        // The GPU and CPU classifications agree (they are both exact).
-        let same =
-            ev_gpu.classification.a == ev.classification.a && ev_gpu.classification.b == ev.classification.b;
-        let plain = if cfg.plain {
-            Some(measure(pair, &sequential(cfg.cpu_method, Grouping::Plain), None, 1)?)
-        } else {
-            None
-        };
-        let reference = if cfg.cgal {
-            match cgal::reference(&pair.a, &pair.b, Some(cfg.runs.max(1) as u32)) {
-                Ok(r) => Some(r),
-                Err(e) => {
-                    crate::note!("texgeo: CGAL on {}: {e}", pair.name);
-                    None
-                }
-            }
-        } else {
-            None
-        };
-        let s = ev.classification.stats;
-        for (k, &op) in OPERATIONS.iter().enumerate() {
-            let total = p1.median() + p2.median() + asm[k].median();
-            let thesis = thesis_seconds(pair.thesis, op);
-            table.row(vec![
-                pair.name.clone(),
-                pair.thesis.to_string(),
-                op.symbol().to_string(),
-                triangles.to_string(),
-                (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
-                s.point_tests.to_string(),
-                plain.as_ref().map_or("–".into(), |p| p.3.classification.stats.point_tests.to_string()),
-                format!("{:.1} %", 100.0 * s.saved_share()),
-                ms(p1.median()),
-                p1.spread_cell(),
-                ms(p2.median() + asm[k].median()),
-                Samples::sum(&[&p2, &asm[k]]).spread_cell(),
-                format!("{}{}", ms(p2_gpu.median() + asm[k].median()), if same { "" } else { " (DIFFERS)" }),
-                Samples::sum(&[&p2_gpu, &asm[k]]).spread_cell(),
-                plain.as_ref().map_or("–".into(), |p| ms(p.1.median() + p.2[k].median())),
-                plain.as_ref().map_or("–".into(), |p| Samples::sum(&[&p.1, &p.2[k]]).spread_cell()),
-                ms(total),
-                reference
-                    .as_ref()
-                    .and_then(|r| r.median_seconds(op))
-                    .map_or("–".into(), |t| format!("{:.1}", t * 1e3)),
-                thesis.map_or("–".into(), |t| t.0.to_string()),
-                thesis.map_or("–".into(), |t| t.1.to_string()),
-            ]);
+        if let Err(why) = pair_rows(ctx, pair, cfg, &mut table)? {
+            refused.push(why);
         }
-        crate::note!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
     }
     table.note(format!(
         "Medians of {} runs after a warm-up (plain: one run); spread: half the range of the runs as a share of \
@@ -260,64 +209,142 @@ pub fn run(ctx: &Context, pairs: &[Pair], cfg: &Config) -> boolean::Result<Repor
     if !refused.is_empty() {
         table.note(format!("Refused as operands, so not measured: {}.", refused.join("; ")));
     }
-    // No pairs (only the scaling series asked for): no empty Table 6-1.
-    let mut tables = if pairs.is_empty() { Vec::new() } else { vec![table] };
-    if !cfg.scaling.is_empty() {
-        let mut scaling = Table::new(
-            "Growth with size: sphere − turned copy (ms)",
-            &[
-                "triangles",
-                "cut A+B",
-                "phase 1",
-                "phase 2",
-                "total",
-                "µs per triangle",
-                "phase 1 µs/tri",
-                "phase 2 µs/tri",
-            ],
-        )
-        .named("scaling")
-        .unit("ms", 2..=4);
-        // (triangles, phase 1 s, phase 2 s) per size, for the growth exponents.
-        let mut growth: Vec<(f64, f64, f64)> = Vec::new();
-        for &n in &cfg.scaling {
-            let pair = scaling_pair(n)?;
-            let (p1, p2, asm, ev) =
-                measure(&pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs)?;
-            let total = p1.median() + p2.median() + asm[2].median();
-            let tris = ev.a.triangles.len() + ev.b.triangles.len();
-            let (s1, s2) = (p1.median().as_secs_f64(), (p2.median() + asm[2].median()).as_secs_f64());
-            growth.push((tris as f64, s1, s2));
-            scaling.row(vec![
-                tris.to_string(),
-                (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
-                ms(p1.median()),
-                ms(p2.median() + asm[2].median()),
-                ms(total),
-                format!("{:.2}", total.as_secs_f64() * 1e6 / tris as f64),
-                format!("{:.2}", s1 * 1e6 / tris as f64),
-                format!("{:.2}", s2 * 1e6 / tris as f64),
-            ]);
+    Ok(table)
+}
+
+/// The rows of one pair, one per operation: the CPU and GPU point tests in turn, run
+/// after run, plain classification once, CGAL when asked. `Err` (inside `Ok`): the pair
+/// was refused as operands, and why.
+fn pair_rows(
+    ctx: &Context,
+    pair: &Pair,
+    cfg: &Config,
+    table: &mut Table,
+) -> boolean::Result<std::result::Result<(), String>> {
+    let triangles = pair.a.num_faces() + pair.b.num_faces();
+    let (cpu, gpu) =
+        (sequential(cfg.cpu_method, Grouping::Grouped), sequential(Method::Gpu, Grouping::Grouped));
+    let grouped = measure_interleaved(pair, &[(&cpu, None), (&gpu, Some(ctx))], cfg.runs);
+    let mut both = match grouped {
+        Err(e @ boolean::BooleanError::Input { .. }) => {
+            crate::note!("texgeo: skipping {}: {e}", pair.name);
+            return Ok(Err(format!("{} ({e})", pair.name)));
         }
-        scaling.note(
-            "Difference A − B; phases as above, CPU point tests. Near-constant µs per triangle = linear growth.",
-        );
-        // Time ∝ n^k between the first size of at least 10 000 triangles (below, fixed
-        // costs dominate) and the largest.
-        let from = growth.iter().position(|g| g.0 >= 1e4).unwrap_or(0);
-        if let (Some(&(n0, a0, b0)), Some(&(n1, a1, b1))) = (growth.get(from), growth.last())
-            && n1 > n0
-        {
-            let k = |t0: f64, t1: f64| (t1 / t0).ln() / (n1 / n0).ln();
-            scaling.note(format!(
-                "Growth from {n0} to {n1} triangles: phase 1 ∝ n^{:.2}, phase 2 ∝ n^{:.2} (1 = linear).",
-                k(a0, a1),
-                k(b0, b1)
-            ));
-        }
-        tables.push(scaling);
+        r => r?,
+    };
+    let (_, p2_gpu, _, ev_gpu) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
+    let (p1, p2, asm, ev) = both.pop().unwrap_or_else(|| unreachable!("two variants"));
+    // The GPU and CPU classifications agree (they are both exact).
+    let same =
+        ev_gpu.classification.a == ev.classification.a && ev_gpu.classification.b == ev.classification.b;
+    let plain = if cfg.plain {
+        Some(measure(pair, &sequential(cfg.cpu_method, Grouping::Plain), None, 1)?)
+    } else {
+        None
+    };
+    let reference = if cfg.cgal { cgal_reference(pair, cfg.runs) } else { None };
+    let s = ev.classification.stats;
+    for (k, &op) in OPERATIONS.iter().enumerate() {
+        let total = p1.median() + p2.median() + asm[k].median();
+        let thesis = thesis_seconds(pair.thesis, op);
+        table.row(vec![
+            pair.name.clone(),
+            pair.thesis.to_string(),
+            op.symbol().to_string(),
+            triangles.to_string(),
+            (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
+            s.point_tests.to_string(),
+            plain.as_ref().map_or("–".into(), |p| p.3.classification.stats.point_tests.to_string()),
+            format!("{:.1} %", 100.0 * s.saved_share()),
+            ms(p1.median()),
+            p1.spread_cell(),
+            ms(p2.median() + asm[k].median()),
+            Samples::sum(&[&p2, &asm[k]]).spread_cell(),
+            format!("{}{}", ms(p2_gpu.median() + asm[k].median()), if same { "" } else { " (DIFFERS)" }),
+            Samples::sum(&[&p2_gpu, &asm[k]]).spread_cell(),
+            plain.as_ref().map_or("–".into(), |p| ms(p.1.median() + p.2[k].median())),
+            plain.as_ref().map_or("–".into(), |p| Samples::sum(&[&p.1, &p.2[k]]).spread_cell()),
+            ms(total),
+            reference
+                .as_ref()
+                .and_then(|r| r.median_seconds(op))
+                .map_or("–".into(), |t| format!("{:.1}", t * 1e3)),
+            thesis.map_or("–".into(), |t| t.0.to_string()),
+            thesis.map_or("–".into(), |t| t.1.to_string()),
+        ]);
     }
-    Ok(Report { name: "boolean".into(), environment: Environment::new(ctx.info().label()), tables })
+    crate::note!("{}: phase 1 {} ms, phase 2 {} ms", pair.name, ms(p1.median()), ms(p2.median()));
+    Ok(Ok(()))
+}
+
+/// CGAL's exact corefinement of `pair`, `runs` times; `None` (and a note) when it
+/// cannot answer.
+fn cgal_reference(pair: &Pair, runs: usize) -> Option<cgal::Reference> {
+    match cgal::reference(&pair.a, &pair.b, Some(runs.max(1) as u32)) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            crate::note!("texgeo: CGAL on {}: {e}", pair.name);
+            None
+        }
+    }
+}
+
+/// The growth with size: a sphere minus its turned copy at each size of `cfg.scaling`,
+/// with the growth exponents of both phases.
+fn scaling_table(cfg: &Config) -> boolean::Result<Table> {
+    let mut scaling = Table::new(
+        "Growth with size: sphere − turned copy (ms)",
+        &[
+            "triangles",
+            "cut A+B",
+            "phase 1",
+            "phase 2",
+            "total",
+            "µs per triangle",
+            "phase 1 µs/tri",
+            "phase 2 µs/tri",
+        ],
+    )
+    .named("scaling")
+    .unit("ms", 2..=4);
+    // (triangles, phase 1 s, phase 2 s) per size, for the growth exponents.
+    let mut growth: Vec<(f64, f64, f64)> = Vec::new();
+    for &n in &cfg.scaling {
+        let pair = scaling_pair(n)?;
+        let (p1, p2, asm, ev) =
+            measure(&pair, &sequential(cfg.cpu_method, Grouping::Grouped), None, cfg.runs)?;
+        let total = p1.median() + p2.median() + asm[2].median();
+        let tris = ev.a.triangles.len() + ev.b.triangles.len();
+        let (s1, s2) = (p1.median().as_secs_f64(), (p2.median() + asm[2].median()).as_secs_f64());
+        growth.push((tris as f64, s1, s2));
+        scaling.row(vec![
+            tris.to_string(),
+            (ev.refinement.stats.cut_a + ev.refinement.stats.cut_b).to_string(),
+            ms(p1.median()),
+            ms(p2.median() + asm[2].median()),
+            ms(total),
+            format!("{:.2}", total.as_secs_f64() * 1e6 / tris as f64),
+            format!("{:.2}", s1 * 1e6 / tris as f64),
+            format!("{:.2}", s2 * 1e6 / tris as f64),
+        ]);
+    }
+    scaling.note(
+        "Difference A − B; phases as above, CPU point tests. Near-constant µs per triangle = linear growth.",
+    );
+    // Time ∝ n^k between the first size of at least 10 000 triangles (below, fixed costs
+    // dominate) and the largest.
+    let from = growth.iter().position(|g| g.0 >= 1e4).unwrap_or(0);
+    if let (Some(&(n0, a0, b0)), Some(&(n1, a1, b1))) = (growth.get(from), growth.last())
+        && n1 > n0
+    {
+        let k = |t0: f64, t1: f64| (t1 / t0).ln() / (n1 / n0).ln();
+        scaling.note(format!(
+            "Growth from {n0} to {n1} triangles: phase 1 ∝ n^{:.2}, phase 2 ∝ n^{:.2} (1 = linear).",
+            k(a0, a1),
+            k(b0, b1)
+        ));
+    }
+    Ok(scaling)
 }
 
 #[cfg(test)]

@@ -244,6 +244,9 @@ const METHODS: [Method; 9] = [
     Method::JordanOctree,
 ];
 
+/// Measures one model: the reference answers, TetraGrid at every resolution (Tables
+/// 4-4, 4-5), every method (Tables 4-6 … 4-9), all of them timed set by set in turn,
+/// then the indexes' own builds (Tables 4-7, 4-8).
 fn measure_model(
     ctx: &Context,
     model: &Model,
@@ -253,30 +256,87 @@ fn measure_model(
     let mesh = &model.mesh;
     progress.step(&format!("{}: reference answers", model.name));
     let sets = point_sets(mesh, cfg);
-    let covering = crate::mesh::covering::Covering::new(mesh);
-    let mut m = Measured {
-        name: model.name.clone(),
-        thesis: model.thesis,
-        vertices: mesh.num_vertices(),
-        faces: mesh.num_faces(),
-        triangles: covering.triangles.len(),
-        grid_builds: Vec::new(),
-        grid_build_times: Vec::new(),
-        times: Vec::new(),
-        failed: Vec::new(),
-        grid_times: Vec::new(),
-        grid_tested: Vec::new(),
-        gpu_split: Vec::new(),
-        disagreements: Vec::new(),
-        index: Vec::new(),
-        index_builds: Vec::new(),
-    };
-
+    let mut m = Measured::new(model);
     // The reference answers: the exact test with basic preprocessing.
     let cpu = crate::inclusion::build(Method::Cpu, mesh, &Options::default())?;
     let want: Vec<Vec<Class>> = sets.iter().map(|s| cpu.classify_all(s)).collect();
+    let mut sides = grids(model, cfg, &sets, &mut m, progress)?;
+    sides.extend(solvers(ctx, model, &mut m, progress)?);
+    let (times, agree) = in_turn(&mut sides, &sets, &want, &model.name, progress)?;
+    m.record(sides, times, agree);
+    index_builds(mesh, &mut m)?;
+    Ok(m)
+}
 
-    // Tables 4-4 and 4-5: GridClassifier at every resolution.
+impl Measured {
+    /// Nothing measured yet on `model`.
+    fn new(model: &Model) -> Measured {
+        let mesh = &model.mesh;
+        Measured {
+            name: model.name.clone(),
+            thesis: model.thesis,
+            vertices: mesh.num_vertices(),
+            faces: mesh.num_faces(),
+            triangles: crate::mesh::covering::Covering::new(mesh).triangles.len(),
+            grid_builds: Vec::new(),
+            grid_build_times: Vec::new(),
+            times: Vec::new(),
+            failed: Vec::new(),
+            grid_times: Vec::new(),
+            grid_tested: Vec::new(),
+            gpu_split: Vec::new(),
+            disagreements: Vec::new(),
+            index: Vec::new(),
+            index_builds: Vec::new(),
+        }
+    }
+
+    /// Each contender's times and whether it agreed with the reference on every set;
+    /// the GPU methods' last split of the work.
+    fn record(&mut self, sides: Vec<(String, Contender)>, times: Vec<Samples>, agree: Vec<bool>) {
+        for ((name, side), (time, ok)) in sides.into_iter().zip(times.into_iter().zip(agree)) {
+            if !ok {
+                self.disagreements.push(if name == "gpu-batch-1" {
+                    "gpu (batch 1)".into()
+                } else {
+                    name.clone()
+                });
+            }
+            if let Contender::Solver(solver) = &side
+                && let Some(g) = solver.gpu_stats()
+                && name != "gpu-batch-1"
+            {
+                self.gpu_split.push(format!(
+                    "{}: last set {} points drawn in {} draw(s), GPU submissions {:.3} ms, host {:.3} ms, {} flagged → exact CPU {:.3} ms",
+                    name,
+                    g.gpu_points,
+                    g.draws,
+                    g.gpu.as_secs_f64() * 1e3,
+                    g.host.as_secs_f64() * 1e3,
+                    g.flagged,
+                    g.fallback.as_secs_f64() * 1e3
+                ));
+            }
+            if name.starts_with("tetragrid-") {
+                self.grid_times.push(time);
+            } else {
+                self.times.push((name, time));
+            }
+        }
+    }
+}
+
+/// Tables 4-4 and 4-5: GridClassifier at every resolution, built `BUILDS` times (the
+/// resolutions in turn: a build time is as exposed to load as a query time, and the
+/// build's growth in n is a claim), with the share of tetrahedra each tests.
+fn grids(
+    model: &Model,
+    cfg: &Config,
+    sets: &[Vec<DVec3>],
+    m: &mut Measured,
+    progress: &mut dyn Progress,
+) -> Result<Vec<(String, Contender)>, InclusionError> {
+    let mesh = &model.mesh;
     let mut sides: Vec<(String, Contender)> = Vec::new();
     for &n in &cfg.resolutions {
         if !RESOLUTIONS.contains(&n) {
@@ -287,11 +347,9 @@ fn measure_model(
         let grid = GridClassifier::new(ft, n)?;
         m.grid_build_times.push(Samples(vec![grid.index_stats().build_time]));
         m.grid_builds.push((Duration::ZERO, grid.index_stats().bytes));
-        m.grid_tested.push(tested_share(&grid, &sets, m.triangles));
+        m.grid_tested.push(tested_share(&grid, sets, m.triangles));
         sides.push((format!("tetragrid-{n}"), Contender::Grid(Box::new(grid))));
     }
-    // More builds of every resolution in turn: a build time is as exposed to load as a
-    // query time, and the build's growth in n is a claim.
     for _ in 1..BUILDS {
         for (i, &n) in cfg.resolutions.iter().enumerate() {
             let grid = GridClassifier::new(FeitoTorres::with_options(mesh, None, EdgeRule::Rerun)?, n)?;
@@ -301,33 +359,51 @@ fn measure_model(
     for (b, t) in m.grid_builds.iter_mut().zip(&m.grid_build_times) {
         b.0 = t.median();
     }
+    Ok(sides)
+}
 
-    // Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6),
-    // and the thesis' layout: one point-vertex per tetrahedron.
+/// Tables 4-6 to 4-9: every method at its default settings (TetraGrid 32³, octree 6),
+/// and the thesis' layout: one point-vertex per tetrahedron. A GPU method this device
+/// cannot run is recorded in `m.failed`, not an error.
+fn solvers(
+    ctx: &Context,
+    model: &Model,
+    m: &mut Measured,
+    progress: &mut dyn Progress,
+) -> Result<Vec<(String, Contender)>, InclusionError> {
+    let mut sides = Vec::new();
     let methods = METHODS.iter().map(|&k| (k, k.name().to_string(), None));
     for (method, name, batch) in
         methods.chain(std::iter::once((Method::Gpu, "gpu-batch-1".to_string(), Some(1))))
     {
         progress.step(&format!("{}: building {name}", model.name));
-        match Solver::new(method, mesh, &Options::default(), Some(ctx), batch) {
+        match Solver::new(method, &model.mesh, &Options::default(), Some(ctx), batch) {
             Ok(s) => sides.push((name, Contender::Solver(Box::new(s)))),
             Err(e) if method.is_cpu() => return Err(e),
-            // A GPU method this device cannot run marks its cells, not the whole run.
             Err(e) => m.failed.push((name, e.to_string())),
         }
     }
+    Ok(sides)
+}
 
-    // Every method on every set in turn (set 1: A, B, …; set 2: A, B, …), after one
-    // untimed warm-up each (lavapipe compiles shaders at the first draw): load that comes
-    // and goes hits every method alike, and the ratio of two methods can be taken set by
-    // set.
-    for (_, side) in &mut sides {
+/// Every contender on every set in turn (set 1: A, B, …; set 2: A, B, …), after one
+/// untimed warm-up each (lavapipe compiles shaders at the first draw): load that comes
+/// and goes hits every method alike, and the ratio of two methods can be taken set by
+/// set. Each one's times, and whether it gave `want` on every set.
+fn in_turn(
+    sides: &mut [(String, Contender)],
+    sets: &[Vec<DVec3>],
+    want: &[Vec<Class>],
+    name: &str,
+    progress: &mut dyn Progress,
+) -> Result<(Vec<Samples>, Vec<bool>), InclusionError> {
+    for (_, side) in sides.iter_mut() {
         side.classify(&sets[0])?;
     }
     let mut times = vec![Samples::default(); sides.len()];
     let mut agree = vec![true; sides.len()];
-    for (k, (set, w)) in sets.iter().zip(&want).enumerate() {
-        progress.step(&format!("{}: set {} of {}, every method in turn", model.name, k + 1, sets.len()));
+    for (k, (set, w)) in sets.iter().zip(want).enumerate() {
+        progress.step(&format!("{name}: set {} of {}, every method in turn", k + 1, sets.len()));
         for (i, (_, side)) in sides.iter_mut().enumerate() {
             let t = Instant::now();
             let got = side.classify(set)?;
@@ -335,34 +411,13 @@ fn measure_model(
             agree[i] &= got == *w;
         }
     }
-    for ((name, side), (time, ok)) in sides.into_iter().zip(times.into_iter().zip(agree)) {
-        if !ok {
-            m.disagreements.push(if name == "gpu-batch-1" { "gpu (batch 1)".into() } else { name.clone() });
-        }
-        if let Contender::Solver(solver) = &side
-            && let Some(g) = solver.gpu_stats()
-            && name != "gpu-batch-1"
-        {
-            m.gpu_split.push(format!(
-                "{}: last set {} points drawn in {} draw(s), GPU submissions {:.3} ms, host {:.3} ms, {} flagged → exact CPU {:.3} ms",
-                name,
-                g.gpu_points,
-                g.draws,
-                g.gpu.as_secs_f64() * 1e3,
-                g.host.as_secs_f64() * 1e3,
-                g.flagged,
-                g.fallback.as_secs_f64() * 1e3
-            ));
-        }
-        if name.starts_with("tetragrid-") {
-            m.grid_times.push(time);
-        } else {
-            m.times.push((name, time));
-        }
-    }
-    // Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
-    // covering and per-tetra planes every Feito-Torres variant shares.
-    // Each built BUILDS times, the indexes in turn.
+    Ok((times, agree))
+}
+
+/// Tables 4-7 and 4-8 count each method's own index, as the thesis did, not the
+/// covering and per-tetra planes every Feito-Torres variant shares. Each built BUILDS
+/// times, the indexes in turn; the medians go into `m.index`.
+fn index_builds(mesh: &Mesh, m: &mut Measured) -> Result<(), InclusionError> {
     let ft = || FeitoTorres::with_options(mesh, None, EdgeRule::Rerun);
     for _ in 0..BUILDS {
         let built = [
@@ -382,7 +437,7 @@ fn measure_model(
     for ((_, stats), s) in m.index.iter_mut().zip(&m.index_builds) {
         stats.build_time = s.median();
     }
-    Ok(m)
+    Ok(())
 }
 
 /// The mean share of the `tetrahedra` a query point of `sets` is tested against: those

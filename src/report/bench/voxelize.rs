@@ -183,6 +183,76 @@ pub fn measure(
     Ok(out)
 }
 
+/// Median total time of each method of one (model, N), and that time without the
+/// preparation.
+type Totals = std::collections::HashMap<Method, (Duration, Duration)>;
+
+/// The row of Table 5-2 of one measurement ("–" where the method could not run), and
+/// its totals when it ran.
+fn method_row(m: &Measured) -> (Vec<String>, Option<(Duration, Duration)>) {
+    let (model, n) = (&m.model, m.n);
+    let thesis = thesis_seconds(n, m.thesis, m.method).map_or("–".into(), |s| format!("{s}"));
+    let r = match &m.result {
+        Ok(r) => r,
+        Err(_) => {
+            let mut row = vec![model.clone(), m.triangles.to_string(), n.to_string(), m.method.to_string()];
+            row.extend((0..12).map(|_| "–".to_string()));
+            row.push(thesis);
+            return (row, None);
+        }
+    };
+    let total = r.times.total.median();
+    let prepare = r.times.prepare.median();
+    let row = vec![
+        model.clone(),
+        m.triangles.to_string(),
+        n.to_string(),
+        m.method.to_string(),
+        ms(total),
+        r.times.total.spread_cell(),
+        ms(total.saturating_sub(prepare)),
+        ms(prepare),
+        ms(r.times.draw.median()),
+        ms(r.times.copy.median()),
+        ms(r.times.readback.median()),
+        ms(r.times.fallback.median()),
+        r.fallback_centres.to_string(),
+        r.corrected.to_string(),
+        r.occupied.to_string(),
+        if r.identical { "yes".into() } else { "NO".into() },
+        thesis,
+    ];
+    (row, Some((total, total.saturating_sub(prepare))))
+}
+
+/// The GPU/CPU ratios of one (model, N), when the CPU slicer or both GPU slicers ran.
+fn ratio_row(model: &str, n: usize, totals: &Totals) -> Option<Vec<String>> {
+    let get = |m: Method| totals.get(&m).copied();
+    if get(Method::Cpu).is_none() && (get(Method::Pgpu).is_none() || get(Method::Zoned).is_none()) {
+        return None;
+    }
+    let time = |m: Method, excl: bool| get(m).map_or("–".into(), |t| ms(if excl { t.1 } else { t.0 }));
+    let ratio = |a: Method, b: Method, excl: bool| match (get(a), get(b)) {
+        (Some(x), Some(y)) => {
+            let y = if excl { y.1 } else { y.0 };
+            format!("{:.2}", x.0.as_secs_f64() / y.as_secs_f64().max(1e-9))
+        }
+        _ => "–".into(),
+    };
+    Some(vec![
+        model.to_string(),
+        n.to_string(),
+        time(Method::Cpu, false),
+        time(Method::Pgpu, false),
+        time(Method::Zoned, false),
+        ratio(Method::Cpu, Method::Pgpu, false),
+        ratio(Method::Cpu, Method::Zoned, false),
+        ratio(Method::Pgpu, Method::Zoned, false),
+        time(Method::Zoned, true),
+        ratio(Method::Cpu, Method::Zoned, true),
+    ])
+}
+
 /// `texgeo bench voxelize`: [`measure`] and [`report`].
 pub fn run(ctx: &Context, models: &[Model], cfg: &Config) -> Result<Report> {
     let measured = measure(ctx, models, cfg, &mut Log("bench voxelize"))?;
@@ -231,67 +301,20 @@ pub fn report(measured: &[Measured], cfg: &Config, environment: Environment) -> 
     let mut failures = Vec::new();
     for group in measured.chunk_by(|a, b| a.model == b.model && a.n == b.n) {
         let (model, n) = (&group[0].model, group[0].n);
-        let mut totals = std::collections::HashMap::new();
+        let mut totals = Totals::new();
         for m in group {
-            let thesis = thesis_seconds(n, m.thesis, m.method).map_or("–".into(), |s| format!("{s}"));
-            let r = match &m.result {
-                Ok(r) => r,
-                Err(why) => {
-                    let mut row =
-                        vec![model.clone(), m.triangles.to_string(), n.to_string(), m.method.to_string()];
-                    row.extend((0..12).map(|_| "–".to_string()));
-                    row.push(thesis);
-                    table.row(row);
-                    failures.push(format!("{model} {n}³ {}: {why}", m.method));
-                    continue;
+            let (row, total) = method_row(m);
+            table.row(row);
+            match (total, &m.result) {
+                (Some(t), _) => {
+                    totals.insert(m.method, t);
                 }
-            };
-            let total = r.times.total.median();
-            let prepare = r.times.prepare.median();
-            totals.insert(m.method, (total, total.saturating_sub(prepare)));
-            table.row(vec![
-                model.clone(),
-                m.triangles.to_string(),
-                n.to_string(),
-                m.method.to_string(),
-                ms(total),
-                r.times.total.spread_cell(),
-                ms(total.saturating_sub(prepare)),
-                ms(prepare),
-                ms(r.times.draw.median()),
-                ms(r.times.copy.median()),
-                ms(r.times.readback.median()),
-                ms(r.times.fallback.median()),
-                r.fallback_centres.to_string(),
-                r.corrected.to_string(),
-                r.occupied.to_string(),
-                if r.identical { "yes".into() } else { "NO".into() },
-                thesis,
-            ]);
+                (None, Err(why)) => failures.push(format!("{model} {n}³ {}: {why}", m.method)),
+                (None, Ok(_)) => {}
+            }
         }
-        let get = |m: Method| totals.get(&m).copied();
-        if get(Method::Cpu).is_some() || (get(Method::Pgpu).is_some() && get(Method::Zoned).is_some()) {
-            let time =
-                |m: Method, excl: bool| get(m).map_or("–".into(), |t| ms(if excl { t.1 } else { t.0 }));
-            let ratio = |a: Method, b: Method, excl: bool| match (get(a), get(b)) {
-                (Some(x), Some(y)) => {
-                    let y = if excl { y.1 } else { y.0 };
-                    format!("{:.2}", x.0.as_secs_f64() / y.as_secs_f64().max(1e-9))
-                }
-                _ => "–".into(),
-            };
-            ratios.row(vec![
-                model.clone(),
-                n.to_string(),
-                time(Method::Cpu, false),
-                time(Method::Pgpu, false),
-                time(Method::Zoned, false),
-                ratio(Method::Cpu, Method::Pgpu, false),
-                ratio(Method::Cpu, Method::Zoned, false),
-                ratio(Method::Pgpu, Method::Zoned, false),
-                time(Method::Zoned, true),
-                ratio(Method::Cpu, Method::Zoned, true),
-            ]);
+        if let Some(row) = ratio_row(model, n, &totals) {
+            ratios.row(row);
         }
     }
     for f in failures {

@@ -393,14 +393,12 @@ fn plots(r: &mut Run) -> Result<Vec<Block>> {
         both(label, i, curve(r.facts, EXP, today), curve(r.thesis, EXP, thesis))
     })
     .collect();
-    let chart = Chart {
-        title: "Boolean operations (A − B): time against triangles per phase and method".into(),
-        x_label: "triangles (both operands)".into(),
-        y_label: "s".into(),
-        x_log: true,
-        y_log: true,
+    let chart = Chart::loglog(
+        "Boolean operations (A − B): time against triangles per phase and method",
+        "triangles (both operands)",
+        "s",
         series,
-    };
+    );
     let mut blocks = r.plot(&chart, "boolean-time")?;
     let mut series = both(
         "phase 2 plain / grouped",
@@ -414,14 +412,12 @@ fn plots(r: &mut Run) -> Result<Vec<Block>> {
         ratio_curve(r.facts, EXP, "time:phase2-cpu", "time:phase2-gpu"),
         Vec::new(),
     ));
-    let chart = Chart {
-        title: "Boolean operations: grouped classification's and the GPU's speed-ups in phase 2".into(),
-        x_label: "triangles (both operands)".into(),
-        y_label: "speed-up (×)".into(),
-        x_log: true,
-        y_log: true,
+    let chart = Chart::loglog(
+        "Boolean operations: grouped classification's and the GPU's speed-ups in phase 2",
+        "triangles (both operands)",
+        "speed-up (×)",
         series,
-    };
+    );
     blocks.extend(r.plot(&chart, "boolean-speedup")?);
     Ok(blocks)
 }

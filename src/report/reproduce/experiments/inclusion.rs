@@ -1,13 +1,16 @@
 //! Point in solid (2006 Ch. 4, Tables 4-4 … 4-9) through `texgeo bench inclusion`'s
 //! measuring code.
 
-use super::{Model, Quantity, both, comparison, curve, models_table, quick_models, ratio_curve, stand_ins};
-use crate::report::bench::inclusion::{self, Config, STAND_INS};
+use super::{
+    Model, Quantity, both, comparison, curve, details, models_table, quick_models, ratio_curve, stand_ins,
+    today_or_thesis,
+};
+use crate::report::Environment;
+use crate::report::bench::inclusion::{self, Config, Measured, STAND_INS};
 use crate::report::plot::{Chart, Series};
 use crate::report::reproduce::doc::Block;
-use crate::report::reproduce::facts::Stat;
+use crate::report::reproduce::facts::{Facts, Stat};
 use crate::report::reproduce::{Result, Run};
-use crate::report::{Environment, Table};
 
 const EXP: &str = "inclusion";
 
@@ -39,17 +42,40 @@ const METHODS: [Curves; 2] = [
     ),
 ];
 
+/// Measures every model with every method (set by set, in turn), adds the facts, then
+/// writes the section: the models and answers, Tables 4-4 … 4-9 beside the thesis', the
+/// time and TetraGrid plots, and the bench's own tables.
 pub fn run(r: &mut Run) -> Result<Vec<Block>> {
+    let (models, notes) = models(r)?;
+    let cfg = Config { sets: if r.quick { 4 } else { 10 } + r.repeat, ..Config::default() };
+    let measured = inclusion::measure(r.ctx, &models, &cfg, r.progress)?;
+    record_facts(r, &measured, &cfg);
+    let mut blocks = section_text(r, &measured, &cfg, notes)?;
+    blocks.extend(thesis_tables(r, &cfg.resolutions)?);
+    blocks.extend(time_plots(r, cfg.points)?);
+    blocks.extend(tetragrid_plots(r, &cfg.resolutions)?);
+    let bench = inclusion::report(&measured, &cfg, Environment::new(r.ctx.info().label()));
+    blocks.extend(details(r, EXP, bench.tables)?);
+    Ok(blocks)
+}
+
+/// The built-in models (`--quick`) or the thesis' stand-ins found, with notes on those
+/// missing.
+fn models(r: &Run) -> Result<(Vec<inclusion::Model>, Vec<String>)> {
     let (models, notes) =
         if r.quick { (quick_models(), Vec::new()) } else { stand_ins(r.models_dir, STAND_INS)? };
-    let cfg = Config { sets: if r.quick { 4 } else { 10 } + r.repeat, ..Config::default() };
-    let models: Vec<inclusion::Model> = models
+    let models = models
         .into_iter()
         .map(|Model { thesis, name, mesh }| inclusion::Model { thesis, name, mesh })
         .collect();
-    let measured = inclusion::measure(r.ctx, &models, &cfg, r.progress)?;
+    Ok((models, notes))
+}
 
-    for m in &measured {
+/// The facts of every model: each method's time (or why it is missing), each TetraGrid
+/// resolution's time, build, memory and share tested, each index's build and memory;
+/// and the answers that differ from the exact test.
+fn record_facts(r: &mut Run, measured: &[Measured], cfg: &Config) {
+    for m in measured {
         let f = &mut *r.facts;
         f.model(EXP, &m.name, m.triangles as f64, m.thesis);
         for (method, samples) in &m.times {
@@ -64,30 +90,27 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             let (_, bytes) = m.grid_builds[i];
             let builds = &m.grid_build_times[i];
             f.add_runs(EXP, &m.name, &format!("build:tetragrid-{n}"), Stat::median_of(builds), builds);
-            f.add(
-                EXP,
-                &m.name,
-                &format!("memory:tetragrid-{n}"),
-                "KiB",
-                Stat::exact(bytes.div_ceil(1024) as f64),
-            );
+            f.add(EXP, &m.name, &format!("memory:tetragrid-{n}"), "KiB", kib(bytes));
             f.add(EXP, &m.name, &format!("tested:tetragrid-{n}"), "", Stat::exact(m.grid_tested[i]));
         }
         for ((index, stats), builds) in m.index.iter().zip(&m.index_builds) {
             f.add_runs(EXP, &m.name, &format!("build:{index}"), Stat::median_of(builds), builds);
-            f.add(
-                EXP,
-                &m.name,
-                &format!("memory:{index}"),
-                "KiB",
-                Stat::exact(stats.bytes.div_ceil(1024) as f64),
-            );
+            f.add(EXP, &m.name, &format!("memory:{index}"), "KiB", kib(stats.bytes));
         }
         for d in &m.disagreements {
             r.disagreement(format!("inclusion: {d} on {}", m.name));
         }
     }
+}
 
+/// `bytes` in KiB, rounded up.
+fn kib(bytes: usize) -> Stat {
+    Stat::exact(bytes.div_ceil(1024) as f64)
+}
+
+/// The section's opening: how the points were tested, the models, and whether every
+/// method agreed with the exact test and which could not run here.
+fn section_text(r: &mut Run, measured: &[Measured], cfg: &Config, notes: Vec<String>) -> Result<Vec<Block>> {
     let mut blocks = vec![Block::Para(format!(
         "{} sets of {} uniform random points in each model's bounding box (fixed seeds); a time is the mean per set \
          after one untimed warm-up, as in the thesis (§4.4.2). Every method runs on set 1, then every method on set \
@@ -115,14 +138,17 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
     if !failed.is_empty() {
         blocks.push(Block::Para(format!("**Not measurable on this device:** {}.", failed.join("; "))));
     }
+    Ok(blocks)
+}
 
-    let res = &cfg.resolutions;
+/// Tables 4-4 … 4-9: (id, title, unit, quantities) at the TetraGrid resolutions `res`.
+fn thesis_table_quantities(res: &[usize]) -> [(&'static str, &'static str, &'static str, Vec<Quantity>); 6] {
     let mut q44 = Vec::new();
     for n in res {
         q44.push(Quantity::same(format!("{n}³ build (s)"), format!("build:tetragrid-{n}")));
         q44.push(Quantity::same(format!("{n}³ memory (KiB)"), format!("memory:tetragrid-{n}")));
     }
-    let tables: [(&str, &str, &str, Vec<Quantity>); 6] = [
+    [
         ("4-4", "Table 4-4: TetraGrid build time and memory", "s or KiB", q44),
         (
             "4-5",
@@ -184,33 +210,40 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
                 Quantity::same("Jordan + octree 6", "time:jordan-octree"),
             ],
         ),
-    ];
-    for (id, title, unit, quantities) in tables {
+    ]
+}
+
+/// Tables 4-4 … 4-9, the thesis' numbers beside today's.
+fn thesis_tables(r: &mut Run, res: &[usize]) -> Result<Vec<Block>> {
+    let mut blocks = Vec::new();
+    for (id, title, unit, quantities) in thesis_table_quantities(res) {
         let mut t = comparison(r, EXP, title, unit, &quantities);
         if id == "4-6" {
             t.note(inclusion::TABLE_4_6_NOTE);
         }
         blocks.push(r.table(t, &format!("inclusion-table{id}"))?);
     }
+    Ok(blocks)
+}
 
-    // Plots: the thesis' Figs. 4-5 … 4-10 as curves, today's beside the thesis'.
+/// The thesis' Figs. 4-5 … 4-10 as curves, today's beside the thesis': time against
+/// triangles per method, and the speed-ups over the CPU test.
+fn time_plots(r: &mut Run, points: usize) -> Result<Vec<Block>> {
+    let mut blocks = Vec::new();
     for (what, stem, methods) in METHODS {
         let mut series = Vec::new();
         for (i, (key, label)) in methods.iter().enumerate() {
             let k = format!("time:{key}");
             series.extend(both(label, i, curve(r.facts, EXP, &k), curve(r.thesis, EXP, &k)));
         }
-        let chart = Chart {
-            title: format!("Point in solid, {what}: time against triangles (Figs. 4-7, 4-10)"),
-            x_label: "triangles".into(),
-            y_label: format!("s per set of {} points", cfg.points),
-            x_log: true,
-            y_log: true,
+        let chart = Chart::loglog(
+            format!("Point in solid, {what}: time against triangles (Figs. 4-7, 4-10)"),
+            "triangles",
+            format!("s per set of {points} points"),
             series,
-        };
+        );
         blocks.extend(r.plot(&chart, stem)?);
     }
-
     let mut series = Vec::new();
     for (i, (key, label)) in
         [("gpu", "GPU"), ("gpu+tetragrid", "GPU + TetraGrid"), ("tetragrid", "TetraGrid")].iter().enumerate()
@@ -223,30 +256,33 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
             ratio_curve(r.thesis, EXP, "time:cpu", &k),
         ));
     }
-    let chart = Chart {
-        title: "Point in solid: speed-up over the CPU test against triangles".into(),
-        x_label: "triangles".into(),
-        y_label: "speed-up (×)".into(),
-        x_log: true,
-        y_log: true,
+    let chart = Chart::loglog(
+        "Point in solid: speed-up over the CPU test against triangles",
+        "triangles",
+        "speed-up (×)",
         series,
-    };
+    );
     blocks.extend(r.plot(&chart, "inclusion-speedup")?);
+    Ok(blocks)
+}
 
+/// TetraGrid's test time and memory against its resolution, per model (Figs. 4-5, 4-6).
+fn tetragrid_plots(r: &mut Run, res: &[usize]) -> Result<Vec<Block>> {
+    let mut blocks = Vec::new();
     for (key, what, unit, stem, fig) in [
         ("time", "test time", "s per set", "inclusion-tetragrid-time", "Fig. 4-6"),
         ("memory", "memory", "KiB", "inclusion-tetragrid-memory", "Fig. 4-5"),
     ] {
+        let pts = |f: &Facts, m: &str| -> Vec<(f64, f64)> {
+            res.iter()
+                .filter_map(|&n| {
+                    f.get(EXP, m, &format!("{key}:tetragrid-{n}")).ok().map(|s| (n as f64, s.value))
+                })
+                .collect()
+        };
         let mut series = Vec::new();
         for (i, (model, _)) in r.facts.models_of(EXP).iter().enumerate() {
             let thesis_model = r.facts.thesis_name(EXP, model);
-            let pts = |f: &crate::report::reproduce::Facts, m: &str| -> Vec<(f64, f64)> {
-                res.iter()
-                    .filter_map(|&n| {
-                        f.get(EXP, m, &format!("{key}:tetragrid-{n}")).ok().map(|s| (n as f64, s.value))
-                    })
-                    .collect()
-            };
             series.push(Series {
                 label: model.clone(),
                 points: pts(r.facts, model),
@@ -254,35 +290,15 @@ pub fn run(r: &mut Run) -> Result<Vec<Block>> {
                 colour: i,
             });
             let then = pts(r.thesis, &thesis_model);
-            if !then.is_empty() {
-                series.push(Series {
-                    label: format!("{thesis_model} (thesis)"),
-                    points: then,
-                    thesis: true,
-                    colour: i,
-                });
-            }
+            series.extend(today_or_thesis(format!("{thesis_model} (thesis)"), then, true, i));
         }
-        let chart = Chart {
-            title: format!("TetraGrid {what} against resolution ({fig})"),
-            x_label: "grid resolution n (n³ cells)".into(),
-            y_label: unit.into(),
-            x_log: true,
-            y_log: true,
+        let chart = Chart::loglog(
+            format!("TetraGrid {what} against resolution ({fig})"),
+            "grid resolution n (n³ cells)",
+            unit,
             series,
-        };
+        );
         blocks.extend(r.plot(&chart, stem)?);
-    }
-
-    blocks.push(Block::Heading(3, "Details (as `texgeo bench inclusion` prints them)".into()));
-    let details = inclusion::report(&measured, &cfg, Environment::new(r.ctx.info().label()));
-    for (k, t) in details.tables.into_iter().enumerate() {
-        let stem = if t.stem.is_empty() {
-            format!("inclusion-bench-{}", k + 1)
-        } else {
-            format!("inclusion-bench-{}", t.stem)
-        };
-        blocks.push(r.table(Table { stem: String::new(), ..t }, &stem)?);
     }
     Ok(blocks)
 }

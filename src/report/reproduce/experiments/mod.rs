@@ -279,12 +279,27 @@ pub fn ratio_curve(facts: &Facts, experiment: &str, a: &str, b: &str) -> Vec<(f6
 
 /// Today's curve and, when the thesis has points, the thesis' in the same colour.
 pub fn both(label: &str, colour: usize, today: Vec<(f64, f64)>, thesis: Vec<(f64, f64)>) -> Vec<Series> {
-    let mut v = Vec::new();
-    if !today.is_empty() {
-        v.push(Series { label: format!("{label} (today)"), points: today, thesis: false, colour });
+    let today = today_or_thesis(format!("{label} (today)"), today, false, colour);
+    today.into_iter().chain(today_or_thesis(format!("{label} (thesis)"), thesis, true, colour)).collect()
+}
+
+/// A curve of today's numbers or (`thesis`) the thesis', when it has points.
+pub fn today_or_thesis(
+    label: String,
+    points: Vec<(f64, f64)>,
+    thesis: bool,
+    colour: usize,
+) -> Option<Series> {
+    (!points.is_empty()).then_some(Series { label, points, thesis, colour })
+}
+
+/// The tables of `texgeo bench EXPERIMENT`'s own report under a heading, each as
+/// `csv/EXPERIMENT-bench-STEM.csv` (numbered where the table has no stem).
+pub fn details(r: &mut Run, experiment: &str, tables: Vec<Table>) -> Result<Vec<Block>> {
+    let mut blocks = vec![Block::Heading(3, format!("Details (as `texgeo bench {experiment}` prints them)"))];
+    for (k, t) in tables.into_iter().enumerate() {
+        let stem = if t.stem.is_empty() { (k + 1).to_string() } else { t.stem.clone() };
+        blocks.push(r.table(Table { stem: String::new(), ..t }, &format!("{experiment}-bench-{stem}"))?);
     }
-    if !thesis.is_empty() {
-        v.push(Series { label: format!("{label} (thesis)"), points: thesis, thesis: true, colour });
-    }
-    v
+    Ok(blocks)
 }
