@@ -5,6 +5,24 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
+/// The helper binary `name` (built by `tools/setup`): the file `$ENV` names, else
+/// `target/tools/NAME` of this checkout, else `tools/NAME` in an ancestor of the running
+/// executable. `Err`: the path it should be at (`$ENV`'s, or this checkout's).
+pub fn helper(env: &str, name: &str) -> Result<PathBuf, PathBuf> {
+    if let Some(path) = std::env::var_os(env) {
+        let path = PathBuf::from(path);
+        return if path.is_file() { Ok(path) } else { Err(path) };
+    }
+    let default = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tools").join(name);
+    if default.is_file() {
+        return Ok(default);
+    }
+    let beside_exe = std::env::current_exe().ok().and_then(|exe| {
+        exe.ancestors().map(|dir| dir.join("tools").join(name)).find(|candidate| candidate.is_file())
+    });
+    beside_exe.ok_or(default)
+}
+
 /// A fresh folder `texgeo-PREFIX-PID-N` in the system's temporary folder.
 #[derive(Debug)]
 pub struct ScratchDir {

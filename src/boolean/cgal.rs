@@ -45,18 +45,7 @@ impl From<crate::output::Error> for CgalError {
 /// The helper binary: `$TEXGEO_CGAL_BOOLEAN`, else `target/tools/cgal-boolean` of this
 /// checkout, else `tools/cgal-boolean` in an ancestor of the running executable.
 pub fn helper_path() -> Result<PathBuf> {
-    if let Some(path) = std::env::var_os(HELPER_ENV) {
-        let path = PathBuf::from(path);
-        return if path.is_file() { Ok(path) } else { Err(CgalError::HelperMissing { path }) };
-    }
-    let default = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tools/cgal-boolean");
-    if default.is_file() {
-        return Ok(default);
-    }
-    let beside_exe = std::env::current_exe().ok().and_then(|exe| {
-        exe.ancestors().map(|dir| dir.join("tools/cgal-boolean")).find(|candidate| candidate.is_file())
-    });
-    beside_exe.ok_or(CgalError::HelperMissing { path: default })
+    crate::scratch::helper(HELPER_ENV, "cgal-boolean").map_err(|path| CgalError::HelperMissing { path })
 }
 
 /// One operation as CGAL computed it.

@@ -44,6 +44,24 @@ pub struct PipelineDesc<'a> {
     pub per_instance: &'a [u32],
 }
 
+impl<'a> PipelineDesc<'a> {
+    /// A pipeline whose vertex inputs all advance per vertex.
+    pub fn new(
+        vertex: &'a Shader,
+        fragment: &'a Shader,
+        topology: Topology,
+        targets: &'a [TexFormat],
+        blend: Blend,
+    ) -> PipelineDesc<'a> {
+        PipelineDesc { vertex, fragment, topology, targets, blend, per_instance: &[] }
+    }
+
+    /// The vertex input locations that advance per instance instead.
+    pub fn per_instance(self, locations: &'a [u32]) -> PipelineDesc<'a> {
+        PipelineDesc { per_instance: locations, ..self }
+    }
+}
+
 /// Fixed-function state of pipelines that draw pictures (depth-tested, possibly
 /// multisampled); `Raster::default()` is what the GPGPU passes use: no depth buffer, one
 /// sample, no culling.
@@ -532,14 +550,7 @@ impl Pipeline {
     pub fn quad(ctx: &Context, fragment: &Shader, targets: &[TexFormat], blend: Blend) -> Result<Pipeline> {
         Pipeline::new(
             ctx,
-            &PipelineDesc {
-                vertex: &shaders::gpu::QUAD_VERT,
-                fragment,
-                topology: Topology::Triangles,
-                targets,
-                blend,
-                per_instance: &[],
-            },
+            &PipelineDesc::new(&shaders::gpu::QUAD_VERT, fragment, Topology::Triangles, targets, blend),
         )
     }
 

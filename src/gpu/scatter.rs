@@ -30,14 +30,13 @@ impl Scatter {
     pub fn new(ctx: &Context, blend: Blend) -> Result<Scatter> {
         let pipeline = Pipeline::new(
             ctx,
-            &PipelineDesc {
-                vertex: &shaders::gpu::SCATTER_VERT,
-                fragment: &shaders::gpu::SCATTER_FRAG,
-                topology: Topology::Points,
-                targets: &[TexFormat::Rgba32F],
+            &PipelineDesc::new(
+                &shaders::gpu::SCATTER_VERT,
+                &shaders::gpu::SCATTER_FRAG,
+                Topology::Points,
+                &[TexFormat::Rgba32F],
                 blend,
-                per_instance: &[],
-            },
+            ),
         )?;
         Ok(Scatter { pipeline })
     }

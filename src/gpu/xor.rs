@@ -18,14 +18,13 @@ impl XorRaster {
     pub fn new(ctx: &Context, format: TexFormat) -> Result<XorRaster> {
         let pipeline = Pipeline::new(
             ctx,
-            &PipelineDesc {
-                vertex: &shaders::gpu::XOR_VERT,
-                fragment: &shaders::gpu::XOR_FRAG,
-                topology: Topology::Triangles,
-                targets: &[format],
-                blend: Blend::Xor,
-                per_instance: &[],
-            },
+            &PipelineDesc::new(
+                &shaders::gpu::XOR_VERT,
+                &shaders::gpu::XOR_FRAG,
+                Topology::Triangles,
+                &[format],
+                Blend::Xor,
+            ),
         )?;
         Ok(XorRaster { pipeline })
     }

@@ -13,8 +13,6 @@
 //! a point in the plane of a non-convex face, over its cancelled part, casts its rays from
 //! ε/2 off that plane ([`Surface::off_polygon_planes`]).
 
-use std::time::Instant;
-
 use glam::DVec3;
 
 use super::classifier::{BuildStats, Class, Classifier};
@@ -161,9 +159,7 @@ impl Jordan {
 
     /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
     pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<Jordan> {
-        let start = Instant::now();
-        let surface = Surface::with_policy(mesh, allow_open)?;
-        let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
+        let (surface, stats) = Surface::timed(mesh, allow_open)?;
         Ok(Jordan { surface, stats })
     }
 

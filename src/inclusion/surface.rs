@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::classifier::vec_bytes;
+use super::classifier::{BuildStats, vec_bytes};
 use super::error::InclusionError;
 use crate::exact;
 use crate::mesh::Mesh;
@@ -41,6 +41,15 @@ impl Surface {
     /// sums to the generalized winding number, which is no longer 0 or 1.
     pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<Surface, InclusionError> {
         if allow_open { Ok(Surface::unchecked(Covering::new(mesh))) } else { Surface::new(mesh) }
+    }
+
+    /// [`Surface::with_policy`], with its build time and bytes: the whole index of the
+    /// classifiers that test every triangle.
+    pub fn timed(mesh: &Mesh, allow_open: bool) -> Result<(Surface, BuildStats), InclusionError> {
+        let start = std::time::Instant::now();
+        let surface = Surface::with_policy(mesh, allow_open)?;
+        let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
+        Ok((surface, stats))
     }
 
     pub fn from_covering(covering: Covering) -> Result<Surface, InclusionError> {

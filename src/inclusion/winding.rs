@@ -7,8 +7,6 @@
 //! surface, accepted with `--allow-open`, it is the generalized winding number); within ε
 //! of a face, OnBoundary (the shared rule of [`crate::inclusion`]).
 
-use std::time::Instant;
-
 use glam::DVec3;
 
 use super::classifier::{BuildStats, Class, Classifier};
@@ -61,9 +59,7 @@ impl WindingNumber {
 
     /// `allow_open` accepts open surfaces (see [`Surface::with_policy`]).
     pub fn with_policy(mesh: &Mesh, allow_open: bool) -> Result<WindingNumber> {
-        let start = Instant::now();
-        let surface = Surface::with_policy(mesh, allow_open)?;
-        let stats = BuildStats { build_time: start.elapsed(), bytes: surface.bytes() };
+        let (surface, stats) = Surface::timed(mesh, allow_open)?;
         Ok(WindingNumber { surface, stats })
     }
 

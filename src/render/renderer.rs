@@ -151,26 +151,25 @@ impl Renderer {
         let raster = |depth| Raster { depth, samples };
         let mesh = Pipeline::with_raster(
             ctx,
-            &PipelineDesc {
-                vertex: &shaders::render::MESH_VERT,
-                fragment: &shaders::render::MESH_FRAG,
-                topology: Topology::Triangles,
-                targets: &[TexFormat::Rgba8],
-                blend: Blend::Replace,
-                per_instance: &[],
-            },
+            &PipelineDesc::new(
+                &shaders::render::MESH_VERT,
+                &shaders::render::MESH_FRAG,
+                Topology::Triangles,
+                &[TexFormat::Rgba8],
+                Blend::Replace,
+            ),
             &raster(DepthTest::Less),
         )?;
         let lines = Pipeline::with_raster(
             ctx,
-            &PipelineDesc {
-                vertex: &shaders::render::LINE_VERT,
-                fragment: &shaders::render::LINE_FRAG,
-                topology: Topology::Triangles,
-                targets: &[TexFormat::Rgba8],
-                blend: Blend::Replace,
-                per_instance: &[0, 1, 2, 3],
-            },
+            &PipelineDesc::new(
+                &shaders::render::LINE_VERT,
+                &shaders::render::LINE_FRAG,
+                Topology::Triangles,
+                &[TexFormat::Rgba8],
+                Blend::Replace,
+            )
+            .per_instance(&[0, 1, 2, 3]),
             &raster(DepthTest::LessOrEqual),
         )?;
         let block = Buffer::host(ctx, std::mem::size_of::<ViewBlock>() as u64, "render view")?;

@@ -18,18 +18,7 @@ pub const HELPER_ENV: &str = "TEXGEO_OSD_REFINE";
 /// checkout, else `tools/osd-refine` next to the running executable's `target` folder.
 /// Fails with [`SubdivError::HelperMissing`] (saying to run `tools/setup`) when absent.
 pub fn helper_path() -> Result<PathBuf> {
-    if let Some(path) = std::env::var_os(HELPER_ENV) {
-        let path = PathBuf::from(path);
-        return if path.is_file() { Ok(path) } else { Err(SubdivError::HelperMissing { path }) };
-    }
-    let default = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/tools/osd-refine");
-    if default.is_file() {
-        return Ok(default);
-    }
-    let beside_exe = std::env::current_exe().ok().and_then(|exe| {
-        exe.ancestors().map(|dir| dir.join("tools/osd-refine")).find(|candidate| candidate.is_file())
-    });
-    beside_exe.ok_or(SubdivError::HelperMissing { path: default })
+    crate::scratch::helper(HELPER_ENV, "osd-refine").map_err(|path| SubdivError::HelperMissing { path })
 }
 
 /// How to run the helper.

@@ -61,16 +61,17 @@ pub trait Task: Default {
     /// Whether these options need a Vulkan device (the worker opens one and keeps it).
     fn needs_device(options: &Self::Options) -> bool;
 
-    /// Runs on one mesh. `ctx` is the worker's device when `needs_device` said so;
-    /// `report` is the mesh's validation report (closed, manifold, …).
-    fn run(
-        &mut self,
-        ctx: Option<&Context>,
-        mesh: &Mesh,
-        report: &Report,
-        options: &Self::Options,
-        out: &mut Record,
-    ) -> Result<(), Failure>;
+    /// Runs on one mesh.
+    fn run(&mut self, input: Input, options: &Self::Options, out: &mut Record) -> Result<(), Failure>;
+}
+
+/// One mesh as a task gets it: the worker's device when [`Task::needs_device`] said so,
+/// the mesh, and its validation report (closed, manifold, …).
+#[derive(Clone, Copy)]
+pub struct Input<'a> {
+    pub ctx: Option<&'a Context>,
+    pub mesh: &'a Mesh,
+    pub report: &'a Report,
 }
 
 /// Parses a task's options from JSON (missing keys take their defaults) and validates them.

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use super::record::Record;
-use super::task::{Failure, Task, TaskKind, Visit, parse_options};
+use super::task::{Failure, Input, Task, TaskKind, Visit, parse_options};
 use crate::gpu::{Context, ContextOptions, DeviceChoice};
 use crate::mesh::spec::MeshSpec;
 use crate::mesh::{MeshError, validate};
@@ -171,7 +171,7 @@ fn run_job<T: Task>(
         rec.check("closed", report.is_closed());
         rec.check("oriented", report.is_oriented());
         rec.check("manifold", report.is_manifold());
-        task.run(ctx.as_ref(), &mesh, &report, &options, &mut rec)
+        task.run(Input { ctx: ctx.as_ref(), mesh: &mesh, report: &report }, &options, &mut rec)
     })();
     if let Err(f) = result {
         rec.outcome = f.outcome;

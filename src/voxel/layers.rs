@@ -44,14 +44,13 @@ pub(crate) trait LayerPainter {
 pub(crate) fn xor_pipeline(ctx: &Context, vertex: &Shader) -> Result<Pipeline> {
     Ok(Pipeline::new(
         ctx,
-        &PipelineDesc {
+        &PipelineDesc::new(
             vertex,
-            fragment: &crate::gpu::shaders::voxel::SLICE_FRAG,
-            topology: Topology::Triangles,
-            targets: &[TexFormat::R32Ui],
-            blend: Blend::Xor,
-            per_instance: &[],
-        },
+            &crate::gpu::shaders::voxel::SLICE_FRAG,
+            Topology::Triangles,
+            &[TexFormat::R32Ui],
+            Blend::Xor,
+        ),
     )?)
 }
 

@@ -548,64 +548,46 @@ fn table_4_5(measured: &[Measured], cfg: &Config) -> Table {
 
 /// Table 4-6: the versions of the Feito-Torres test.
 fn table_4_6(measured: &[Measured], cfg: &Config) -> Table {
-    let mut t46 = Table::new(
+    times_table(
+        measured,
         format!("Table 4-6: versions of Feito-Torres, s per set of {} points", cfg.points),
         &[
-            "model",
-            "faces",
-            "basic (cpu)",
-            "CPU+GPU",
-            "GPU",
-            "GPU, thesis layout (batch 1)",
-            "octants",
-            "TetraGrid 32",
-            "GPU+TetraGrid 32",
+            ("basic (cpu)", "cpu"),
+            ("CPU+GPU", "cpu+gpu"),
+            ("GPU", "gpu"),
+            ("GPU, thesis layout (batch 1)", "gpu-batch-1"),
+            ("octants", "octants"),
+            ("TetraGrid 32", "tetragrid"),
+            ("GPU+TetraGrid 32", "gpu+tetragrid"),
         ],
     )
-    .unit("s", 2..9);
+}
+
+/// A table of the mean time per set of each method (column header, method) beside each
+/// model and its faces.
+fn times_table(measured: &[Measured], title: String, methods: &[(&str, &str)]) -> Table {
+    let mut columns = vec!["model", "faces"];
+    columns.extend(methods.iter().map(|m| m.0));
+    let mut t = Table::new(title, &columns).unit("s", 2..2 + methods.len());
     for m in measured {
-        t46.row(vec![
-            label(m),
-            m.faces.to_string(),
-            m.time("cpu"),
-            m.time("cpu+gpu"),
-            m.time("gpu"),
-            m.time("gpu-batch-1"),
-            m.time("octants"),
-            m.time("tetragrid"),
-            m.time("gpu+tetragrid"),
-        ]);
+        let mut row = vec![label(m), m.faces.to_string()];
+        row.extend(methods.iter().map(|(_, method)| m.time(method)));
+        t.row(row);
     }
-    t46
+    t
 }
 
 /// Tables 4-7 and 4-8: each method's index, its memory and its build time.
 fn index_tables(measured: &[Measured]) -> (Table, Table) {
     let pre = ["octants", "tetragrid", "bvh", "jordan-octree"];
+    let columns =
+        ["model", "triangles", "Feito (octants)", "Feito (TetraGrid 32)", "Feito (BVH)", "Jordan (octree 6)"];
     let mut t47 = Table::new(
         "Table 4-7: memory of each method's index (KiB; BVH stands where the thesis had BSP)",
-        &[
-            "model",
-            "triangles",
-            "Feito (octants)",
-            "Feito (TetraGrid 32)",
-            "Feito (BVH)",
-            "Jordan (octree 6)",
-        ],
+        &columns,
     )
     .unit("KiB", 2..6);
-    let mut t48 = Table::new(
-        "Table 4-8: time to build each method's index (s)",
-        &[
-            "model",
-            "triangles",
-            "Feito (octants)",
-            "Feito (TetraGrid 32)",
-            "Feito (BVH)",
-            "Jordan (octree 6)",
-        ],
-    )
-    .unit("s", 2..6);
+    let mut t48 = Table::new("Table 4-8: time to build each method's index (s)", &columns).unit("s", 2..6);
     for m in measured {
         let mut mem = vec![label(m), m.triangles.to_string()];
         let mut time = mem.clone();
@@ -622,33 +604,18 @@ fn index_tables(measured: &[Measured]) -> (Table, Table) {
 
 /// Table 4-9: the inclusion tests of both families.
 fn table_4_9(measured: &[Measured], cfg: &Config) -> Table {
-    let mut t49 = Table::new(
+    times_table(
+        measured,
         format!("Table 4-9: inclusion tests, s per set of {} points", cfg.points),
         &[
-            "model",
-            "faces",
-            "Feito CPU",
-            "Feito GPU",
-            "Feito GPU+TetraGrid 32",
-            "Feito BVH",
-            "Jordan",
-            "Jordan octree 6",
+            ("Feito CPU", "cpu"),
+            ("Feito GPU", "gpu"),
+            ("Feito GPU+TetraGrid 32", "gpu+tetragrid"),
+            ("Feito BVH", "bvh"),
+            ("Jordan", "jordan"),
+            ("Jordan octree 6", "jordan-octree"),
         ],
     )
-    .unit("s", 2..8);
-    for m in measured {
-        t49.row(vec![
-            label(m),
-            m.faces.to_string(),
-            m.time("cpu"),
-            m.time("gpu"),
-            m.time("gpu+tetragrid"),
-            m.time("bvh"),
-            m.time("jordan"),
-            m.time("jordan-octree"),
-        ]);
-    }
-    t49
 }
 
 /// The speed-up of every method over the CPU test, with what was measured and how.

@@ -713,22 +713,16 @@ fn missing_cells(t: &[VoxelTime], methods: &[&str], f: &Facts) -> String {
 
 fn voxel_grows_with_n(f: &Facts) -> Measure {
     let t = voxel_times(f)?;
-    let (mut grows_n, mut total) = (0, 0);
     let mut series: Vec<(String, String)> = t.iter().map(|e| (e.0.clone(), e.3.clone())).collect();
     series.sort();
     series.dedup();
-    let mut decisions = Vec::new();
-    for (model, method) in series.iter().filter(|s| SLICERS.contains(&s.1.as_str())) {
+    let curves = series.iter().filter(|s| SLICERS.contains(&s.1.as_str())).map(|(model, method)| {
         let mut pts: Vec<(usize, Stat)> =
             t.iter().filter(|e| &e.0 == model && &e.3 == method).map(|e| (e.2, e.4)).collect();
         pts.sort_by_key(|p| p.0);
-        if pts.len() >= 2 {
-            total += 1;
-            let d = Decision::all(pts.windows(2).map(|w| grows(&w[0].1, &w[1].1)));
-            grows_n += usize::from(d == Decision::Holds);
-            decisions.push(d);
-        }
-    }
+        (pts.len() >= 2).then(|| pts.into_iter().map(|p| p.1).collect::<Vec<Stat>>())
+    });
+    let (grows_n, total, decisions) = growth(curves);
     if total == 0 {
         return Err("needs two or more resolutions".into());
     }
@@ -738,27 +732,23 @@ fn voxel_grows_with_n(f: &Facts) -> Measure {
              within it or shrinking"
         ),
         Decision::all(decisions),
-    ).into())
+    )
+        .into())
 }
 
 fn voxel_grows_with_size(f: &Facts) -> Measure {
     let t = voxel_times(f)?;
-    let (mut grows_n, mut total) = (0, 0);
     let mut series: Vec<(usize, String)> = t.iter().map(|e| (e.2, e.3.clone())).collect();
     series.sort();
     series.dedup();
-    let mut decisions = Vec::new();
-    for (n, method) in series.iter().filter(|s| SLICERS.contains(&s.1.as_str())) {
+    let curves = series.iter().filter(|s| SLICERS.contains(&s.1.as_str())).map(|(n, method)| {
         let mut pts: Vec<(f64, Stat)> =
             t.iter().filter(|e| e.2 == *n && &e.3 == method).map(|e| (e.1, e.4)).collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        if pts.len() >= 2 && pts.windows(2).all(|w| w[1].0 > w[0].0) {
-            total += 1;
-            let d = Decision::all(pts.windows(2).map(|w| grows(&w[0].1, &w[1].1)));
-            grows_n += usize::from(d == Decision::Holds);
-            decisions.push(d);
-        }
-    }
+        (pts.len() >= 2 && pts.windows(2).all(|w| w[1].0 > w[0].0))
+            .then(|| pts.into_iter().map(|p| p.1).collect::<Vec<Stat>>())
+    });
+    let (grows_n, total, decisions) = growth(curves);
     if total == 0 {
         return Err("needs two or more models of different sizes at one resolution".into());
     }
@@ -768,7 +758,18 @@ fn voxel_grows_with_size(f: &Facts) -> Measure {
              rest within it or shrinking"
         ),
         Decision::all(decisions),
-    ).into())
+    )
+        .into())
+}
+
+/// Of `curves` (each the times along a growing quantity; `None`: too few points), how
+/// many grow beyond their runs' range at every step, how many there are, and each one's
+/// decision.
+fn growth(curves: impl Iterator<Item = Option<Vec<Stat>>>) -> (usize, usize, Vec<Decision>) {
+    let decisions: Vec<Decision> =
+        curves.flatten().map(|c| Decision::all(c.windows(2).map(|w| grows(&w[0], &w[1])))).collect();
+    let grows_n = decisions.iter().filter(|&&d| d == Decision::Holds).count();
+    (grows_n, decisions.len(), decisions)
 }
 
 /// "Equal or better": zoned is slower only where the whole interval of pgpu / zoned lies

@@ -8,14 +8,13 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::boolean::{self, BooleanError, InputError, Names, Operation, Transform, cgal};
-use crate::gpu::Context;
 use crate::inclusion::Choice;
 use crate::mesh::covering::measures;
 use crate::mesh::spec::Placed;
-use crate::mesh::{Mesh, Report, procedural};
+use crate::mesh::{Mesh, procedural};
 use crate::report::bench::boolean::turned_copy;
 use crate::sweep::record::{Record, mesh_hash};
-use crate::sweep::task::{Failure, Task, relative};
+use crate::sweep::task::{Failure, Input, Task, relative};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -93,14 +92,8 @@ impl Task for BooleanTask {
         !o.method.is_cpu()
     }
 
-    fn run(
-        &mut self,
-        ctx: Option<&Context>,
-        mesh: &Mesh,
-        _report: &Report,
-        o: &Options,
-        out: &mut Record,
-    ) -> Result<(), Failure> {
+    fn run(&mut self, input: Input, o: &Options, out: &mut Record) -> Result<(), Failure> {
+        let Input { ctx, mesh, .. } = input;
         let op = o.op;
         let other = o.other(mesh).map_err(|e| Failure::failed("options", e))?;
         let options = boolean::Options { method: o.method, ..boolean::Options::default() };

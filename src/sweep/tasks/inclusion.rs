@@ -5,14 +5,13 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::gpu::Context;
 use crate::inclusion::solver::Solver;
 use crate::inclusion::{self, Choice, Class, InclusionError, Method};
+use crate::mesh::Mesh;
 use crate::mesh::solidity::{Policy, require_solid};
-use crate::mesh::{Mesh, Report};
 use crate::random::Rng;
 use crate::sweep::record::{Fnv, Record};
-use crate::sweep::task::{Failure, Task};
+use crate::sweep::task::{Failure, Input, Task};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -72,14 +71,8 @@ impl Task for Inclusion {
         !o.method.is_cpu()
     }
 
-    fn run(
-        &mut self,
-        ctx: Option<&Context>,
-        mesh: &Mesh,
-        _report: &Report,
-        o: &Options,
-        out: &mut Record,
-    ) -> Result<(), Failure> {
+    fn run(&mut self, input: Input, o: &Options, out: &mut Record) -> Result<(), Failure> {
+        let Input { ctx, mesh, .. } = input;
         // The same gate as `texgeo inclusion`: what the command refuses, the sweep refuses.
         let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
         let accepted = require_solid(mesh.clone(), policy).map_err(Failure::not_solid)?;

@@ -5,13 +5,11 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::gpu::Context;
-use crate::mesh::{Mesh, Report};
 use crate::subdiv::compare::Comparison;
 use crate::subdiv::gpu::{Options as GpuOptions, Subdivider};
 use crate::subdiv::{SubdivError, cpu, osd};
 use crate::sweep::record::{Record, mesh_hash as hash};
-use crate::sweep::task::{Failure, Task, relative};
+use crate::sweep::task::{Failure, Input, Task, relative};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -79,14 +77,8 @@ impl Task for Subdivide {
         o.gpu().unwrap_or(false)
     }
 
-    fn run(
-        &mut self,
-        ctx: Option<&Context>,
-        mesh: &Mesh,
-        _report: &Report,
-        o: &Options,
-        out: &mut Record,
-    ) -> Result<(), Failure> {
+    fn run(&mut self, input: Input, o: &Options, out: &mut Record) -> Result<(), Failure> {
+        let Input { ctx, mesh, .. } = input;
         let gpu = o.gpu().map_err(|e| Failure::failed("options", e))?;
         out.size("level", o.level);
         let refined = if gpu {

@@ -9,7 +9,7 @@ use crate::gpu::Context;
 use crate::mesh::solidity::{Policy, require_solid};
 use crate::mesh::{Mesh, Report};
 use crate::sweep::record::{Fnv, Record};
-use crate::sweep::task::{Failure, Task};
+use crate::sweep::task::{Failure, Input, Task};
 use crate::voxel::auto::{Counts, Device, Plan};
 use crate::voxel::{Choice, Grid, Method, Solid, VoxelError, Voxelizer, Zone, grid};
 
@@ -77,14 +77,8 @@ impl Task for Voxelize {
         [o.method.fixed(), o.reference].into_iter().flatten().any(Method::uses_gpu)
     }
 
-    fn run(
-        &mut self,
-        ctx: Option<&Context>,
-        mesh: &Mesh,
-        report: &Report,
-        o: &Options,
-        out: &mut Record,
-    ) -> Result<(), Failure> {
+    fn run(&mut self, input: Input, o: &Options, out: &mut Record) -> Result<(), Failure> {
+        let Input { ctx, mesh, report } = input;
         let refusal = |e: VoxelError| refusal(e, report);
         // The same gate as `texgeo voxelize`: what the command refuses, the sweep refuses.
         let policy = Policy { allow_open: o.allow_open, ..Policy::default() };
