@@ -54,11 +54,24 @@ fn remedy(defect: &solidity::Defect) -> &'static str {
 /// every command, then what refinement needs on top (faces it can triangulate, a volume). `allow_self_intersections` excuses faces that
 /// cross; an inverted operand is refused (the command flips it first when asked).
 pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Result<TriangleSoup, InputError> {
+    check_known(mesh, frame, allow_self_intersections, None).map(|(soup, _)| soup)
+}
+
+/// [`check`], with the solid check's verdict on `mesh` when it is already known (a valid
+/// solid's, remembered from an earlier run: [`solidity::remembered`]); also returns the
+/// verdict, in the operand's units, so that a caller can remember it (none for the empty
+/// solid, which needs no check).
+pub fn check_known(
+    mesh: &Mesh,
+    frame: Frame,
+    allow_self_intersections: bool,
+    known: Option<solidity::Solidity>,
+) -> Result<(TriangleSoup, Option<solidity::Solidity>), InputError> {
     if mesh.num_faces() == 0 {
         // The empty solid: A ∪ ∅ = A, A ∩ ∅ = ∅, and so on, from the same steps.
-        return Ok(TriangleSoup::new(mesh));
+        return Ok((TriangleSoup::new(mesh), None));
     }
-    let solid = solidity::check_in(mesh, frame);
+    let solid = known.unwrap_or_else(|| solidity::check_in(mesh, frame));
     let policy = Policy { allow_self_intersections, ..Policy::default() };
     if let Some(defect) = solidity::first_refusal(&solid, policy) {
         return Err(NotSolid { defect: defect.clone() }.into());
@@ -71,12 +84,19 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
     // command sees (mesh stats, inclusion and voxelize measure and test it the same).
     let soup =
         soup.without_zero_area().map_err(|face| InputError::Degenerate { face: face as usize })?.into_owned();
-    // In the frame: the volume in the input's units may underflow.
-    let volume = Covering::new(mesh).volume();
-    if volume.abs() <= flatness_bound(piece_boxes(&soup)) {
+    // In the frame: the volume in the input's units may underflow. The solid check's
+    // volume serves where it is a normal number clearly above the bound (the same sum up
+    // to rounding); near the bound it is measured again here.
+    let bound = flatness_bound(piece_boxes(&soup));
+    let known = solid.volume.filter(|v| v.is_normal()).map(|v| frame.volume_in(v));
+    let volume = match known {
+        Some(v) if v.is_normal() && v.abs() > 2.0 * bound => v,
+        _ => Covering::new(mesh).volume(),
+    };
+    if volume.abs() <= bound {
         return Err(InputError::Flat);
     }
-    Ok(soup)
+    Ok((soup, Some(solid)))
 }
 
 /// "It encloses no volume": |`volume`| at most 1e-12 × the cube of the largest extent of

@@ -43,6 +43,7 @@ use crate::inclusion::{self, Choice, Method, solver::Solver};
 use crate::mesh::Mesh;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
+use crate::mesh::solidity::{self, Solidity};
 
 pub mod cgal;
 pub mod classify;
@@ -76,6 +77,11 @@ pub struct Options {
     /// Build the CPU classifiers while the refinement runs (the phases then overlap in
     /// wall time; benchmarks that split phases turn this off).
     pub overlap: bool,
+    /// Take an operand's solid check from the user's cache when an earlier run found the
+    /// same mesh a valid solid, and remember the verdicts found here
+    /// ([`crate::mesh::solidity::remembered`], as every command does); benchmarks that
+    /// time the checks turn this off.
+    pub remember_verdicts: bool,
 }
 
 impl Default for Options {
@@ -86,6 +92,7 @@ impl Default for Options {
             allow_self_intersections: false,
             inclusion: inclusion::Options::default(),
             overlap: true,
+            remember_verdicts: true,
         }
     }
 }
@@ -164,18 +171,24 @@ impl Default for Names<'_> {
     }
 }
 
-/// Checks both operands, given in `frame` (in parallel), and returns their triangles.
+/// Checks both operands, given in `frame` (in parallel), and returns their triangles and
+/// the verdicts of the solid check (`known` where given: remembered from an earlier run).
 pub fn check_operands(
     a: &Mesh,
     b: &Mesh,
     names: Names,
     frame: Frame,
     allow_self: bool,
-) -> Result<(TriangleSoup, TriangleSoup)> {
-    let (ra, rb) = rayon::join(|| input::check(a, frame, allow_self), || input::check(b, frame, allow_self));
+    known: [Option<Solidity>; 2],
+) -> Result<[(TriangleSoup, Option<Solidity>); 2]> {
+    let [ka, kb] = known;
+    let (ra, rb) = rayon::join(
+        || input::check_known(a, frame, allow_self, ka),
+        || input::check_known(b, frame, allow_self, kb),
+    );
     let sa = ra.map_err(|reason| BooleanError::Input { name: names.a.to_string(), reason })?;
     let sb = rb.map_err(|reason| BooleanError::Input { name: names.b.to_string(), reason })?;
-    Ok((sa, sb))
+    Ok([sa, sb])
 }
 
 /// Evaluates A against B (§6.3): checks, refinement, classification, in the operands'
@@ -189,10 +202,20 @@ pub fn evaluate(
 ) -> Result<Evaluation> {
     let mut timings = Timings::default();
     let start = Instant::now();
+    let remembered = |m: &Mesh| if options.remember_verdicts { solidity::remembered(m) } else { None };
+    let known = [remembered(a), remembered(b)];
+    let fresh = known.each_ref().map(Option::is_none);
     let frame = Frame::of(&[a, b]);
-    let (a, b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
-    let (a, b) = (a.as_ref(), b.as_ref());
-    let (sa, sb) = check_operands(a, b, names, frame, options.allow_self_intersections)?;
+    let (framed_a, framed_b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
+    let [(sa, va), (sb, vb)] =
+        check_operands(&framed_a, &framed_b, names, frame, options.allow_self_intersections, known)?;
+    if options.remember_verdicts {
+        for (mesh, fresh, verdict) in [(a, fresh[0], va), (b, fresh[1], vb)] {
+            if let (true, Some(v)) = (fresh, verdict) {
+                solidity::remember(mesh, &v);
+            }
+        }
+    }
     // The point tests answer for the surface the refinement cuts: the operands'
     // triangles. (A polygon face is its covering for the inclusion methods, which differs
     // from its triangles on a non-planar face whose centroid fan folds, by up to the
@@ -294,13 +317,9 @@ impl Evaluation {
             let mesh = select::assemble(&r.points, &tris);
             return Ok(Output { mesh, from_a, repair: Repair::default() });
         }
-        let report = select::assemble(&r.points, &tris).report();
-        if !report.is_closed() {
-            return Err(BooleanError::NotClosed {
-                op,
-                boundary: report.boundary_edges,
-                misoriented: report.misoriented_edges,
-            });
+        let (boundary, misoriented) = crate::mesh::validate::edge_defects(&tris);
+        if boundary > 0 || misoriented > 0 {
+            return Err(BooleanError::NotClosed { op, boundary, misoriented });
         }
         // The same walk as `select`: which selected triangles are uncut input triangles.
         let mut changed = Vec::with_capacity(tris.len());

@@ -115,6 +115,12 @@ impl Frame {
     pub fn volume_out(&self, x: f64) -> f64 {
         scale(x, -3 * self.exponent)
     }
+
+    /// A volume in the input's units in this frame (exact when `x` is a normal number and
+    /// the result is one).
+    pub fn volume_in(&self, x: f64) -> f64 {
+        scale(x, 3 * self.exponent)
+    }
 }
 
 /// e with 2^e ≤ |x| < 2^(e+1), for finite non-zero x.

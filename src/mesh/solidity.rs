@@ -453,25 +453,45 @@ pub struct NotSolid {
 pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
     let store = crate::cache::Store::open(CACHE_KIND);
     let key = store.as_ref().map(|_| verdict_key(&mesh));
-    if let (Some(store), Some(key)) = (&store, &key) {
-        if let Some(solidity) = store.get(key).and_then(|b| decode_solid(&b)) {
-            let frame = Frame::of(&[&mesh]);
-            return Ok(Accepted {
-                mesh: frame.mesh_in(mesh),
-                frame,
-                solidity,
-                flipped: false,
-                non_solid: None,
-            });
-        }
+    if let Some(solidity) = recall(store.as_ref(), key.as_ref()) {
+        let frame = Frame::of(&[&mesh]);
+        return Ok(Accepted { mesh: frame.mesh_in(mesh), frame, solidity, flipped: false, non_solid: None });
     }
     let accepted = require_solid_uncached(mesh, policy)?;
-    if let (Some(store), Some(key)) = (&store, &key) {
-        if !accepted.flipped && accepted.solidity.is_solid() {
-            store.put(key, &encode_solid(&accepted.solidity));
-        }
+    if !accepted.flipped {
+        store_verdict(store.as_ref(), key.as_ref(), &accepted.solidity);
     }
     Ok(accepted)
+}
+
+/// The verdict of an earlier [`check`] that found `mesh` (exactly these positions and
+/// faces) a valid solid, from the user's cache; `None` when there is none (or caching is
+/// off). The same memory [`require_solid`] keeps, for callers that check in their own frame
+/// (the Booleans' operands).
+pub fn remembered(mesh: &Mesh) -> Option<Solidity> {
+    let store = crate::cache::Store::open(CACHE_KIND);
+    let key = store.as_ref().map(|_| verdict_key(mesh));
+    recall(store.as_ref(), key.as_ref())
+}
+
+/// Remembers `solidity`, the result of [`check`] on `mesh` in the mesh's units, if it says
+/// that `mesh` is a valid solid (only valid solids are remembered).
+pub fn remember(mesh: &Mesh, solidity: &Solidity) {
+    let store = crate::cache::Store::open(CACHE_KIND);
+    let key = store.as_ref().map(|_| verdict_key(mesh));
+    store_verdict(store.as_ref(), key.as_ref(), solidity);
+}
+
+fn recall(store: Option<&crate::cache::Store>, key: Option<&crate::cache::Key>) -> Option<Solidity> {
+    store?.get(key?).and_then(|b| decode_solid(&b))
+}
+
+fn store_verdict(store: Option<&crate::cache::Store>, key: Option<&crate::cache::Key>, solidity: &Solidity) {
+    if let (Some(store), Some(key)) = (store, key) {
+        if solidity.is_solid() {
+            store.put(key, &encode_solid(solidity));
+        }
+    }
 }
 
 /// Names the rules of this module in every cached verdict's key: change it whenever what

@@ -109,6 +109,36 @@ pub(crate) fn half_edges_by_lower_vertex(
     (start, items)
 }
 
+/// The boundary and misoriented edges of `triangles`, counted as [`report`] counts them
+/// ([`Report::is_closed`] when both are 0), without the rest of the report: the closure
+/// test of a Boolean result.
+pub fn edge_defects(triangles: &[[u32; 3]]) -> (usize, usize) {
+    use rayon::prelude::*;
+    // (lower vertex, higher vertex) as one key, and whether the side runs lower → higher.
+    let mut sides: Vec<(u64, bool)> = triangles
+        .par_iter()
+        .with_min_len(4096)
+        .flat_map_iter(|t| {
+            (0..3).filter_map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                (a != b).then(|| ((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), a < b))
+            })
+        })
+        .collect();
+    sides.par_sort_unstable();
+    let (mut boundary, mut misoriented) = (0, 0);
+    for run in sides.chunk_by(|x, y| x.0 == y.0) {
+        let forward = run.iter().filter(|s| s.1).count();
+        if run.len() == 1 {
+            boundary += 1;
+        }
+        if run.len() >= 2 && 2 * forward != run.len() {
+            misoriented += 1;
+        }
+    }
+    (boundary, misoriented)
+}
+
 /// Builds the [`Report`] of `mesh`.
 pub fn report(mesh: &Mesh) -> Report {
     let (offsets, indices) = mesh.face_parts();
@@ -282,5 +312,35 @@ impl fmt::Display for Report {
             yes(self.is_oriented()),
             yes(self.is_manifold())
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{procedural, triangulate::triangulated};
+
+    /// The lean closure test counts what the full report counts, on closed, open,
+    /// misoriented and non-manifold triangle meshes.
+    #[test]
+    fn edge_defects_count_as_the_report_does() {
+        for mesh in [procedural::cube(), procedural::two_cubes_sharing_edge()] {
+            let mesh = triangulated(&mesh);
+            let closed: Vec<[u32; 3]> = mesh.faces().map(|f| [f[0], f[1], f[2]]).collect();
+            let open = closed[1..].to_vec();
+            let mut flipped = closed.clone();
+            flipped[3].swap(0, 1);
+            let mut doubled = closed.clone();
+            doubled.push(closed[0]);
+            for t in [closed, open, flipped, doubled] {
+                let m = Mesh::new(mesh.positions().to_vec(), t.iter().map(|x| x.to_vec()).collect()).unwrap();
+                let r = report(&m);
+                assert_eq!(edge_defects(&t), (r.boundary_edges, r.misoriented_edges), "{t:?}");
+            }
+        }
+        let cube = triangulated(&procedural::cube());
+        let t: Vec<[u32; 3]> = cube.faces().skip(1).map(|f| [f[0], f[1], f[2]]).collect();
+        let (boundary, misoriented) = edge_defects(&t);
+        assert!(boundary == 3 && misoriented == 0, "{boundary} {misoriented}");
     }
 }
