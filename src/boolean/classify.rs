@@ -453,31 +453,45 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
     let n = refined.triangles.len();
     let mut sets = UnionFind::new(n);
     {
-        // Edges of every triangle, sorted so that the triangles around an edge are adjacent.
-        let mut edges: Vec<(u64, u32)> = (0..n as u32)
-            .into_par_iter()
-            .with_min_len(4096)
-            .flat_map_iter(|t| {
-                let [p, q, s] = refined.triangles[t as usize];
-                [(edge_key(p, q), t), (edge_key(q, s), t), (edge_key(s, p), t)]
-            })
-            .collect();
-        edges.par_sort_unstable();
-        let mut i = 0;
-        while i < edges.len() {
-            let mut j = i + 1;
-            while j < edges.len() && edges[j].0 == edges[i].0 {
-                j += 1;
+        // The sides of every triangle bucketed by their lower point (a counting sort), each
+        // bucket ordered by (higher point, triangle): the triangles around an edge are
+        // adjacent, in increasing order.
+        let nv = r.points.len();
+        let sides = |t: usize| {
+            let [p, q, s] = refined.triangles[t];
+            [(p, q), (q, s), (s, p)].map(|(a, b)| (a.min(b), a.max(b)))
+        };
+        let mut start = vec![0usize; nv + 1];
+        for t in 0..n {
+            for (lo, _) in sides(t) {
+                start[lo as usize + 1] += 1;
             }
-            if j - i > 1 && r.cut_edges.binary_search(&edges[i].0).is_err() {
-                for k in i + 1..j {
-                    let (s, t) = (edges[i].1, edges[k].1);
-                    if on[s as usize] == on[t as usize] {
-                        sets.union(s, t);
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![(0u32, 0u32); start[nv]];
+        for t in 0..n {
+            for (lo, hi) in sides(t) {
+                items[fill[lo as usize]] = (hi, t as u32);
+                fill[lo as usize] += 1;
+            }
+        }
+        drop(fill);
+        for lo in 0..nv {
+            let bucket = &mut items[start[lo]..start[lo + 1]];
+            bucket.sort_unstable();
+            for run in bucket.chunk_by(|x, y| x.0 == y.0) {
+                if run.len() > 1 && r.cut_edges.binary_search(&edge_key(lo as u32, run[0].0)).is_err() {
+                    let s = run[0].1;
+                    for &(_, t) in &run[1..] {
+                        if on[s as usize] == on[t as usize] {
+                            sets.union(s, t);
+                        }
                     }
                 }
             }
-            i = j;
         }
     }
     // Number the off-surface groups 0..count, then the rest.

@@ -224,8 +224,10 @@ pub fn evaluate(
     let (a, b) = (&sa.to_mesh()?, &sb.to_mesh()?);
     timings.check = start.elapsed();
 
+    // The operands' closure is checked above.
+    let inclusion = inclusion::Options { known_closed: true, ..options.inclusion.clone() };
     let build = |mesh: &Mesh, name: &str| {
-        Solver::new(options.method, mesh, &options.inclusion, ctx, None)
+        Solver::new(options.method, mesh, &inclusion, ctx, None)
             .map_err(|source| BooleanError::Inclusion { name: name.to_string(), source })
     };
     let build_both = || {

@@ -122,7 +122,7 @@ pub struct Options {
     pub non_solid: bool,
     /// The caller has already found the surface closed and consistently oriented (the
     /// command line's [`crate::mesh::solidity::require_solid`], whose verdicts are cached),
-    /// so the default method does not check it again.
+    /// so it is not checked again (the default method's closure check and the exact tests').
     pub known_closed: bool,
 }
 

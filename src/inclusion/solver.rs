@@ -187,7 +187,15 @@ pub fn build(method: impl Into<Choice>, mesh: &Mesh, options: &Options) -> Resul
         }
         return Ok(Box::new(FastWinding::new(mesh, options.points)?));
     }
-    let ft = || FeitoTorres::with_policy(mesh, options.apex, EdgeRule::Rerun, options.allow_open);
+    // A closure the caller has checked is not checked again.
+    let ft = || {
+        FeitoTorres::with_policy(
+            mesh,
+            options.apex,
+            EdgeRule::Rerun,
+            options.allow_open || options.known_closed,
+        )
+    };
     Ok(match method {
         Method::Cpu => Box::new(ft()?),
         Method::Bvh => Box::new(Bvh::new(ft()?)),

@@ -133,7 +133,13 @@ pub fn measure_interleaved(
 /// classifiers' build with the refinement), so each phase's time is its own; operands
 /// checked every time (no verdicts from or into the user's cache).
 pub fn sequential(method: impl Into<Choice>, grouping: Grouping) -> Options {
-    Options { method: method.into(), grouping, overlap: false, remember_verdicts: false, ..Options::default() }
+    Options {
+        method: method.into(),
+        grouping,
+        overlap: false,
+        remember_verdicts: false,
+        ..Options::default()
+    }
 }
 
 /// The columns of Table 6-1 between the pair and the totals, shared with `texgeo
