@@ -9,22 +9,26 @@
 //! from the edges' triangle lists. So fans cost nothing: the triangles around a vertex
 //! are paired only where the edges opposite it reach.
 //!
-//! The (edge, triangle) pairs come from an adaptive octree over the mesh's box: a triangle
-//! or edge enters a cell only when it may cross it (its box overlaps the cell, and the
-//! cell is not strictly on one side of its plane or, for an edge, of the planes through
-//! it along the axes; tested with a margin for rounding, so nothing that crosses is left
-//! out). A cell stops splitting when it holds few entries, when all its entries share a
-//! vertex or all belong to one face (no pair there counts), or when it holds no edge or
-//! no triangle. A cell is halved only along the axes that part its entries when some do
-//! (long slivers side by side are cut across, not along). Long slivers and high-valence
-//! fans therefore sit in few cells, unlike boxes in a uniform grid, whose overlaps grow
-//! with the square of the fan's size.
+//! The (edge, triangle) pairs come from an adaptive octree over the mesh's box that holds
+//! the triangles alone: a triangle enters a cell only when it may cross it (its box
+//! overlaps the cell, and the cell is not strictly on one side of its plane or of the
+//! planes through its edges along the axis it faces most; tested with a margin for
+//! rounding, so nothing that crosses is left out). An edge crosses no cell its triangles
+//! do not, so a cell's edges are those of its triangles that may cross it (the same test,
+//! made in the leaves only): the edges never go down the tree themselves, which would
+//! place three times as many entries at every level. A cell stops splitting when it holds
+//! few triangles, when all of them belong to one face, or when all of them share a vertex
+//! and none of the edges opposite it may cross the cell (no pair there counts). A cell
+//! is halved only along the axes that part its triangles when some do (long slivers side
+//! by side are cut across, not along). Long slivers and high-valence fans therefore sit
+//! in few cells, unlike boxes in a uniform grid, whose overlaps grow with the square of
+//! the fan's size.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// A cell with at most this many entries pairs them instead of splitting.
-const LEAF: usize = 48;
+/// A cell with at most this many triangles pairs them instead of splitting.
+const LEAF: usize = 24;
 /// Deeper cells are not split (a point where many triangles truly cross); a level may
 /// halve fewer than three axes ([`Tree::parting_axes`]).
 const MAX_DEPTH: u32 = 32;
@@ -34,8 +38,6 @@ const PARALLEL: usize = 4096;
 /// because symmetric meshes put apexes, rings and axes on their box's middle planes, and
 /// every entry touching a split plane goes to both halves.
 const SPLIT_AT: f64 = 0.4567;
-/// Face of an edge whose triangles belong to different faces.
-const MIXED: u32 = u32::MAX;
 
 type Box3 = (DVec3, DVec3);
 
@@ -43,13 +45,15 @@ struct Tree<'a> {
     positions: &'a [DVec3],
     triangles: &'a [[u32; 3]],
     face_of: &'a [u32],
-    /// Entries: triangles `0..n`, then edges `n..`.
+    /// Entries of the tree are triangles `0..n`; [`Tree::children_crossed`] also takes
+    /// edge e as `n + e`.
     n: u32,
+    /// Every edge once, as (lower, higher) vertex, in order.
     edges: Vec<[u32; 2]>,
     /// Triangles of edge e: `adjacent[start[e]..start[e + 1]]`.
     start: Vec<u32>,
     adjacent: Vec<u32>,
-    edge_face: Vec<u32>,
+    /// The triangles' boxes.
     boxes: Vec<Box3>,
 }
 
@@ -86,7 +90,6 @@ pub fn candidate_pairs(
         edges: Vec::new(),
         start: vec![0],
         adjacent: Vec::with_capacity(ends.len()),
-        edge_face: Vec::new(),
         boxes: Vec::new(),
     };
     let mut out: Vec<u64> = Vec::new();
@@ -97,8 +100,6 @@ pub fn candidate_pairs(
         tree.adjacent.extend(run.iter().map(|&(_, t)| t));
         tree.start.push(tree.adjacent.len() as u32);
         let faces = &tree.adjacent[first..];
-        let f = face_of[faces[0] as usize];
-        tree.edge_face.push(if faces.iter().all(|&t| face_of[t as usize] == f) { f } else { MIXED });
         for (k, &t) in faces.iter().enumerate() {
             for &u in &faces[k + 1..] {
                 out.push((t.min(u) as u64) << 32 | t.max(u) as u64);
@@ -111,10 +112,8 @@ pub fn candidate_pairs(
             (lo.min(positions[i as usize]), hi.max(positions[i as usize]))
         })
     };
-    tree.boxes =
-        triangles.par_iter().map(|t| hull(t)).chain(tree.edges.par_iter().map(|e| hull(e))).collect();
-    let entries: Vec<u32> =
-        (0..n).filter(|&t| !skip[t as usize]).chain((0..tree.edges.len() as u32).map(|e| n + e)).collect();
+    tree.boxes = triangles.par_iter().with_min_len(4096).map(|t| hull(t)).collect();
+    let entries: Vec<u32> = (0..n).filter(|&t| !skip[t as usize]).collect();
     let root = entries
         .iter()
         .map(|&x| tree.boxes[x as usize])
@@ -128,27 +127,39 @@ pub fn candidate_pairs(
 }
 
 impl Tree<'_> {
-    fn vertices(&self, x: u32) -> &[u32] {
-        if x < self.n { &self.triangles[x as usize] } else { &self.edges[(x - self.n) as usize] }
-    }
-
-    fn face(&self, x: u32) -> u32 {
-        if x < self.n { self.face_of[x as usize] } else { self.edge_face[(x - self.n) as usize] }
-    }
-
-    /// No pair of `entries` can count: none is an edge or none a triangle, all share a
-    /// vertex, or all belong to one face.
-    fn nothing_to_pair(&self, entries: &[u32]) -> bool {
-        let edges = entries.iter().filter(|&&x| x >= self.n).count();
-        if edges == 0 || edges == entries.len() {
+    /// No pair of the triangles `entries` can meet in `cell` beyond what it shares: fewer
+    /// than two, all of one face, or all sharing a vertex v while no edge opposite v may
+    /// cross the cell (two triangles that share only v and meet beyond it meet at a point
+    /// of such an edge, see the module docs).
+    fn nothing_to_pair(&self, entries: &[u32], cell: Box3) -> bool {
+        if entries.len() < 2 {
             return true;
         }
-        let first = entries[0];
-        if self.vertices(first).iter().any(|v| entries.iter().all(|&x| self.vertices(x).contains(v))) {
+        let f = self.face_of[entries[0] as usize];
+        if entries.iter().all(|&t| self.face_of[t as usize] == f) {
             return true;
         }
-        let f = self.face(first);
-        f != MIXED && entries.iter().all(|&x| self.face(x) == f)
+        self.triangles[entries[0] as usize].iter().any(|&v| {
+            entries.iter().all(|&t| {
+                let w = self.triangles[t as usize];
+                w.iter()
+                    .position(|&x| x == v)
+                    .is_some_and(|k| !self.segment_may_cross(w[(k + 1) % 3], w[(k + 2) % 3], cell))
+            })
+        })
+    }
+
+    /// The segment between vertices `a` and `b` may cross the closed `cell`: no coordinate
+    /// axis and no cross product of the segment with one shows them apart (as
+    /// [`Tree::children_crossed`] tests an edge).
+    fn segment_may_cross(&self, a: u32, b: u32, cell: Box3) -> bool {
+        let (p, q) = (self.positions[a as usize], self.positions[b as usize]);
+        if !(p.min(q).cmple(cell.1).all() && cell.0.cmple(p.max(q)).all()) {
+            return false;
+        }
+        edge_axes(q - p).into_iter().all(|axis| {
+            apart_children(axis, axis.abs(), p, 0.0, DVec3::ZERO, cell, cell.1, [false; 3], 1) == 0
+        })
     }
 
     /// The children of `cell` (halved at `mid` along the axes of `split`; child c takes
@@ -219,7 +230,7 @@ impl Tree<'_> {
     }
 
     fn walk(&self, cell: Box3, entries: Vec<u32>, depth: u32, out: &mut Vec<u64>) {
-        if self.nothing_to_pair(&entries) {
+        if self.nothing_to_pair(&entries, cell) {
             return;
         }
         let (lo, hi) = cell;
@@ -230,7 +241,7 @@ impl Tree<'_> {
             split = self.parting_axes(&entries, mid, split);
         }
         if entries.len() <= LEAF || depth >= MAX_DEPTH || !split.contains(&true) {
-            self.pair(&entries, out);
+            self.pair(&entries, cell, out);
             return;
         }
         let child_box = |c: usize| -> Box3 {
@@ -311,18 +322,33 @@ impl Tree<'_> {
         }
     }
 
-    /// Every (edge, triangle) of a leaf with no common vertex and overlapping boxes gives
-    /// the pairs of the edge's triangles with that triangle.
-    fn pair(&self, entries: &[u32], out: &mut Vec<u64>) {
+    /// The candidate pairs of a leaf: every edge of its triangles that may cross `cell`,
+    /// against every triangle of the leaf with no vertex of the edge whose box overlaps
+    /// the edge's box within the cell, gives the pairs of the edge's triangles with that
+    /// triangle.
+    fn pair(&self, entries: &[u32], cell: Box3, out: &mut Vec<u64>) {
         let overlaps = |a: Box3, b: Box3| a.0.cmple(b.1).all() && b.0.cmple(a.1).all();
-        let (edges, triangles): (Vec<u32>, Vec<u32>) = entries.iter().partition(|&&x| x >= self.n);
+        let mut edges: Vec<[u32; 2]> = entries
+            .iter()
+            .flat_map(|&t| {
+                let v = self.triangles[t as usize];
+                (0..3).map(move |k| [v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3])])
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
         let first = out.len();
-        for &e in &edges {
-            let k = (e - self.n) as usize;
-            let [a, b] = self.edges[k];
-            let edge_box = self.boxes[e as usize];
+        for [a, b] in edges {
+            if !self.segment_may_cross(a, b, cell) {
+                continue;
+            }
+            // Every edge of a triangle is listed (the triangles not skipped).
+            let Ok(k) = self.edges.binary_search(&[a, b]) else { continue };
+            let (p, q) = (self.positions[a as usize], self.positions[b as usize]);
+            // Where the edge meets a triangle in this cell lies in both boxes and the cell.
+            let edge_box = (p.min(q).max(cell.0), p.max(q).min(cell.1));
             let around = &self.adjacent[self.start[k] as usize..self.start[k + 1] as usize];
-            for &u in &triangles {
+            for &u in entries {
                 let tu = self.triangles[u as usize];
                 if tu.contains(&a) || tu.contains(&b) || !overlaps(edge_box, self.boxes[u as usize]) {
                     continue;
@@ -363,6 +389,7 @@ fn edge_axes(d: DVec3) -> [DVec3; 3] {
 /// correctly rounded, so every error is relative to a term (or an underflowed product,
 /// absolutely tiny); overflow never gives "apart".
 #[allow(clippy::too_many_arguments)]
+#[inline]
 fn apart_children(
     axis: DVec3,
     size: DVec3,
@@ -450,7 +477,6 @@ mod tests {
             edges: vec![[0, 1]],
             start: vec![0, 1],
             adjacent: vec![0],
-            edge_face: vec![0],
             boxes: Vec::new(),
         };
         // The cell [0.4, 0.8] × [0.35, 0.75] × [−0.2, 0.2] (inside the sliver's box),
