@@ -1,7 +1,8 @@
 //! `cargo bench --bench sweep`: the per-mesh cost of a sweep over many tiny meshes (200
 //! perturbed tetrahedra), for each task: wall time per mesh, the work the worker
 //! recorded per mesh (reading, checks and the task itself), and the rest — process and
-//! device start amortized, the JSON lines, the fsync'd results line — per mesh.
+//! device start amortized, the JSON lines, the fsync'd results line — per mesh. CSV on
+//! stdout (`tools/results` saves it under docs/bench/).
 
 use std::process::Command;
 use std::time::Instant;
@@ -29,9 +30,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let manifest = dir.join("tiny.txt");
     std::fs::write(&manifest, list)?;
 
-    println!("{MESHES} tetrahedra per sweep, one worker; ms per mesh\n");
-    println!("| task | wall | in the worker | rest (start-up, protocol, results line) |");
-    println!("|---|---|---|---|");
+    eprintln!("{MESHES} tetrahedra per sweep, one worker; ms per mesh");
+    println!(
+        "task,meshes,wall (ms per mesh),in the worker (ms per mesh),rest: start-up + protocol + results line (ms per mesh)"
+    );
     for (label, args) in [
         ("inclusion (gpu, 1000 points, cpu check)", &["--task", "inclusion"][..]),
         ("inclusion (cpu, 1000 points, cpu check)", &["--task", "inclusion", "--method", "cpu"][..]),
@@ -60,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let work: f64 = records.iter().filter_map(|r| r.total_ms()).sum();
         let n = MESHES as f64;
-        println!("| {label} | {:.2} | {:.2} | {:.2} |", wall / n, work / n, (wall - work) / n);
+        println!("\"{label}\",{MESHES},{:.2},{:.2},{:.2}", wall / n, work / n, (wall - work) / n);
     }
     let _ = std::fs::remove_dir_all(&dir);
     Ok(())

@@ -613,28 +613,32 @@ fn copy_tree(from: &Path, to: &Path) {
 }
 
 #[test]
-fn the_results_page_is_the_saved_report_regenerated() {
-    // docs/results.md's marked tables, written anew from the report saved under
-    // docs/report/, give the committed page byte for byte: the page shows what that run
-    // measured, not numbers pasted by hand.
+fn the_results_page_is_the_saved_reports_regenerated() {
+    // docs/results.md's marked tables, written anew from the reports saved under
+    // docs/report/ (the reproduction run) and docs/bench/ (the benchmark suites and the
+    // comparisons with other tools), give the committed page byte for byte: the page shows
+    // what those runs measured, not numbers pasted by hand.
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
     let committed = std::fs::read(docs.join("results.md")).unwrap();
     let dir = temp("page");
     copy_tree(&docs.join("report"), &dir.join("report"));
+    copy_tree(&docs.join("bench"), &dir.join("bench"));
     let page = dir.join("results.md");
     // A page whose tables were emptied is filled again with exactly the committed ones.
     let text = String::from_utf8(committed.clone()).unwrap();
     let mut emptied = String::new();
     let mut inside = false;
+    let mut files = Vec::new();
     for line in text.split_inclusive('\n') {
-        if line.starts_with("<!-- end of texgeo reproduce table") {
+        if line.starts_with("<!-- end of texgeo table") {
             inside = false;
         }
         if !inside {
             emptied.push_str(line);
         }
-        if line.starts_with("<!-- texgeo reproduce table: ") {
+        if let Some(spec) = line.strip_prefix("<!-- texgeo table: ") {
             inside = true;
+            files.push(spec.split([';', ' ']).next().unwrap().to_string());
         }
     }
     assert!(emptied.len() < text.len(), "docs/results.md has no generated table");
@@ -644,22 +648,56 @@ fn the_results_page_is_the_saved_report_regenerated() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("rewritten"));
     assert!(
         std::fs::read(&page).unwrap() == committed,
-        "docs/results.md differs from its saved report: run `texgeo reproduce --results-md docs/results.md`"
+        "docs/results.md differs from its saved reports: run `tools/results --page`"
     );
     // Regenerating the committed page changes nothing, and says so.
     let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).contains("unchanged"));
     assert!(std::fs::read(&page).unwrap() == committed);
-    // The page names the device and the machine's state as the report recorded them.
-    let mut run = csv::Reader::from_path(docs.join("report/csv/run.csv")).unwrap();
-    let run: HashMap<String, String> =
-        run.records().map(|r| r.unwrap()).map(|r| (r[0].to_string(), r[1].to_string())).collect();
+    // The page names the device and the machine's state as the reproduction run recorded them.
+    let rows = |path: PathBuf| -> HashMap<String, String> {
+        let mut r = csv::Reader::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        r.records().map(|r| r.unwrap()).map(|r| (r[0].to_string(), r[1].to_string())).collect()
+    };
+    let run = rows(docs.join("report/csv/run.csv"));
     for what in ["device", "driver", "load average (1, 5, 15 min)", "CPU time", "other processes"] {
         let row =
             format!("| {what} | {} |", run.get(what).unwrap_or_else(|| panic!("run.csv has no {what}")));
         assert!(text.contains(&row), "docs/results.md has no \"{row}\" row");
     }
+    // Every saved benchmark report records how it was made and how busy the machine was,
+    // the page shows it, and the page shows every saved report it keeps.
+    let mut folders = 0;
+    for entry in std::fs::read_dir(docs.join("bench")).unwrap() {
+        let entry = entry.unwrap();
+        if !entry.file_type().unwrap().is_dir() {
+            continue;
+        }
+        let name = entry.file_name().into_string().unwrap();
+        let run = rows(entry.path().join("run.csv"));
+        for what in [
+            "command",
+            "date",
+            "device",
+            "load average before (1, 5, 15 min)",
+            "load average after (1, 5, 15 min)",
+        ] {
+            assert!(run.get(what).is_some_and(|v| !v.is_empty()), "bench/{name}/run.csv has no {what}");
+        }
+        assert!(
+            text.contains(&format!("| bench/{name} | {} |", run["command"])),
+            "the page has no row for bench/{name}"
+        );
+        assert!(
+            files.iter().any(|f| f.starts_with(&format!("bench/{name}/"))
+                && f.ends_with(".csv")
+                && !f.ends_with("/run.csv")),
+            "the page shows no table of bench/{name}"
+        );
+        folders += 1;
+    }
+    assert!(folders > 0, "docs/bench holds no saved report");
 
     // Refusals: one line, status 2, the page left as it was.
     let refused = |what: &str, expect: &str| {
@@ -670,6 +708,18 @@ fn the_results_page_is_the_saved_report_regenerated() {
         assert!(err.contains(expect), "{what}: {err}");
         assert!(std::fs::read(&page).unwrap() == committed, "{what}: the page changed");
     };
+    // A benchmark report cut short in the middle of a row, and one emptied.
+    let bench = files.iter().find(|f| f.starts_with("bench/")).expect("the page shows no benchmark table");
+    let saved = std::fs::read_to_string(dir.join(bench)).unwrap();
+    let header = saved.lines().next().unwrap();
+    assert!(header.contains(','), "{bench} has one column");
+    let first = saved.lines().nth(1).unwrap().split(',').next().unwrap();
+    std::fs::write(dir.join(bench), format!("{header}\n{first}")).unwrap();
+    refused("cut short", &format!("results.md:{}: ", line_of(&text, bench)));
+    refused("cut short", "found record with 1 fields");
+    std::fs::write(dir.join(bench), "").unwrap();
+    refused("emptied", &format!("{bench}: empty"));
+    std::fs::write(dir.join(bench), saved).unwrap();
     // A damaged report: a table without the columns the page shows.
     std::fs::write(dir.join("report/csv/claims.csv"), "id,verdict\nI1,holds\n").unwrap();
     refused("damaged", "report/csv/claims.csv has no column \"claim (the thesis' words)\"");
@@ -680,8 +730,12 @@ fn the_results_page_is_the_saved_report_regenerated() {
     std::fs::write(&page, "# nothing to regenerate\n").unwrap();
     let o = texgeo(&["reproduce", "--results-md", page.to_str().unwrap()], &[]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(
-        String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo reproduce table: FILE -->\" marker")
-    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no \"<!-- texgeo table: FILE -->\" marker"));
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The line (from 1) of the page's first marker naming `file`.
+fn line_of(page: &str, file: &str) -> usize {
+    let marker = format!("<!-- texgeo table: {file}");
+    page.lines().position(|l| l.starts_with(&marker)).unwrap() + 1
 }

@@ -15,7 +15,7 @@ three tools get the same two files. Per tool, pair and operation the outcome is 
   failed     the tool ran and gave no answer (an error, a crash, CGAL declining the operation)
   timeout    over --timeout seconds (texgeo and CGAL run as processes; manifold in process)
 
-Writes results.csv (one row per tool, pair and operation) and table.md (per tool and
+Writes results.csv (one row per tool, pair and operation) and table.md and table.csv (per tool and
 transform: counts of each outcome, invalid results, volumes more than 1e-9 (relative) from
 CGAL's, the largest relative volume difference from CGAL, the median time) into --out. Times: texgeo and CGAL are whole processes (CGAL's one
 process computes all four operations, its time is divided by four); manifold's is the operation
@@ -312,21 +312,31 @@ def write_tables(out, rows, quiet=False):
              " | invalid results | volume off by > 1e-9 | max rel. volume diff vs CGAL | median s |",
              "|---|---|---:|" + "---:|" * len(outcomes) + "---:|---:|---:|---:|"]
     keys = sorted({(r["tool"], r["transform"]) for r in rows}, key=lambda k: (k[0] != "texgeo", k))
+    table = []
     for tool, tname in keys + [(t, "all") for t in sorted({r["tool"] for r in rows})]:
         sel = [r for r in rows if r["tool"] == tool and (tname == "all" or r["transform"] == tname)]
         counts = [sum(r["outcome"] == o for r in sel) for o in outcomes]
         invalid = sum(r["valid"] == "no" for r in sel)
         diffs = [r["rel_volume_diff"] for r in sel if r["rel_volume_diff"] != ""]
         times = [r["seconds"] for r in sel if r["outcome"] == "ok" and r["seconds"] is not None]
-        cells = [tool, f"**{tname}**" if tname == "all" else tname, str(len(sel))] + [str(c) for c in counts]
-        cells += [str(invalid) if tool != "cgal" else "–",
-                  str(sum(d > 1e-9 for d in diffs)) if tool != "cgal" else "–",
-                  f"{max(diffs):.1e}" if diffs else "–",
-                  f"{statistics.median(times):.3f}" if times else "–"]
-        lines.append("| " + " | ".join(cells) + " |")
+        cells = [tool, tname, str(len(sel))] + [str(c) for c in counts]
+        cells += [str(invalid) if tool != "cgal" else "",
+                  str(sum(d > 1e-9 for d in diffs)) if tool != "cgal" else "",
+                  f"{max(diffs):.1e}" if diffs else "",
+                  f"{statistics.median(times):.3f}" if times else ""]
+        table.append(cells)
+        md = [c or "–" for c in cells]
+        md[1] = f"**{tname}**" if tname == "all" else tname
+        lines.append("| " + " | ".join(md) + " |")
     with open(os.path.join(out, "table.md.tmp"), "w") as f:
         f.write("\n".join(lines) + "\n")
     os.replace(os.path.join(out, "table.md.tmp"), os.path.join(out, "table.md"))
+    with open(os.path.join(out, "table.csv.tmp"), "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["tool", "transform", "runs"] + outcomes +
+                   ["invalid results", "volume off by > 1e-9", "max rel. volume diff vs CGAL", "median s"])
+        w.writerows(table)
+    os.replace(os.path.join(out, "table.csv.tmp"), os.path.join(out, "table.csv"))
     if not quiet:
         print(os.path.join(out, "table.md"), file=sys.stderr)
 

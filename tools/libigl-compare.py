@@ -12,6 +12,9 @@ libigl's |w − ½| > 0.05 (texgeo's boundary points, label 2, left out).
 alternating: median wall times and their ratio.
 
 --libigl MESH POINTS -o W: one libigl run; its phase times on stderr.
+
+The tables are printed as Markdown; `--csv-dir DIR` also writes them as CSV (what
+tools/results saves under docs/bench/).
 """
 
 import argparse
@@ -58,6 +61,22 @@ def timed(cmd):
     return wall, p.stderr.decode()
 
 
+def write_csv(folder, name, header, rows):
+    """A table as CSV in `folder` (written whole: a temporary file renamed), when one is given."""
+    if not folder:
+        return
+    import csv
+
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, name)
+    with open(path + ".tmp", "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(header)
+        w.writerows(rows)
+    os.replace(path + ".tmp", path)
+    print(f"wrote {path}", file=sys.stderr)
+
+
 def compare(args):
     import numpy as np
     import igl
@@ -84,10 +103,12 @@ def compare(args):
         print(f"texgeo: {t_runs[-1][1].strip()}", file=sys.stderr)
         print(l_runs[-1][1].strip(), file=sys.stderr)
         print(f"\n{args.mesh}: {args.points} uniform points in its box, {args.runs} runs each, alternating\n")
-        print("| texgeo s (whole) | libigl s (whole) | libigl build+query s | texgeo / libigl whole "
-              "| texgeo / libigl build+query | labels equal where abs(w - 1/2) > 0.05 |")
-        print("|---:|---:|---:|---:|---:|---|")
-        print(f"| {tt:.3f} | {lt:.3f} | {inner:.3f} | {tt / lt:.3f} | {tt / inner:.3f} | {agree}/{int(clear.sum())} |")
+        header = ["points", "texgeo s (whole)", "libigl s (whole)", "libigl build+query s", "texgeo / libigl whole",
+                  "texgeo / libigl build+query", "labels equal where abs(w - 1/2) > 0.05"]
+        cells = [str(args.points), f"{tt:.3f}", f"{lt:.3f}", f"{inner:.3f}", f"{tt / lt:.3f}", f"{tt / inner:.3f}",
+                 f"{agree} of {int(clear.sum())}"]
+        print("| " + " | ".join(header) + " |\n|" + "---:|" * 6 + "---|\n| " + " | ".join(cells) + " |")
+        write_csv(args.csv_dir, "inclusion.csv", header, [cells])
         if args.voxels:
             out = os.path.join(tmp, "v.binvox")
             o_cmd = [texgeo, "voxelize", args.mesh, "--res", str(args.voxels), "--allow-open", "-o", out]
@@ -98,9 +119,11 @@ def compare(args):
                 s_runs.append(timed(s_cmd)[0])
             ot, st = statistics.median(o_runs), statistics.median(s_runs)
             print(f"\nvoxelize at {args.voxels}^3, {args.runs} runs each, alternating, whole processes\n")
-            print(f"| {os.path.basename(args.mesh)} --allow-open s | {os.path.basename(args.solid)} (solid) s | ratio |")
-            print("|---:|---:|---:|")
-            print(f"| {ot:.3f} | {st:.3f} | {ot / st:.2f} |")
+            header = ["N", f"{os.path.basename(args.mesh)} --allow-open s", f"{os.path.basename(args.solid)} (solid) s",
+                      "ratio"]
+            cells = [str(args.voxels), f"{ot:.3f}", f"{st:.3f}", f"{ot / st:.2f}"]
+            print("| " + " | ".join(header) + " |\n|" + "---:|" * 4 + "\n| " + " | ".join(cells) + " |")
+            write_csv(args.csv_dir, "voxelize.csv", header, [cells])
         differ = np.where(clear & ((labels == 1) != (w >= 0.5)))[0]
         for i in differ[:10]:
             # libigl's far field carries no error bound: such a point is worth a direct sum.
@@ -125,6 +148,7 @@ def main():
     p.add_argument("--runs", type=int, default=3)
     p.add_argument("--voxels", type=int)
     p.add_argument("--solid")
+    p.add_argument("--csv-dir", help="also write the tables as CSV into this folder (inclusion.csv, voxelize.csv)")
     a = p.parse_args()
     if a.voxels and not a.solid:
         p.error("--voxels needs --solid SOLID (a valid solid of about the same size)")

@@ -12,6 +12,9 @@ write), its phase times on stderr. Otherwise: for each points file, `texgeo incl
 gives median wall time and peak RSS (wait4) of each whole process, open3d's own build+query
 time (RaycastingScene + compute_occupancy, timed inside its process), and how many labels
 agree (open3d has no boundary class: texgeo's boundary points are left out).
+
+Both comparisons print a Markdown table; `--csv FILE` also writes it as CSV (what
+tools/results saves under docs/bench/).
 """
 
 import argparse
@@ -131,10 +134,33 @@ def compare_voxels(args):
             print(f"texgeo: {t_runs[-1][2].strip()}", file=sys.stderr)
             print(o_runs[-1][2].strip(), file=sys.stderr)
     print(f"\n{args.mesh}: texgeo {args.runs} runs (median), open3d {args.open3d_runs}; whole texgeo processes\n")
-    print("| N | texgeo s | open3d build+query s | ratio | texgeo peak MiB | binvox MiB | voxels that differ |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
-    for n, tt, inner, tm, out, differ in rows:
-        print(f"| {n} | {tt:.3f} | {inner:.2f} | {tt / inner:.4f} | {tm:.1f} | {out:.2f} | {differ} |")
+    header = ["N", "texgeo s", "open3d build+query s", "ratio", "texgeo peak MiB", "binvox MiB", "voxels that differ"]
+    cells = [[str(n), f"{tt:.3f}", f"{inner:.2f}", f"{tt / inner:.4f}", f"{tm:.1f}", f"{out:.2f}", differ]
+             for n, tt, inner, tm, out, differ in rows]
+    print_table(header, cells, "|---:" * len(header) + "|")
+    write_csv(args.csv, header, cells)
+
+
+def print_table(header, cells, rule):
+    print("| " + " | ".join(header) + " |")
+    print(rule)
+    for c in cells:
+        print("| " + " | ".join(c) + " |")
+
+
+def write_csv(path, header, cells):
+    """The table as CSV at `path` (written whole: a temporary file renamed), when one is given."""
+    if not path:
+        return
+    import csv
+
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(header)
+        w.writerows(cells)
+    os.replace(tmp, path)
+    print(f"wrote {path}", file=sys.stderr)
 
 
 def measured(cmd):
@@ -176,16 +202,14 @@ def compare(args):
             print(f"texgeo: {t_runs[-1][2].strip()}", file=sys.stderr)
             print(o_runs[-1][2].strip(), file=sys.stderr)
     print(f"\n{args.mesh}, {args.runs} runs each, alternating; whole processes\n")
-    print(
-        "| points file | points | texgeo s | open3d s | open3d build+query s | texgeo / open3d build+query "
-        "| texgeo peak MiB | open3d peak MiB | labels MiB | agree (off the boundary) |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
-    for p, n, tt, ot, inner, tm, om, out, agree, decided in rows:
-        print(
-            f"| {os.path.basename(p)} | {n} | {tt:.3f} | {ot:.3f} | {inner:.3f} | {tt / inner:.2f} "
-            f"| {tm:.0f} | {om:.0f} | {out:.1f} | {agree}/{decided} |"
-        )
+    header = ["points file", "points", "texgeo s", "open3d s", "open3d build+query s",
+              "texgeo / open3d build+query", "texgeo peak MiB", "open3d peak MiB", "labels MiB",
+              "agree (off the boundary)"]
+    cells = [[os.path.basename(p), str(n), f"{tt:.3f}", f"{ot:.3f}", f"{inner:.3f}", f"{tt / inner:.2f}",
+              f"{tm:.0f}", f"{om:.0f}", f"{out:.1f}", f"{agree} of {decided}"]
+             for p, n, tt, ot, inner, tm, om, out, agree, decided in rows]
+    print_table(header, cells, "|---|" + "---:|" * 8 + "---|")
+    write_csv(args.csv, header, cells)
 
 
 def main():
@@ -201,6 +225,7 @@ def main():
         p.add_argument("--open3d-runs", type=int, default=1, help="open3d runs per size (slow: one by default)")
         p.add_argument("--texgeo", help="texgeo binary (default target/release/texgeo)")
         p.add_argument("--texgeo-args", default="")
+        p.add_argument("--csv", help="also write the table as CSV to this file")
         compare_voxels(p.parse_args())
         return
     if len(sys.argv) > 1 and sys.argv[1] == "--open3d":
@@ -218,6 +243,7 @@ def main():
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--texgeo", help="texgeo binary (default target/release/texgeo)")
     p.add_argument("--texgeo-args", default="", help="global texgeo options, e.g. '--threads 1'")
+    p.add_argument("--csv", help="also write the table as CSV to this file")
     compare(p.parse_args())
 
 

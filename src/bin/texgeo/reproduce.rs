@@ -40,9 +40,11 @@ pub struct Args {
     /// claims whose verdict changed.
     #[arg(long, num_args = 2, value_names = ["OLD", "NEW"], conflicts_with_all = ["quick", "only", "out"])]
     compare: Option<Vec<PathBuf>>,
-    /// Rewrite the tables of a Markdown page (docs/results.md) from the saved report's CSV
-    /// files its marker comments name (`<!-- texgeo reproduce table: FILE; columns: … -->`
-    /// … `<!-- end of texgeo reproduce table -->`); the rest of the page is kept as it is.
+    /// Rewrite the tables of a Markdown page (docs/results.md) from the saved reports' CSV
+    /// files its marker comments name, relative to the page (`<!-- texgeo table: FILE;
+    /// columns: … -->` … `<!-- end of texgeo table -->`): a reproduction report's, a
+    /// `texgeo bench` suite's, a comparison tool's. The rest of the page is kept as it is;
+    /// a missing or damaged file is refused and the page left unchanged.
     #[arg(long, value_name = "PAGE", conflicts_with_all = ["quick", "only", "out", "compare"])]
     results_md: Option<PathBuf>,
 }
@@ -111,13 +113,13 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(page).map_err(|e| anyhow::anyhow!("{}: {e}", page.display()))?;
         let (new, tables) = reproduce::results_page(page, &text)?;
         if tables == 0 {
-            anyhow::bail!("{}: no \"<!-- texgeo reproduce table: FILE -->\" marker", page.display());
+            anyhow::bail!("{}: no \"{}FILE -->\" marker", page.display(), reproduce::TABLE_MARKER);
         }
         let what = if new == text { "unchanged" } else { "rewritten" };
         if new != text {
             reproduce::write_atomic(page, new.as_bytes())?;
         }
-        say!("{}: {tables} table(s) from the saved report, {what}", page.display());
+        say!("{}: {tables} table(s) from the saved reports, {what}", page.display());
         return Ok(());
     }
     let out = args.out.clone().ok_or_else(|| anyhow::anyhow!("-o DIR is required"))?;

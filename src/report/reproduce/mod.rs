@@ -36,7 +36,7 @@ pub use experiments::{EXPERIMENTS, Experiment, Figure};
 pub use facts::{Facts, NotRun, Stat};
 pub use figures::{FigureRecord, valence_model};
 pub use files::{check_writable, write_atomic};
-pub use page::regenerate as results_page;
+pub use page::{BEGIN as TABLE_MARKER, regenerate as results_page};
 
 use crate::gpu::Context;
 use crate::report::{Progress, Table};

@@ -1,24 +1,29 @@
-//! Tables of a saved report regenerated into a Markdown page (`texgeo reproduce
+//! Tables of saved reports regenerated into a Markdown page (`texgeo reproduce
 //! --results-md PAGE`), so that a results page shows what a run measured rather than
-//! numbers pasted by hand. The page marks each generated table with two comments:
+//! numbers pasted by hand. Any CSV file serves: a `texgeo reproduce` report's, a
+//! `texgeo bench` suite's, a comparison tool's. The page marks each generated table with
+//! two comments:
 //!
 //! ```text
-//! <!-- texgeo reproduce table: report/csv/claims.csv; columns: id, verdict -->
+//! <!-- texgeo table: report/csv/claims.csv; columns: id, verdict -->
 //! (the table, written by texgeo)
-//! <!-- end of texgeo reproduce table -->
+//! <!-- end of texgeo table -->
 //! ```
 //!
 //! The file is named relative to the page; `columns:` (optional) picks and orders the
 //! CSV's columns by name. Everything outside the markers is the page's own text and is
-//! kept byte for byte, so hand-written tables live beside the generated ones.
+//! kept byte for byte. A file that is missing, empty, without rows or with rows of
+//! another width than its header is refused, and the page is left as it was.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::{ReproduceError, Result};
 
-const BEGIN: &str = "<!-- texgeo reproduce table: ";
-const END: &str = "<!-- end of texgeo reproduce table -->";
+/// The comment that opens a generated table.
+pub const BEGIN: &str = "<!-- texgeo table: ";
+/// The comment that closes it.
+pub const END: &str = "<!-- end of texgeo table -->";
 
 /// `page` (the text of the file at `path`) with every marked table written anew from the
 /// CSV file its marker names; how many tables it holds.
@@ -57,7 +62,10 @@ fn numeric(cell: &str) -> bool {
 /// `columns` in that order (all when empty), and the link to the file.
 fn table(path: &Path, name: &str, columns: &[&str]) -> std::result::Result<String, String> {
     if !path.is_file() {
-        return Err(format!("{name}: missing (no saved report there; `texgeo reproduce -o DIR` makes one)"));
+        return Err(format!("{name}: missing (no saved report there; tools/results makes every one)"));
+    }
+    if std::fs::metadata(path).map_err(|e| format!("{name}: {e}"))?.len() == 0 {
+        return Err(format!("{name}: empty (a damaged report: no header, no rows)"));
     }
     let mut r = csv::Reader::from_path(path).map_err(|e| format!("{name}: {e}"))?;
     let header: Vec<String> =
@@ -79,6 +87,9 @@ fn table(path: &Path, name: &str, columns: &[&str]) -> std::result::Result<Strin
     for rec in r.records() {
         let rec = rec.map_err(|e| format!("{name}: {e}"))?;
         rows.push(picked.iter().map(|&i| rec.get(i).unwrap_or("").to_string()).collect::<Vec<_>>());
+    }
+    if rows.is_empty() {
+        return Err(format!("{name}: a header and no rows (a damaged or cut-short report)"));
     }
     let cell =
         |s: &str| if s.is_empty() { "–".to_string() } else { s.replace('|', "/").replace('\n', " ") };
@@ -115,23 +126,23 @@ mod tests {
         let (path, page) = page_in(
             &dir,
             "id,value (×),note\nA,2.5,x|y\nB,,\n",
-            "# Page\n\nHand-written | kept |\n\n<!-- texgeo reproduce table: r/t.csv; columns: value (×), id -->\nold\n\
-             stuff\n<!-- end of texgeo reproduce table -->\nafter\n",
+            "# Page\n\nHand-written | kept |\n\n<!-- texgeo table: r/t.csv; columns: value (×), id -->\nold\n\
+             stuff\n<!-- end of texgeo table -->\nafter\n",
         );
         let (new, n) = regenerate(&path, &page).unwrap();
         assert_eq!(n, 1);
         assert_eq!(
             new,
-            "# Page\n\nHand-written | kept |\n\n<!-- texgeo reproduce table: r/t.csv; columns: value (×), id -->\n\n\
+            "# Page\n\nHand-written | kept |\n\n<!-- texgeo table: r/t.csv; columns: value (×), id -->\n\n\
              | value (×) | id |\n|---:|---|\n| 2.5 | A |\n| – | B |\n\nFrom [r/t.csv](r/t.csv).\n\n\
-             <!-- end of texgeo reproduce table -->\nafter\n"
+             <!-- end of texgeo table -->\nafter\n"
         );
         // Regenerating the regenerated page changes nothing; a new number changes the page.
         assert_eq!(regenerate(&path, &new).unwrap().0, new);
         std::fs::write(dir.join("r/t.csv"), "id,value (×),note\nA,3.5,\nB,,\n").unwrap();
         assert!(regenerate(&path, &new).unwrap().0.contains("| 3.5 | A |"));
         // Every column, in the file's order, without a column list.
-        let all = "<!-- texgeo reproduce table: r/t.csv -->\n<!-- end of texgeo reproduce table -->\n";
+        let all = "<!-- texgeo table: r/t.csv -->\n<!-- end of texgeo table -->\n";
         assert!(regenerate(&path, all).unwrap().0.contains("| id | value (×) | note |\n|---|---:|---|\n"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
@@ -141,23 +152,32 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("texgeo-page-bad-{}", std::process::id()));
         let (path, _) = page_in(&dir, "id\nA\n", "");
         let e = |page: &str| regenerate(&path, page).unwrap_err().to_string();
-        let unclosed = "x\n<!-- texgeo reproduce table: r/t.csv -->\n| old |\n";
-        assert!(
-            e(unclosed)
-                .ends_with("page.md:2: no \"<!-- end of texgeo reproduce table -->\" after this marker")
-        );
-        let column = "<!-- texgeo reproduce table: r/t.csv; columns: nope -->\n<!-- end of texgeo reproduce table -->\n";
+        let unclosed = "x\n<!-- texgeo table: r/t.csv -->\n| old |\n";
+        assert!(e(unclosed).ends_with("page.md:2: no \"<!-- end of texgeo table -->\" after this marker"));
+        let column = "<!-- texgeo table: r/t.csv; columns: nope -->\n<!-- end of texgeo table -->\n";
         assert!(
             e(column).contains("page.md:1: r/t.csv has no column \"nope\" (it has: id)"),
             "{}",
             e(column)
         );
-        let missing = "<!-- texgeo reproduce table: r/none.csv -->\n<!-- end of texgeo reproduce table -->\n";
+        let missing = "<!-- texgeo table: r/none.csv -->\n<!-- end of texgeo table -->\n";
         assert!(
             e(missing).contains("page.md:1: r/none.csv: missing (no saved report there"),
             "{}",
             e(missing)
         );
+        // A damaged file: a row wider than the header, nothing at all, a header alone.
+        let marker = "<!-- texgeo table: r/t.csv -->\n<!-- end of texgeo table -->\n";
+        for (csv, why) in [
+            ("id\nA\nB,2\n", "found record with 2 fields, but the previous record has 1 fields"),
+            ("", "r/t.csv: empty (a damaged report"),
+            ("id,value\n", "r/t.csv: a header and no rows"),
+        ] {
+            std::fs::write(dir.join("r/t.csv"), csv).unwrap();
+            assert!(e(marker).contains(why), "{csv:?}: {}", e(marker));
+            assert!(e(marker).starts_with(&format!("{}:1: ", path.display())), "{}", e(marker));
+            assert_eq!(e(marker).lines().count(), 1, "{}", e(marker));
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
