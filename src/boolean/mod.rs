@@ -225,7 +225,7 @@ pub fn evaluate(
     timings.check = start.elapsed();
 
     // The operands' closure is checked above.
-    let inclusion = inclusion::Options { known_closed: true, ..options.inclusion.clone() };
+    let inclusion = inclusion::Options { known_closed: true, ..options.inclusion };
     let build = |mesh: &Mesh, name: &str| {
         Solver::new(options.method, mesh, &inclusion, ctx, None)
             .map_err(|source| BooleanError::Inclusion { name: name.to_string(), source })
