@@ -14,7 +14,7 @@ use super::picture::Picture;
 use super::scene::{Colours, Scene, SceneMesh, Shading};
 use crate::gpu::{
     Attachment, Blend, Buffer, Context, DepthTest, Load, Pipeline, PipelineDesc, Pod, Raster, Recorder,
-    Targets, TexFormat, Texture, Topology, shaders,
+    Shader, Targets, TexFormat, Texture, Topology, shaders,
 };
 use crate::mesh::triangulate::{newell_normal, polygon_or_fan};
 
@@ -149,29 +149,15 @@ impl Renderer {
     /// device must offer it).
     pub fn new(ctx: &Context, samples: u32) -> Result<Renderer> {
         let raster = |depth| Raster { depth, samples };
-        let mesh = Pipeline::with_raster(
-            ctx,
-            &PipelineDesc::new(
-                &shaders::render::MESH_VERT,
-                &shaders::render::MESH_FRAG,
-                Topology::Triangles,
-                &[TexFormat::Rgba8],
-                Blend::Replace,
-            ),
-            &raster(DepthTest::Less),
-        )?;
-        let lines = Pipeline::with_raster(
-            ctx,
-            &PipelineDesc::new(
-                &shaders::render::LINE_VERT,
-                &shaders::render::LINE_FRAG,
-                Topology::Triangles,
-                &[TexFormat::Rgba8],
-                Blend::Replace,
-            )
-            .per_instance(&[0, 1, 2, 3]),
-            &raster(DepthTest::LessOrEqual),
-        )?;
+        // Both draw triangles into one RGBA8 target.
+        let desc = |vertex: &'static Shader, fragment: &'static Shader| {
+            PipelineDesc::new(vertex, fragment, Topology::Triangles, &[TexFormat::Rgba8], Blend::Replace)
+        };
+        let (mesh_vs, mesh_fs) = (&shaders::render::MESH_VERT, &shaders::render::MESH_FRAG);
+        let mesh = Pipeline::with_raster(ctx, &desc(mesh_vs, mesh_fs), &raster(DepthTest::Less))?;
+        let (line_vs, line_fs) = (&shaders::render::LINE_VERT, &shaders::render::LINE_FRAG);
+        let line_desc = desc(line_vs, line_fs).per_instance(&[0, 1, 2, 3]);
+        let lines = Pipeline::with_raster(ctx, &line_desc, &raster(DepthTest::LessOrEqual))?;
         let block = Buffer::host(ctx, std::mem::size_of::<ViewBlock>() as u64, "render view")?;
         Ok(Renderer { ctx: ctx.clone(), samples, mesh, lines, block, frame: None, readback: None })
     }
