@@ -33,6 +33,7 @@ use crate::exact::orient3d;
 use crate::inclusion;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::intersect::{TriangleSoup, segment_meets_triangle};
+use crate::mesh::validate::half_edges_by_lower_vertex;
 
 /// Where a refined triangle lies relative to the other solid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -453,39 +454,20 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
     let n = refined.triangles.len();
     let mut sets = UnionFind::new(n);
     {
-        // The sides of every triangle bucketed by their lower point (a counting sort), each
-        // bucket ordered by (higher point, triangle): the triangles around an edge are
-        // adjacent, in increasing order.
-        let nv = r.points.len();
-        let sides = |t: usize| {
-            let [p, q, s] = refined.triangles[t];
-            [(p, q), (q, s), (s, p)].map(|(a, b)| (a.min(b), a.max(b)))
-        };
-        let mut start = vec![0usize; nv + 1];
-        for t in 0..n {
-            for (lo, _) in sides(t) {
-                start[lo as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![(0u32, 0u32); start[nv]];
-        for t in 0..n {
-            for (lo, hi) in sides(t) {
-                items[fill[lo as usize]] = (hi, t as u32);
-                fill[lo as usize] += 1;
-            }
-        }
-        drop(fill);
-        for lo in 0..nv {
-            let bucket = &mut items[start[lo]..start[lo + 1]];
-            bucket.sort_unstable();
-            for run in bucket.chunk_by(|x, y| x.0 == y.0) {
-                if run.len() > 1 && r.cut_edges.binary_search(&edge_key(lo as u32, run[0].0)).is_err() {
-                    let s = run[0].1;
-                    for &(_, t) in &run[1..] {
+        // The sides of every triangle bucketed by their lower point, each bucket ordered by
+        // (higher point, corner): the triangles around an edge are adjacent, in increasing
+        // order.
+        let offsets: Vec<usize> = (0..=n).map(|t| 3 * t).collect();
+        let (start, items) =
+            half_edges_by_lower_vertex(&offsets, refined.triangles.as_flattened(), r.points.len());
+        for lo in 0..r.points.len() {
+            for run in items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32) {
+                let hi = (run[0] >> 32) as u32;
+                if run.len() > 1 && r.cut_edges.binary_search(&edge_key(lo as u32, hi)).is_err() {
+                    let triangle = |item: u64| (item & 0xffff_ffff) as u32 / 3;
+                    let s = triangle(run[0]);
+                    for &item in &run[1..] {
+                        let t = triangle(item);
                         if on[s as usize] == on[t as usize] {
                             sets.union(s, t);
                         }

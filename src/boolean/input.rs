@@ -58,7 +58,7 @@ pub fn check(mesh: &Mesh, frame: Frame, allow_self_intersections: bool) -> Resul
 }
 
 /// [`check`], with the solid check's verdict on `mesh` when it is already known (a valid
-/// solid's, remembered from an earlier run: [`solidity::remembered`]); also returns the
+/// solid's, remembered from an earlier run: [`solidity::Memory`]); also returns the
 /// verdict, in the operand's units, so that a caller can remember it (none for the empty
 /// solid, which needs no check).
 pub fn check_known(

@@ -43,7 +43,7 @@ use crate::inclusion::{self, Choice, Method, solver::Solver};
 use crate::mesh::Mesh;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
-use crate::mesh::solidity::{self, Solidity};
+use crate::mesh::solidity::{Memory, Solidity};
 
 pub mod cgal;
 pub mod classify;
@@ -79,7 +79,7 @@ pub struct Options {
     pub overlap: bool,
     /// Take an operand's solid check from the user's cache when an earlier run found the
     /// same mesh a valid solid, and remember the verdicts found here
-    /// ([`crate::mesh::solidity::remembered`], as every command does); benchmarks that
+    /// ([`crate::mesh::solidity::Memory`], as every command does); benchmarks that
     /// time the checks turn this off.
     pub remember_verdicts: bool,
 }
@@ -202,17 +202,17 @@ pub fn evaluate(
 ) -> Result<Evaluation> {
     let mut timings = Timings::default();
     let start = Instant::now();
-    let remembered = |m: &Mesh| if options.remember_verdicts { solidity::remembered(m) } else { None };
-    let known = [remembered(a), remembered(b)];
+    let memory = options.remember_verdicts.then(|| [Memory::of(a), Memory::of(b)]);
+    let known = memory.as_ref().map_or([None, None], |m| m.each_ref().map(Memory::recall));
     let fresh = known.each_ref().map(Option::is_none);
     let frame = Frame::of(&[a, b]);
     let (framed_a, framed_b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
     let [(sa, va), (sb, vb)] =
         check_operands(&framed_a, &framed_b, names, frame, options.allow_self_intersections, known)?;
-    if options.remember_verdicts {
-        for (mesh, fresh, verdict) in [(a, fresh[0], va), (b, fresh[1], vb)] {
+    if let Some(memory) = &memory {
+        for (memory, fresh, verdict) in [(&memory[0], fresh[0], va), (&memory[1], fresh[1], vb)] {
             if let (true, Some(v)) = (fresh, verdict) {
-                solidity::remember(mesh, &v);
+                memory.remember(&v);
             }
         }
     }

@@ -451,45 +451,43 @@ pub struct NotSolid {
 /// is let through without repeating [`check`]. Only valid solids are remembered, so a
 /// mesh is refused, with the same reason, exactly when [`check`] refuses it.
 pub fn require_solid(mesh: Mesh, policy: Policy) -> Result<Accepted, NotSolid> {
-    let store = crate::cache::Store::open(CACHE_KIND);
-    let key = store.as_ref().map(|_| verdict_key(&mesh));
-    if let Some(solidity) = recall(store.as_ref(), key.as_ref()) {
+    let memory = Memory::of(&mesh);
+    if let Some(solidity) = memory.recall() {
         let frame = Frame::of(&[&mesh]);
         return Ok(Accepted { mesh: frame.mesh_in(mesh), frame, solidity, flipped: false, non_solid: None });
     }
     let accepted = require_solid_uncached(mesh, policy)?;
     if !accepted.flipped {
-        store_verdict(store.as_ref(), key.as_ref(), &accepted.solidity);
+        memory.remember(&accepted.solidity);
     }
     Ok(accepted)
 }
 
-/// The verdict of an earlier [`check`] that found `mesh` (exactly these positions and
-/// faces) a valid solid, from the user's cache; `None` when there is none (or caching is
-/// off). The same memory [`require_solid`] keeps, for callers that check in their own frame
-/// (the Booleans' operands).
-pub fn remembered(mesh: &Mesh) -> Option<Solidity> {
-    let store = crate::cache::Store::open(CACHE_KIND);
-    let key = store.as_ref().map(|_| verdict_key(mesh));
-    recall(store.as_ref(), key.as_ref())
+/// The user's cache entry for one mesh's verdict (exactly these positions and faces): the
+/// memory [`require_solid`] keeps, for callers that check in their own frame (the
+/// Booleans' operands). Empty when caching is off.
+pub struct Memory {
+    entry: Option<(crate::cache::Store, crate::cache::Key)>,
 }
 
-/// Remembers `solidity`, the result of [`check`] on `mesh` in the mesh's units, if it says
-/// that `mesh` is a valid solid (only valid solids are remembered).
-pub fn remember(mesh: &Mesh, solidity: &Solidity) {
-    let store = crate::cache::Store::open(CACHE_KIND);
-    let key = store.as_ref().map(|_| verdict_key(mesh));
-    store_verdict(store.as_ref(), key.as_ref(), solidity);
-}
+impl Memory {
+    pub fn of(mesh: &Mesh) -> Memory {
+        Memory { entry: crate::cache::Store::open(CACHE_KIND).map(|store| (store, verdict_key(mesh))) }
+    }
 
-fn recall(store: Option<&crate::cache::Store>, key: Option<&crate::cache::Key>) -> Option<Solidity> {
-    store?.get(key?).and_then(|b| decode_solid(&b))
-}
+    /// The verdict of an earlier [`check`] that found the mesh a valid solid, if any.
+    pub fn recall(&self) -> Option<Solidity> {
+        let (store, key) = self.entry.as_ref()?;
+        store.get(key).and_then(|b| decode_solid(&b))
+    }
 
-fn store_verdict(store: Option<&crate::cache::Store>, key: Option<&crate::cache::Key>, solidity: &Solidity) {
-    if let (Some(store), Some(key)) = (store, key) {
-        if solidity.is_solid() {
-            store.put(key, &encode_solid(solidity));
+    /// Remembers `solidity`, the result of [`check`] on the mesh in its units, if it says
+    /// the mesh is a valid solid (only valid solids are remembered).
+    pub fn remember(&self, solidity: &Solidity) {
+        if let Some((store, key)) = &self.entry {
+            if solidity.is_solid() {
+                store.put(key, &encode_solid(solidity));
+            }
         }
     }
 }

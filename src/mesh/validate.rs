@@ -113,27 +113,22 @@ pub(crate) fn half_edges_by_lower_vertex(
 /// ([`Report::is_closed`] when both are 0), without the rest of the report: the closure
 /// test of a Boolean result.
 pub fn edge_defects(triangles: &[[u32; 3]]) -> (usize, usize) {
-    use rayon::prelude::*;
-    // (lower vertex, higher vertex) as one key, and whether the side runs lower → higher.
-    let mut sides: Vec<(u64, bool)> = triangles
-        .par_iter()
-        .with_min_len(4096)
-        .flat_map_iter(|t| {
-            (0..3).filter_map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                (a != b).then(|| ((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), a < b))
-            })
-        })
-        .collect();
-    sides.par_sort_unstable();
+    let indices = triangles.as_flattened();
+    let nv = indices.iter().max().map_or(0, |&v| v as usize + 1);
+    let offsets: Vec<usize> = (0..=triangles.len()).map(|t| 3 * t).collect();
+    let (start, items) = half_edges_by_lower_vertex(&offsets, indices, nv);
     let (mut boundary, mut misoriented) = (0, 0);
-    for run in sides.chunk_by(|x, y| x.0 == y.0) {
-        let forward = run.iter().filter(|s| s.1).count();
-        if run.len() == 1 {
-            boundary += 1;
-        }
-        if run.len() >= 2 && 2 * forward != run.len() {
-            misoriented += 1;
+    for lo in 0..nv {
+        for run in items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32) {
+            // Sides leaving the lower point (lo → hi) and the others, as `report` counts.
+            let forward =
+                run.iter().filter(|&&item| indices[(item & 0xffff_ffff) as usize] as usize == lo).count();
+            if run.len() == 1 {
+                boundary += 1;
+            }
+            if run.len() >= 2 && 2 * forward != run.len() {
+                misoriented += 1;
+            }
         }
     }
     (boundary, misoriented)
