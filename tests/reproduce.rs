@@ -613,6 +613,23 @@ fn copy_tree(from: &Path, to: &Path) {
 }
 
 #[test]
+fn the_saved_device_comparison_is_the_two_saved_reports_compared() {
+    // docs/gpu/compare.md is what `texgeo reproduce --compare` prints for the lavapipe and
+    // the NVIDIA H200 reports saved beside it (their csv/ and run.json only, no report.md):
+    // byte for byte, and with no damage (status 0). Cargo runs tests from the package root,
+    // so the relative paths in its header are the ones the command was given.
+    let gpu = Path::new("docs/gpu");
+    let committed = std::fs::read_to_string(gpu.join("compare.md")).unwrap();
+    let (old, new) = ("docs/gpu/lavapipe/report", "docs/gpu/nvidia-h200/report");
+    let o = texgeo(&["reproduce", "--compare", old, new], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stdout) == committed,
+        "docs/gpu/compare.md differs: run `texgeo reproduce --compare {old} {new} > docs/gpu/compare.md`"
+    );
+}
+
+#[test]
 fn the_results_page_is_the_saved_reports_regenerated() {
     // docs/results.md's marked tables, written anew from the reports saved under
     // docs/report/ (the reproduction run) and docs/bench/ (the benchmark suites and the
@@ -623,6 +640,7 @@ fn the_results_page_is_the_saved_reports_regenerated() {
     let dir = temp("page");
     copy_tree(&docs.join("report"), &dir.join("report"));
     copy_tree(&docs.join("bench"), &dir.join("bench"));
+    copy_tree(&docs.join("gpu"), &dir.join("gpu"));
     let page = dir.join("results.md");
     // A page whose tables were emptied is filled again with exactly the committed ones.
     let text = String::from_utf8(committed.clone()).unwrap();

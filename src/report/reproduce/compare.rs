@@ -5,8 +5,10 @@
 //! the noise is what the runs themselves showed, not a constant. Counts and sizes (a
 //! single exact value) moved when they differ at all. Claims whose verdict changed are
 //! listed too, and so is everything that keeps the two reports from being compared whole:
-//! a missing or unreadable file (`run.json`, `csv/measurements.csv`, `csv/claims.csv`,
-//! `report.md`), measurements and claims found in one report only. A report with a
+//! a missing or unreadable file (`run.json`, `csv/measurements.csv`, `csv/claims.csv`),
+//! measurements and claims found in one report only. Those three files are all a comparison
+//! reads, so a saved report (its `csv/` and `run.json`, as `docs/report/` keeps) compares
+//! whole without its `report.md`, plots and figures. A report with a
 //! missing or unreadable file is damaged ([`Comparison::damage`]): the command prints the
 //! comparison and exits with status 2.
 
@@ -362,7 +364,7 @@ fn read_measurements_of_both(old: &Path, new: &Path, damage: &mut Vec<String>) -
             Ok(None) => damage.push(format!("{}: missing", dir.join("csv/measurements.csv").display())),
             Err(e) => damage.push(e.to_string()),
         }
-        for file in ["report.md", "csv/claims.csv", "run.json"] {
+        for file in ["csv/claims.csv", "run.json"] {
             if !dir.join(file).is_file() {
                 damage.push(format!("{}: missing", dir.join(file).display()));
             }
