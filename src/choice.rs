@@ -3,7 +3,8 @@
 //!
 //! Each method enum derives `clap::ValueEnum`, whose names are the only spelling of its
 //! methods: [`Choice`] parses and prints through them, and [`by_name`] / [`by_name_or_none`]
-//! (de)serialize a method or an optional one (`none`) through them in a task's options.
+//! / [`choice_or_none`] (de)serialize a method, an optional one or an optional choice
+//! (`none`) through them in a task's options.
 
 use std::fmt;
 use std::str::FromStr;
@@ -112,18 +113,40 @@ pub mod by_name_or_none {
     use super::*;
 
     pub fn serialize<M: ValueEnum, S: Serializer>(m: &Option<M>, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&m.as_ref().map_or_else(|| "none".to_string(), name))
+        s.serialize_str(&m.as_ref().map_or_else(|| NONE.to_string(), name))
     }
 
     pub fn deserialize<'de, M: ValueEnum, D: Deserializer<'de>>(d: D) -> Result<Option<M>, D::Error> {
-        let s = String::deserialize(d)?;
-        if s == "none" {
-            return Ok(None);
-        }
-        parse(&s)
-            .map(Some)
-            .ok_or_else(|| serde::de::Error::custom(format!("no method '{s}' ({}, none)", names::<M>())))
+        none_or(d, |s| parse(s).ok_or_else(|| format!("no method '{s}' ({}, none)", names::<M>())))
     }
+}
+
+/// `#[serde(with = "crate::choice::choice_or_none")]`: `auto`, a method by its name, or `none`.
+pub mod choice_or_none {
+    use super::*;
+
+    pub fn serialize<M: ValueEnum, S: Serializer>(c: &Option<Choice<M>>, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&c.as_ref().map_or_else(|| NONE.to_string(), Choice::to_string))
+    }
+
+    pub fn deserialize<'de, M: ValueEnum, D: Deserializer<'de>>(d: D) -> Result<Option<Choice<M>>, D::Error> {
+        none_or(d, |s| s.parse().map_err(|_| format!("no method '{s}' (auto, {}, none)", names::<M>())))
+    }
+}
+
+/// How a task's options spell "no method" (no reference, no comparison).
+const NONE: &str = "none";
+
+/// `None` for [`NONE`], else what `parse` makes of the string.
+fn none_or<'de, T, D: Deserializer<'de>>(
+    d: D,
+    parse: impl FnOnce(&str) -> Result<T, String>,
+) -> Result<Option<T>, D::Error> {
+    let s = String::deserialize(d)?;
+    if s == NONE {
+        return Ok(None);
+    }
+    parse(&s).map(Some).map_err(serde::de::Error::custom)
 }
 
 #[cfg(test)]
@@ -144,6 +167,12 @@ mod tests {
         reference: Option<Way>,
     }
 
+    #[derive(Debug, PartialEq, Serialize, Deserialize)]
+    struct Compared {
+        #[serde(with = "choice_or_none")]
+        reference: Option<Choice<Way>>,
+    }
+
     #[test]
     fn names_come_from_the_value_enum() {
         assert_eq!("auto".parse::<Choice<Way>>(), Ok(Choice::Auto));
@@ -162,5 +191,19 @@ mod tests {
         assert_eq!(serde_json::from_str::<Task>(&text).unwrap(), t);
         let e = serde_json::from_str::<Task>(r#"{"method":"x","reference":"none"}"#).unwrap_err();
         assert!(e.to_string().starts_with("no method 'x' (auto, slow, cpu+gpu)"), "{e}");
+    }
+
+    #[test]
+    fn a_choice_or_none_round_trips_each_spelling() {
+        for (text, reference) in
+            [("auto", Some(Choice::Auto)), ("cpu+gpu", Some(Choice::Fixed(Way::Both))), ("none", None)]
+        {
+            let json = format!(r#"{{"reference":"{text}"}}"#);
+            let c: Compared = serde_json::from_str(&json).unwrap();
+            assert_eq!(c, Compared { reference });
+            assert_eq!(serde_json::to_string(&c).unwrap(), json);
+        }
+        let e = serde_json::from_str::<Compared>(r#"{"reference":"x"}"#).unwrap_err();
+        assert!(e.to_string().starts_with("no method 'x' (auto, slow, cpu+gpu, none)"), "{e}");
     }
 }

@@ -19,7 +19,7 @@ use texgeo::mesh::spec::Placed;
 use texgeo::mesh::stats::Stats;
 use texgeo::mesh::{Mesh, formats, procedural, triangulate};
 use texgeo::subdiv::tags::{self, TaggedOptions};
-use texgeo::subdiv::{Boundary, Features, Surface};
+use texgeo::subdiv::{Boundary, Features, Method, Surface};
 use texgeo::voxel::{Choice, Grid, Volume, npy};
 
 create_exception!(_texgeo, Error, PyException, "Every error texgeo raises: the CLI's one-line message.");
@@ -279,12 +279,10 @@ impl RawMesh {
         crease_angle: Option<f64>,
         crease_sharpness: f32,
     ) -> PyResult<RawMesh> {
-        let gpu = match method {
-            "gpu" => true,
-            "cpu" => false,
-            m => {
-                return Err(SubdivisionError::new_err(format!("unknown method '{m}' (expected gpu or cpu)")));
-            }
+        let Some(method) = texgeo::choice::parse::<Method>(method) else {
+            return Err(SubdivisionError::new_err(format!(
+                "unknown method '{method}' (expected gpu or cpu)"
+            )));
         };
         let mut surface = Surface {
             mesh: self.mesh.clone(),
@@ -314,15 +312,18 @@ impl RawMesh {
             surface.features.creases.extend(features.creases);
         }
         let mesh = work(py, || -> PyResult<Mesh> {
-            if gpu {
-                let ctx = context().map_err(err(Kind::Plain))?;
-                let run = texgeo::subdiv::gpu::refine_surface(&ctx, &surface, level)
-                    .map_err(err(Kind::Subdivision))?;
-                Ok(run.mesh)
-            } else {
-                let refined =
-                    texgeo::subdiv::cpu::refine_surface(&surface, level).map_err(err(Kind::Subdivision))?;
-                Ok(refined.mesh)
+            match method {
+                Method::Gpu => {
+                    let ctx = context().map_err(err(Kind::Plain))?;
+                    let run = texgeo::subdiv::gpu::refine_surface(&ctx, &surface, level)
+                        .map_err(err(Kind::Subdivision))?;
+                    Ok(run.mesh)
+                }
+                Method::Cpu => {
+                    let refined = texgeo::subdiv::cpu::refine_surface(&surface, level)
+                        .map_err(err(Kind::Subdivision))?;
+                    Ok(refined.mesh)
+                }
             }
         })?;
         Ok(RawMesh::plain(mesh))

@@ -20,3 +20,14 @@ pub mod topology;
 
 pub use error::{Result, SubdivError};
 pub use features::{Boundary, CreaseMethod, Features, Options, Surface, Triangles};
+
+/// How a mesh is refined (`texgeo subdivide --method`, a sweep's `subdivide` task, Python's
+/// `Mesh.subdivide`), named by its clap name ([`crate::choice`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Method {
+    /// Base level on the CPU, then one fragment pass per level on the GPU.
+    #[default]
+    Gpu,
+    /// The f64 CPU reference (same vertex order as OpenSubdiv).
+    Cpu,
+}

@@ -10,15 +10,9 @@ use texgeo::host::{Mib, count_text};
 use texgeo::mesh::{Mesh, formats};
 use texgeo::subdiv::compare::Comparison;
 use texgeo::subdiv::gpu::{Options, Run, Subdivider};
-use texgeo::subdiv::{Boundary, CreaseMethod, Features, SubdivError, Surface, Triangles, cpu, crease, osd};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Base level on the CPU, then one fragment pass per level on the GPU.
-    Gpu,
-    /// The f64 CPU reference (same vertex order as OpenSubdiv).
-    Cpu,
-}
+use texgeo::subdiv::{
+    Boundary, CreaseMethod, Features, Method, SubdivError, Surface, Triangles, cpu, crease, osd,
+};
 
 /// Boundary interpolation (OpenSubdiv's VtxBoundaryInterpolation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -306,7 +300,7 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             "vertices": mesh.num_vertices(),
             "faces": mesh.num_faces(),
             "level": args.level,
-            "method": if args.method == Method::Gpu { "gpu" } else { "cpu" },
+            "method": texgeo::choice::name(&args.method),
             "features": {
                 "creases": f.creases.len(),
                 "infinite_creases": f.creases.iter().filter(|c| crease::is_infinite(c.sharpness)).count(),

@@ -7,6 +7,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use crate::gpu::Context;
+use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, formats, procedural};
 use crate::report::{Environment, Log, Progress, Report, Samples, Table, interleave};
 use crate::subdiv::compare::Comparison;
@@ -450,13 +451,9 @@ pub struct CreaseSettings {
 pub fn crease_models(models_dir: &Path) -> Result<Vec<Model>> {
     let mut models = Vec::new();
     for &name in CREASE_MODELS {
-        if let Some(builtin) = name.strip_prefix("builtin:") {
-            if let Some(mesh) = procedural::by_name(builtin) {
-                models.push(Model { name: name.to_string(), mesh });
-            }
-        } else if models_dir.join(name).is_file() {
-            let path = models_dir.join(name);
-            models.push(Model { name: path.display().to_string(), mesh: formats::read(&path)? });
+        let spec = MeshSpec::parse(name).in_folder(models_dir);
+        if spec.file().is_none_or(Path::is_file) {
+            models.push(Model { name: spec.to_string(), mesh: spec.load()? });
         }
     }
     Ok(models)

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::boolean::{self, BooleanError, InputError, Names, Operation, Transform, cgal};
 use crate::inclusion::Choice;
 use crate::mesh::covering::measures;
-use crate::mesh::spec::Placed;
+use crate::mesh::spec::{MeshSpec, Placed};
 use crate::mesh::{Mesh, procedural};
 use crate::report::bench::boolean::turned_copy;
 use crate::sweep::record::{Record, mesh_hash};
@@ -65,7 +65,7 @@ impl Options {
         if let Some(steps) = self.with.strip_prefix("transform:") {
             return Transform::parse(steps)?.apply(mesh).map_err(|e| e.to_string());
         }
-        if self.with.starts_with("builtin:") {
+        if MeshSpec::parse(&self.with).builtin().is_some() {
             return Placed::parse(&self.with)?.load().map_err(|e| e.to_string());
         }
         Err(format!(

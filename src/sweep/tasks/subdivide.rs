@@ -5,20 +5,23 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::choice::{self, Choice};
 use crate::subdiv::compare::Comparison;
 use crate::subdiv::gpu::{Options as GpuOptions, Subdivider};
-use crate::subdiv::{SubdivError, cpu, osd};
+use crate::subdiv::{Method, SubdivError, cpu, osd};
 use crate::sweep::record::{Record, mesh_hash as hash};
 use crate::sweep::task::{Failure, Input, Task, relative};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Options {
-    /// `gpu` (fragment meshes) or `cpu` (the f64 reference).
-    pub method: String,
+    /// `gpu` (fragment meshes) or `cpu` (the f64 reference), as `texgeo subdivide --method`.
+    #[serde(with = "crate::choice::by_name")]
+    pub method: Method,
     pub level: u32,
     /// `auto` (the CPU reference for `gpu`, OpenSubdiv for `cpu`), `cpu`, `osd` or `none`.
-    pub reference: String,
+    #[serde(with = "crate::choice::choice_or_none")]
+    pub reference: Option<Choice<Reference>>,
     /// Largest position error accepted, × the reference's bounding-box diagonal
     /// (default: 1e-5 for `gpu`, 1e-12 for `cpu`, as `texgeo subdivide --validate`).
     pub tolerance: Option<f64>,
@@ -26,29 +29,31 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Options {
-        Options { method: "gpu".into(), level: 2, reference: "auto".into(), tolerance: None }
+        Options { method: Method::Gpu, level: 2, reference: Some(Choice::Auto), tolerance: None }
     }
+}
+
+/// What a refinement is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Reference {
+    /// The f64 CPU reference.
+    Cpu,
+    /// OpenSubdiv (its helper, built by `tools/setup`).
+    Osd,
 }
 
 /// The highest level a sweep asks for (each level multiplies the faces by four).
 const MAX_LEVEL: u32 = 8;
 
 impl Options {
-    fn gpu(&self) -> Result<bool, String> {
-        match self.method.as_str() {
-            "gpu" => Ok(true),
-            "cpu" => Ok(false),
-            m => Err(format!("unknown subdivision method '{m}' (expected gpu or cpu)")),
-        }
-    }
-
-    fn reference(&self) -> Result<&str, String> {
-        match (self.reference.as_str(), self.gpu()?) {
-            ("auto", true) => Ok("cpu"),
-            ("auto", false) => Ok("osd"),
-            (r @ ("cpu" | "osd" | "none"), _) => Ok(r),
-            (r, _) => Err(format!("unknown reference '{r}' (expected auto, cpu, osd or none)")),
-        }
+    /// The reference `auto` stands for: the CPU one for `gpu`, OpenSubdiv for `cpu`.
+    fn reference(&self) -> Option<Reference> {
+        self.reference.map(|r| {
+            r.fixed().unwrap_or(match self.method {
+                Method::Gpu => Reference::Cpu,
+                Method::Cpu => Reference::Osd,
+            })
+        })
     }
 }
 
@@ -63,7 +68,6 @@ impl Task for Subdivide {
     type Options = Options;
 
     fn validate(o: &Options) -> Result<(), String> {
-        o.reference()?;
         if o.level > MAX_LEVEL {
             return Err(format!("level {} is above {MAX_LEVEL}", o.level));
         }
@@ -74,12 +78,12 @@ impl Task for Subdivide {
     }
 
     fn needs_device(o: &Options) -> bool {
-        o.gpu().unwrap_or(false)
+        o.method == Method::Gpu
     }
 
     fn run(&mut self, input: Input, o: &Options, out: &mut Record) -> Result<(), Failure> {
         let Input { ctx, mesh, .. } = input;
-        let gpu = o.gpu().map_err(|e| Failure::failed("options", e))?;
+        let gpu = o.method == Method::Gpu;
         out.size("level", o.level);
         let refined = if gpu {
             let ctx = ctx.ok_or_else(|| Failure::failed("device", "the GPU method needs a Vulkan device"))?;
@@ -116,14 +120,13 @@ impl Task for Subdivide {
         out.size("out_faces", refined.num_faces());
         out.hash("mesh", &hash(&refined));
 
-        let reference = o.reference().map_err(|e| Failure::failed("options", e))?;
-        if reference == "none" {
+        let Some(reference) = o.reference() else {
             return Ok(());
-        }
+        };
         let t = Instant::now();
         let expected = match reference {
-            "cpu" => cpu::refine(mesh, o.level),
-            _ => osd::refine(mesh, o.level),
+            Reference::Cpu => cpu::refine(mesh, o.level),
+            Reference::Osd => osd::refine(mesh, o.level),
         }
         .map_err(|e| match e {
             SubdivError::HelperMissing { .. } | SubdivError::Helper { .. } | SubdivError::Io { .. } => {
@@ -140,9 +143,13 @@ impl Task for Subdivide {
         if !c.is_match() {
             return Err(Failure::failed(
                 "check",
-                format!("differs from the {reference} reference beyond {tolerance:e} × diagonal: {}", c)
-                    .trim_end()
-                    .replace('\n', ";"),
+                format!(
+                    "differs from the {} reference beyond {tolerance:e} × diagonal: {}",
+                    choice::name(&reference),
+                    c
+                )
+                .trim_end()
+                .replace('\n', ";"),
             ));
         }
         Ok(())
@@ -163,4 +170,26 @@ fn refusal(e: SubdivError) -> Failure {
         }
     };
     Failure::refused(reason, e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_keep_their_spelling_and_auto_picks_the_reference_by_method() {
+        let o = Options::default();
+        let text = serde_json::to_string(&o).unwrap();
+        assert_eq!(text, r#"{"method":"gpu","level":2,"reference":"auto","tolerance":null}"#);
+        assert_eq!(serde_json::from_str::<Options>(&text).unwrap(), o);
+        assert_eq!(o.reference(), Some(Reference::Cpu));
+        let cpu: Options = serde_json::from_str(r#"{"method":"cpu"}"#).unwrap();
+        assert_eq!(cpu.reference(), Some(Reference::Osd));
+        let fixed: Options = serde_json::from_str(r#"{"method":"cpu","reference":"cpu"}"#).unwrap();
+        assert_eq!(fixed.reference(), Some(Reference::Cpu));
+        let none: Options = serde_json::from_str(r#"{"reference":"none"}"#).unwrap();
+        assert_eq!(none.reference(), None);
+        assert!(serde_json::from_str::<Options>(r#"{"reference":"gpu"}"#).is_err());
+        assert!(serde_json::from_str::<Options>(r#"{"method":"osd"}"#).is_err());
+    }
 }

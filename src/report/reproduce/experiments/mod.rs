@@ -14,7 +14,8 @@ use super::doc::Block;
 use super::facts::{Facts, Stat};
 use super::figures;
 use super::{Result, Run};
-use crate::mesh::{Mesh, formats, procedural};
+use crate::mesh::spec::MeshSpec;
+use crate::mesh::{Mesh, procedural};
 use crate::report::Table;
 use crate::report::plot::Series;
 
@@ -144,21 +145,14 @@ pub fn quick_models() -> Vec<Model> {
 pub fn stand_ins(dir: &Path, list: &[(&'static str, &'static str)]) -> Result<(Vec<Model>, Vec<String>)> {
     let mut models = Vec::new();
     let mut notes = Vec::new();
-    for &(thesis, spec) in list {
-        if let Some(name) = spec.strip_prefix("builtin:") {
-            if let Some(mesh) = procedural::by_name(name) {
-                models.push(Model { thesis, name: spec.to_string(), mesh });
-            }
-            continue;
-        }
-        let path = dir.join(spec);
-        if path.is_file() {
-            models.push(Model { thesis, name: spec.to_string(), mesh: formats::read(&path)? });
-        } else {
-            notes.push(format!(
+    for &(thesis, name) in list {
+        let spec = MeshSpec::parse(name).in_folder(dir);
+        match spec.file() {
+            Some(path) if !path.is_file() => notes.push(format!(
                 "{} not found (run tools/fetch-models): no stand-in for {thesis}",
                 path.display()
-            ));
+            )),
+            _ => models.push(Model { thesis, name: name.to_string(), mesh: spec.load()? }),
         }
     }
     Ok((models, notes))

@@ -2,6 +2,7 @@
 //! subdivide`'s measuring code, plus a level sweep: where the GPU starts to win.
 
 use super::{Quantity, both, comparison, curve, details, ratio_curve};
+use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, formats, procedural};
 use crate::report::bench::subdiv::{self, LevelTimes, Measured, Model, Settings, default_models};
 use crate::report::plot::{Chart, Series};
@@ -59,9 +60,7 @@ fn models(r: &Run) -> Result<Vec<Model>> {
         default_models(r.models_dir)?
     };
     for m in &mut models {
-        if let Some(file) =
-            std::path::Path::new(&m.name).file_name().filter(|_| !m.name.starts_with("builtin:"))
-        {
+        if let Some(file) = MeshSpec::parse(&m.name).file().and_then(std::path::Path::file_name) {
             m.name = file.to_string_lossy().into_owned();
         }
     }
