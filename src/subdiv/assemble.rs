@@ -29,7 +29,7 @@ use glam::DVec3;
 use crate::mesh::Mesh;
 
 use super::cpu;
-use super::fragment::{Built, Class, FragmentMesh, sharp_edges};
+use super::fragment::{Built, Class, FragmentMesh, StreamLayout, sharp_edges};
 use super::topology::Topology;
 use super::{Result, SubdivError, Surface};
 
@@ -42,120 +42,121 @@ pub fn assemble<T: Sync>(
     levels: u32,
     position: impl Fn(&T) -> DVec3 + Sync,
 ) -> Result<Mesh> {
-    let owned = 1u64 << levels;
     let layout = fragments.layout(levels, levels, 1);
-    let radius = layout.radius;
-    if owned > u64::from(radius) || (stream.len() as u64) < layout.total {
-        return Err(SubdivError::Fragment(format!(
-            "a stream of {} entries at ring radius {radius} cannot hold {owned} owned rings ({} entries needed)",
-            stream.len(),
-            layout.total
-        )));
-    }
-    let topo = fragments.coarse();
-    let g = 2 * owned;
-    let (nv, ne, nf) = (topo.num_vertices() as u64, topo.num_edges() as u64, topo.num_faces() as u64);
-    let vertices = nv + ne * (g - 1) + nf * (g - 1) * (g - 1);
-    let quads = nf * g * g;
-    if vertices >= u64::from(u32::MAX) || 4 * quads >= u64::from(u32::MAX) {
-        return Err(SubdivError::TooLarge { level: fragments.cpu_levels() + levels, vertices });
-    }
-    let grid = Grid { topo, g: g as u32, nv: nv as u32, face0: (nv + ne * (g - 1)) as u32 };
-    let n = owned as u32;
+    let grid = Grid::for_stream(fragments, &layout, stream.len(), levels)?;
+    // Faces: a G × G grid of quads per coarse face not under a hole, in face order.
+    let kept: Vec<u32> = (0..grid.topo.num_faces() as u32).filter(|&f| !fragments.is_hole(f)).collect();
+    let indices = grid.face_indices(&kept, levels);
+    let owners = Owners { fragments, layout: &layout, stream, position, n: grid.g / 2 };
+    let positions = grid.positions(&owners);
+    let offsets = quad_offsets(indices.len() / 4);
+    Ok(Mesh::from_parts(positions, offsets, indices)?)
+}
 
-    // Faces: a G × G grid of quads per coarse face not under a hole, in face order, each
-    // grid in OpenSubdiv's quadtree order.
-    let kept: Vec<u32> = (0..nf as u32).filter(|&f| !fragments.is_hole(f)).collect();
-    let order = quadtree_order(levels + 1);
-    let mut indices = vec![0u32; 4 * kept.len() * (g * g) as usize];
-    let per_face = (4 * g * g) as usize;
-    for_each_block(&mut indices, per_face, |first, block| {
-        let mut ids = Vec::new();
-        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
-            grid.face_ids(kept[first + k], &mut ids);
-            let row = grid.g as usize + 1;
-            for (q, &(i, j)) in order.iter().enumerate() {
-                let c = j as usize * row + i as usize;
-                out[4 * q..4 * q + 4].copy_from_slice(&[ids[c], ids[c + 1], ids[c + 1 + row], ids[c + row]]);
-            }
-        }
-    });
-
-    // Positions, gathered from the owning fragment.
-    let mut positions = vec![DVec3::ZERO; vertices as usize];
-    let (vertex_part, rest) = positions.split_at_mut(nv as usize);
-    let (edge_part, face_part) = rest.split_at_mut((ne * (g - 1)) as usize);
-    // Where the owned region of sector s of fragment f starts, and its class.
-    let sector = |(f, s): (u32, u32)| {
-        let class = fragments.fragments()[f as usize].class;
-        (fragments.fragment_start(&layout, f), class, s)
-    };
-    let at = |(start, class, s): (u64, Class, u32), a: u32, b: u32| {
-        position(&stream[(start + class.index(s, a.into(), b.into())) as usize])
-    };
-    for (v, out) in vertex_part.iter_mut().enumerate() {
-        *out = match fragments.fragment_of(v as u32) {
-            Some(f) => at(sector((f, 0)), 0, 0),
-            // A vertex no face uses stays where it is.
-            None => fragments.isolated_position(v as u32),
-        };
-    }
-    let per_edge = (g - 1) as usize;
-    for_each_block(edge_part, per_edge, |first, block| {
-        for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
-            let e = (first + k) as u32;
-            let (first_half, second_half) = out.split_at_mut(n as usize);
-            let s0 = sector(fragments.spoke_along(e, 0));
-            for (t, p) in (1..=n).zip(first_half.iter_mut()) {
-                *p = at(s0, t, 0);
-            }
-            let s1 = sector(fragments.spoke_along(e, 1));
-            for (t, p) in (n + 1..grid.g).zip(second_half.iter_mut()) {
-                *p = at(s1, grid.g - t, 0);
-            }
-        }
-    });
-    let per_face = ((g - 1) * (g - 1)) as usize;
-    let side = grid.g as usize - 1;
-    for_each_block(face_part, per_face, |first, block| {
-        for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
-            let f = (first + k) as u32;
-            let h0 = topo.face_half_edges(f).start;
-            for m in 0..4 {
-                // The quarter at corner m: sector s of the fragment centred there. Its
-                // points off the spokes (a, b ≥ 1) are, ring by ring, the entries t ≥ 1 of
-                // the sector's 2r consecutive entries: read in storage order, written at
-                // their (i, j) in the face's frame.
-                let h = h0 + m;
-                let (start, class, s) = sector(fragments.corner_sector(h));
-                let g = grid.g as usize;
-                for r in 1..=n as u64 {
-                    let ring = start + 1 + class.ring_offset(r) + u64::from(s) * 2 * r;
-                    let entries = &stream[(ring + 1) as usize..(ring + 2 * r) as usize];
-                    for (t, texel) in (1..2 * r as usize).zip(entries) {
-                        let r = r as usize;
-                        let (a, b) = if t <= r { (r, t) } else { (2 * r - t, r) };
-                        let (i, j) = match m {
-                            0 => (a, b),
-                            1 => (g - b, a),
-                            2 => (g - a, g - b),
-                            _ => (b, g - a),
-                        };
-                        out[(j - 1) * side + i - 1] = position(texel);
-                    }
-                }
-            }
-        }
-    });
-
-    let quads = kept.len() as u64 * g * g;
-    let mut offsets = vec![0usize; quads as usize + 1];
+/// Offsets of `quads` faces of four vertices each.
+fn quad_offsets(quads: usize) -> Vec<usize> {
+    let mut offsets = vec![0usize; quads + 1];
     for_each_block(&mut offsets, 1, |first, block| {
         for (k, o) in block.iter_mut().enumerate() {
             *o = 4 * (first + k);
         }
     });
-    Ok(Mesh::from_parts(positions, offsets, indices)?)
+    offsets
+}
+
+/// Reads each output point from the fragment that owns it: the stream entries of the
+/// owned regions, `n` rings each.
+struct Owners<'a, T, P> {
+    fragments: &'a FragmentMesh,
+    layout: &'a StreamLayout,
+    stream: &'a [T],
+    position: P,
+    n: u32,
+}
+
+impl<T: Sync, P: Fn(&T) -> DVec3 + Sync> Owners<'_, T, P> {
+    /// Where the owned region of sector s of fragment f starts, and its class.
+    fn sector(&self, (f, s): (u32, u32)) -> (u64, Class, u32) {
+        let class = self.fragments.fragments()[f as usize].class;
+        (self.fragments.fragment_start(self.layout, f), class, s)
+    }
+
+    /// The point (a, b) of a sector's owned region.
+    fn at(&self, (start, class, s): (u64, Class, u32), a: u32, b: u32) -> DVec3 {
+        (self.position)(&self.stream[(start + class.index(s, a.into(), b.into())) as usize])
+    }
+
+    /// Coarse vertex v: the centre of its fragment.
+    fn vertices(&self, out: &mut [DVec3]) {
+        for (v, out) in out.iter_mut().enumerate() {
+            *out = match self.fragments.fragment_of(v as u32) {
+                Some(f) => self.at(self.sector((f, 0)), 0, 0),
+                // A vertex no face uses stays where it is.
+                None => self.fragments.isolated_position(v as u32),
+            };
+        }
+    }
+
+    /// The G − 1 points inside each coarse edge: the first half from the spoke of the
+    /// fragment at its first vertex, the second from the one at its second.
+    fn edges(&self, out: &mut [DVec3]) {
+        let (n, g) = (self.n, 2 * self.n);
+        let per_edge = (g - 1) as usize;
+        for_each_block(out, per_edge, |first, block| {
+            for (k, out) in block.chunks_exact_mut(per_edge).enumerate() {
+                let e = (first + k) as u32;
+                let (first_half, second_half) = out.split_at_mut(n as usize);
+                let s0 = self.sector(self.fragments.spoke_along(e, 0));
+                for (t, p) in (1..=n).zip(first_half.iter_mut()) {
+                    *p = self.at(s0, t, 0);
+                }
+                let s1 = self.sector(self.fragments.spoke_along(e, 1));
+                for (t, p) in (n + 1..g).zip(second_half.iter_mut()) {
+                    *p = self.at(s1, g - t, 0);
+                }
+            }
+        });
+    }
+
+    /// The (G − 1)² points inside each coarse face, a quarter from the fragment at each
+    /// of its corners.
+    fn faces(&self, out: &mut [DVec3]) {
+        let g = 2 * self.n as usize;
+        let per_face = (g - 1) * (g - 1);
+        for_each_block(out, per_face, |first, block| {
+            for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+                let h0 = self.fragments.coarse().face_half_edges((first + k) as u32).start;
+                for m in 0..4 {
+                    self.quarter(h0 + m, m, out);
+                }
+            }
+        });
+    }
+
+    /// The quarter at corner m of a face (`h`: its half-edge from that corner): sector s
+    /// of the fragment centred there. Its points off the spokes (a, b ≥ 1) are, ring by
+    /// ring, the entries t ≥ 1 of the sector's 2r consecutive entries: read in storage
+    /// order, written at their (i, j) in the face's frame.
+    fn quarter(&self, h: u32, m: u32, out: &mut [DVec3]) {
+        let g = 2 * self.n as usize;
+        let side = g - 1;
+        let (start, class, s) = self.sector(self.fragments.corner_sector(h));
+        for r in 1..=u64::from(self.n) {
+            let ring = start + 1 + class.ring_offset(r) + u64::from(s) * 2 * r;
+            let entries = &self.stream[(ring + 1) as usize..(ring + 2 * r) as usize];
+            for (t, texel) in (1..2 * r as usize).zip(entries) {
+                let r = r as usize;
+                let (a, b) = if t <= r { (r, t) } else { (2 * r - t, r) };
+                let (i, j) = match m {
+                    0 => (a, b),
+                    1 => (g - b, a),
+                    2 => (g - a, g - b),
+                    _ => (b, g - a),
+                };
+                out[(j - 1) * side + i - 1] = (self.position)(texel);
+            }
+        }
+    }
 }
 
 /// The cells (i, j) of a 2^depth × 2^depth grid in quadtree order: at each depth the four
@@ -180,7 +181,72 @@ struct Grid<'a> {
     face0: u32,
 }
 
-impl Grid<'_> {
+impl<'a> Grid<'a> {
+    /// The numbering of the mesh `stream` refines after `levels` fragment levels, once the
+    /// stream is known to hold every owned region and the result to fit 32-bit indices.
+    fn for_stream(
+        fragments: &'a FragmentMesh,
+        layout: &StreamLayout,
+        entries: usize,
+        levels: u32,
+    ) -> Result<Grid<'a>> {
+        let owned = 1u64 << levels;
+        let radius = layout.radius;
+        if owned > u64::from(radius) || (entries as u64) < layout.total {
+            return Err(SubdivError::Fragment(format!(
+                "a stream of {entries} entries at ring radius {radius} cannot hold {owned} owned rings ({} entries needed)",
+                layout.total
+            )));
+        }
+        let topo = fragments.coarse();
+        let g = 2 * owned;
+        let (nv, ne, nf) = (topo.num_vertices() as u64, topo.num_edges() as u64, topo.num_faces() as u64);
+        let vertices = nv + ne * (g - 1) + nf * (g - 1) * (g - 1);
+        let quads = nf * g * g;
+        if vertices >= u64::from(u32::MAX) || 4 * quads >= u64::from(u32::MAX) {
+            return Err(SubdivError::TooLarge { level: fragments.cpu_levels() + levels, vertices });
+        }
+        Ok(Grid { topo, g: g as u32, nv: nv as u32, face0: (nv + ne * (g - 1)) as u32 })
+    }
+
+    /// The quads of the `kept` faces, each face's grid in OpenSubdiv's quadtree order.
+    fn face_indices(&self, kept: &[u32], levels: u32) -> Vec<u32> {
+        let order = quadtree_order(levels + 1);
+        let g = self.g as usize;
+        let per_face = 4 * g * g;
+        let mut indices = vec![0u32; kept.len() * per_face];
+        for_each_block(&mut indices, per_face, |first, block| {
+            let mut ids = Vec::new();
+            for (k, out) in block.chunks_exact_mut(per_face).enumerate() {
+                self.face_ids(kept[first + k], &mut ids);
+                let row = g + 1;
+                for (q, &(i, j)) in order.iter().enumerate() {
+                    let c = j as usize * row + i as usize;
+                    out[4 * q..4 * q + 4].copy_from_slice(&[
+                        ids[c],
+                        ids[c + 1],
+                        ids[c + 1 + row],
+                        ids[c + row],
+                    ]);
+                }
+            }
+        });
+        indices
+    }
+
+    /// Every output position, gathered from the fragment that owns it: coarse vertices,
+    /// then edge points, then face points.
+    fn positions<T: Sync, P: Fn(&T) -> DVec3 + Sync>(&self, owners: &Owners<'_, T, P>) -> Vec<DVec3> {
+        let side = self.g as usize - 1;
+        let mut positions = vec![DVec3::ZERO; self.face0 as usize + self.topo.num_faces() * side * side];
+        let (vertex_part, rest) = positions.split_at_mut(self.nv as usize);
+        let (edge_part, face_part) = rest.split_at_mut((self.face0 - self.nv) as usize);
+        owners.vertices(vertex_part);
+        owners.edges(edge_part);
+        owners.faces(face_part);
+        positions
+    }
+
     /// Ids of the grid points of face `f`, row by row (j outer, i inner).
     fn face_ids(&self, f: u32, ids: &mut Vec<u32>) {
         let g = self.g;

@@ -44,11 +44,23 @@ fn table(facts: &mut Facts, experiment: &'static str, csv: &str, size_column: &s
 /// Every transcribed table of both theses.
 pub fn facts() -> Facts {
     let mut f = Facts::new(Source::Thesis);
-    let inc = "inclusion";
-    table(
-        &mut f,
-        inc,
-        inclusion::thesis_csv("4-9"),
+    inclusion_tables(&mut f);
+    voxelize_table(&mut f);
+    subdivide_table(&mut f);
+    boolean_table(&mut f);
+    f
+}
+
+/// A transcribed inclusion table: (table, size column, columns).
+type InclusionTable = (&'static str, &'static str, Columns<'static>);
+
+/// The inclusion tables of times by method, read before the TetraGrid tables. Table 4-6 as
+/// printed repeats Table 4-5's TetraGrid columns under its method names
+/// (`inclusion::TABLE_4_6_NOTE`): its numbers stay under its own keys, shown beside today's
+/// Table 4-6 and used by no claim; TetraGrid 32³ comes from Table 4-5.
+const INCLUSION_TIMES: [InclusionTable; 3] = [
+    (
+        "4-9",
         "faces",
         &[
             ("feito_cpu", "time:cpu", "s"),
@@ -58,14 +70,9 @@ pub fn facts() -> Facts {
             ("jordan", "time:jordan", "s"),
             ("jordan_octree_6", "time:jordan-octree", "s"),
         ],
-    );
-    // Table 4-6 as printed repeats Table 4-5's TetraGrid columns under its method names
-    // (`inclusion::TABLE_4_6_NOTE`): its numbers stay under its own keys, shown beside
-    // today's Table 4-6 and used by no claim; TetraGrid 32³ comes from Table 4-5.
-    table(
-        &mut f,
-        inc,
-        inclusion::thesis_csv("4-6"),
+    ),
+    (
+        "4-6",
         "faces",
         &[
             ("basic", "table4-6:basic", "s"),
@@ -75,15 +82,54 @@ pub fn facts() -> Facts {
             ("tetragrid_32", "table4-6:tetragrid", "s"),
             ("gpu_tetragrid_32", "table4-6:gpu+tetragrid", "s"),
         ],
-    );
-    table(&mut f, inc, inclusion::thesis_csv("4-5"), "faces", &[("tetragrid_32", "time:tetragrid", "s")]);
+    ),
+    ("4-5", "faces", &[("tetragrid_32", "time:tetragrid", "s")]),
+];
+
+/// The inclusion tables of each method's index, read after the TetraGrid tables.
+const INCLUSION_INDEXES: [InclusionTable; 2] = [
+    (
+        "4-7",
+        "triangles",
+        &[
+            ("feito_octants_kb", "memory:octants", "KiB"),
+            ("feito_tetragrid_32_kb", "memory:tetragrid", "KiB"),
+            ("bsp_kb", "memory:bsp", "KiB"),
+            ("jordan_octree_6_kb", "memory:jordan-octree", "KiB"),
+        ],
+    ),
+    (
+        "4-8",
+        "triangles",
+        &[
+            ("feito_octants_s", "build:octants", "s"),
+            ("feito_tetragrid_32_s", "build:tetragrid", "s"),
+            ("bsp_s", "build:bsp", "s"),
+            ("jordan_octree_6_s", "build:jordan-octree", "s"),
+        ],
+    ),
+];
+
+/// Tables 4-4 to 4-9 of the inclusion test.
+fn inclusion_tables(f: &mut Facts) {
+    let read = |f: &mut Facts, &(id, size, columns): &InclusionTable| {
+        table(f, "inclusion", inclusion::thesis_csv(id), size, columns)
+    };
+    INCLUSION_TIMES.iter().for_each(|t| read(f, t));
+    tetragrid_tables(f);
+    INCLUSION_INDEXES.iter().for_each(|t| read(f, t));
+}
+
+/// Tables 4-5 (query time) and 4-4 (build time and memory) at every TetraGrid resolution.
+fn tetragrid_tables(f: &mut Facts) {
+    let inc = "inclusion";
     let grid_times: Vec<(String, String)> = [2, 4, 8, 16, 32, 64]
         .iter()
         .map(|n| (format!("tetragrid_{n}"), format!("time:tetragrid-{n}")))
         .collect();
     let cols: Vec<(&str, &str, &str)> =
         grid_times.iter().map(|(c, k)| (c.as_str(), k.as_str(), "s")).collect();
-    table(&mut f, inc, inclusion::thesis_csv("4-5"), "faces", &cols);
+    table(f, inc, inclusion::thesis_csv("4-5"), "faces", &cols);
     let builds: Vec<(String, String, String, String)> = [2, 4, 8, 16, 32, 64]
         .iter()
         .map(|n| {
@@ -100,33 +146,11 @@ pub fn facts() -> Facts {
         cols.push((tc, tk, "s"));
         cols.push((mc, mk, "KiB"));
     }
-    table(&mut f, inc, inclusion::thesis_csv("4-4"), "triangles", &cols);
-    table(
-        &mut f,
-        inc,
-        inclusion::thesis_csv("4-7"),
-        "triangles",
-        &[
-            ("feito_octants_kb", "memory:octants", "KiB"),
-            ("feito_tetragrid_32_kb", "memory:tetragrid", "KiB"),
-            ("bsp_kb", "memory:bsp", "KiB"),
-            ("jordan_octree_6_kb", "memory:jordan-octree", "KiB"),
-        ],
-    );
-    table(
-        &mut f,
-        inc,
-        inclusion::thesis_csv("4-8"),
-        "triangles",
-        &[
-            ("feito_octants_s", "build:octants", "s"),
-            ("feito_tetragrid_32_s", "build:tetragrid", "s"),
-            ("bsp_s", "build:bsp", "s"),
-            ("jordan_octree_6_s", "build:jordan-octree", "s"),
-        ],
-    );
+    table(f, inc, inclusion::thesis_csv("4-4"), "triangles", &cols);
+}
 
-    // Table 5-2: one row per (resolution, model).
+/// Table 5-2: one row per (resolution, model).
+fn voxelize_table(f: &mut Facts) {
     for line in voxelize::THESIS_TABLE.lines().skip(1).filter(|l| !l.trim().is_empty()) {
         let c: Vec<&str> = line.split(',').collect();
         let (Some(n), Some(model), Some(faces)) =
@@ -141,23 +165,28 @@ pub fn facts() -> Facts {
             }
         }
     }
+}
 
-    // Table 5 of the 2010 thesis: models unnamed; rows numbered, the first is the cube.
+/// Table 5 of the 2010 thesis: models unnamed; rows numbered, the first is the cube.
+fn subdivide_table(f: &mut Facts) {
     for (i, line) in subdiv::THESIS_TABLE5.lines().skip(1).filter(|l| !l.trim().is_empty()).enumerate() {
         let c: Vec<f64> = line.split(',').filter_map(|v| v.trim().parse().ok()).collect();
         let [fragments, faces, _vertices, tcpu1, tgpu, tcpu2] = c[..] else { continue };
         let model = if i == 0 { "row 1: cube".to_string() } else { format!("row {}", i + 1) };
         f.model("subdivide", &model, faces, &model);
         let sub = |f: &mut Facts, key: &str, v: f64| f.add("subdivide", &model, key, "s", Stat::exact(v));
-        sub(&mut f, "time:tcpu1", tcpu1);
-        sub(&mut f, "time:tgpu", tgpu);
-        sub(&mut f, "time:gpu-path", tcpu1 + tgpu);
-        sub(&mut f, "time:tcpu2", tcpu2);
+        sub(f, "time:tcpu1", tcpu1);
+        sub(f, "time:tgpu", tgpu);
+        sub(f, "time:gpu-path", tcpu1 + tgpu);
+        sub(f, "time:tcpu2", tcpu2);
         f.add("subdivide", &model, "faces", "", Stat::exact(faces));
         f.add("subdivide", &model, "fragments", "", Stat::exact(fragments));
     }
-    // Table 6-1: one row per (pair, operation); phases from the difference, which every
-    // pair has. The thesis' grouped ("optimizado") runs used the GPU point test.
+}
+
+/// Table 6-1: one row per (pair, operation); phases from the difference, which every
+/// pair has. The thesis' grouped ("optimizado") runs used the GPU point test.
+fn boolean_table(f: &mut Facts) {
     for line in boolean::THESIS_TABLE.lines().skip(1).filter(|l| !l.trim().is_empty()) {
         let c: Vec<&str> = line.split(',').collect();
         let v: Vec<Option<f64>> = c.iter().map(|x| x.trim().parse::<f64>().ok()).collect();
@@ -168,16 +197,15 @@ pub fn facts() -> Facts {
         let _ = g1;
         f.model("boolean", pair, *triangles, pair);
         let b = |f: &mut Facts, key: &str, v: f64| f.add("boolean", pair, key, "s", Stat::exact(v));
-        b(&mut f, &format!("time:plain:{op}"), pt);
-        b(&mut f, &format!("time:grouped:{op}"), gt);
+        b(f, &format!("time:plain:{op}"), pt);
+        b(f, &format!("time:grouped:{op}"), gt);
         if *op == "difference" {
-            b(&mut f, "time:phase1", p1);
-            b(&mut f, "time:phase2-plain", p2);
-            b(&mut f, "time:phase2-grouped", g2);
-            b(&mut f, "time:total", gt);
+            b(f, "time:phase1", p1);
+            b(f, "time:phase2-plain", p2);
+            b(f, "time:phase2-grouped", g2);
+            b(f, "time:total", gt);
         }
     }
-    f
 }
 
 #[cfg(test)]
