@@ -18,7 +18,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::exact::implicit::Point;
-use crate::exact::{line_crossing, orient2d, orient3d};
+use crate::exact::{Sign, line_crossing, orient2d, orient3d};
 use crate::mesh::intersect::triangle_projection;
 
 /// The smallest simplex of one mesh that holds a point (vertex ids are position-welded
@@ -191,6 +191,37 @@ impl Ends {
         }
     }
 
+    /// The ends of triangle `p`'s meeting with the plane of triangle `q` that lie in `q`:
+    /// its vertices on that plane (`signs[i] == 0`) and its edges crossing it. One function
+    /// for both operands: `p_is_a` says whether `p` is A's triangle, so that every key
+    /// names A's simplex first.
+    fn of_crossing(
+        &mut self,
+        (p, p_ids, signs): ([DVec3; 3], [u32; 3], [Sign; 3]),
+        (q, q_ids, q_face): ([DVec3; 3], [u32; 3], u32),
+        p_is_a: bool,
+    ) {
+        let key = |mine: Simplex, other: Simplex| {
+            if p_is_a { Key { a: mine, b: other } } else { Key { a: other, b: mine } }
+        };
+        let proj = triangle_projection(q[0], q[1], q[2]);
+        for i in 0..3 {
+            let j = (i + 1) % 3;
+            if signs[i] == 0 {
+                if let Some(proj) = proj {
+                    let tri = q.map(|x| proj.apply(x));
+                    if let Some(s) = locate_2d(tri, q_ids, q_face, proj.apply(p[i])) {
+                        self.push(key(Simplex::Vertex(p_ids[i]), s));
+                    }
+                }
+            } else if signs[i] * signs[j] < 0 {
+                if let Some(s) = locate_crossing(p[i], p[j], q, q_ids, q_face) {
+                    self.push(key(Simplex::edge(p_ids[i], p_ids[j]), s));
+                }
+            }
+        }
+    }
+
     fn meeting(&self) -> Meeting {
         match self.keys {
             [None, ..] => Meeting::Apart,
@@ -216,40 +247,9 @@ pub fn meet(ops: &Operands, t: u32, u: u32) -> Meeting {
         return coplanar(ops, t, u);
     }
     let mut ends = Ends::default();
-    // Ends of t ∩ plane(u) that lie in u.
-    let proj_b = triangle_projection(tb[0], tb[1], tb[2]);
-    for i in 0..3 {
-        let j = (i + 1) % 3;
-        if sa[i] == 0 {
-            if let Some(proj) = proj_b {
-                let tri = tb.map(|p| proj.apply(p));
-                if let Some(s) = locate_2d(tri, ib, u, proj.apply(ta[i])) {
-                    ends.push(Key { a: Simplex::Vertex(ia[i]), b: s });
-                }
-            }
-        } else if sa[i] * sa[j] < 0 {
-            if let Some(s) = locate_crossing(ta[i], ta[j], tb, ib, u) {
-                ends.push(Key { a: Simplex::edge(ia[i], ia[j]), b: s });
-            }
-        }
-    }
-    // Ends of u ∩ plane(t) that lie in t.
-    let proj_a = triangle_projection(ta[0], ta[1], ta[2]);
-    for i in 0..3 {
-        let j = (i + 1) % 3;
-        if sb[i] == 0 {
-            if let Some(proj) = proj_a {
-                let tri = ta.map(|p| proj.apply(p));
-                if let Some(s) = locate_2d(tri, ia, t, proj.apply(tb[i])) {
-                    ends.push(Key { a: s, b: Simplex::Vertex(ib[i]) });
-                }
-            }
-        } else if sb[i] * sb[j] < 0 {
-            if let Some(s) = locate_crossing(tb[i], tb[j], ta, ia, t) {
-                ends.push(Key { a: s, b: Simplex::edge(ib[i], ib[j]) });
-            }
-        }
-    }
+    // Ends of t ∩ plane(u) that lie in u, then of u ∩ plane(t) that lie in t.
+    ends.of_crossing((ta, ia, sa), (tb, ib, u), true);
+    ends.of_crossing((tb, ib, sb), (ta, ia, t), false);
     ends.meeting()
 }
 
@@ -268,13 +268,13 @@ fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
     // u's edges clipped to t.
     for k in 0..3 {
         let (j, l) = (k, (k + 1) % 3);
-        let pts = clip(b2[j], b2[l], ib[j], ib[l], a2, ia, t, |own, other| Key { a: other, b: own });
+        let pts = clip((b2[j], b2[l]), (ib[j], ib[l]), (a2, ia, t), |own, other| Key { a: other, b: own });
         emit(&pts, &mut in_a, &mut points);
     }
     // t's edges clipped to u.
     for k in 0..3 {
         let (j, l) = (k, (k + 1) % 3);
-        let pts = clip(a2[j], a2[l], ia[j], ia[l], b2, ib, u, |own, other| Key { a: own, b: other });
+        let pts = clip((a2[j], a2[l]), (ia[j], ia[l]), (b2, ib, u), |own, other| Key { a: own, b: other });
         emit(&pts, &mut in_b, &mut points);
     }
     if in_a.is_empty() && in_b.is_empty() && points.is_empty() {
@@ -298,15 +298,10 @@ fn emit(pts: &[(f64, Key)], segments: &mut Vec<[Key; 2]>, points: &mut Vec<Key>)
 /// `tri`, and then all are input vertices on one line, ordered by their coordinate along
 /// pr's larger component (an edge crossing, inexact, is then never among them).
 /// `key(own, other)` builds a key from the segment's simplex and the triangle's.
-#[allow(clippy::too_many_arguments)]
 fn clip(
-    p: DVec2,
-    r: DVec2,
-    ip: u32,
-    ir: u32,
-    tri: [DVec2; 3],
-    tid: [u32; 3],
-    face: u32,
+    (p, r): (DVec2, DVec2),
+    (ip, ir): (u32, u32),
+    (tri, tid, face): ([DVec2; 3], [u32; 3], u32),
     key: impl Fn(Simplex, Simplex) -> Key,
 ) -> Vec<(f64, Key)> {
     let mut pts: Vec<(f64, Key)> = Vec::with_capacity(3);

@@ -21,6 +21,10 @@ use std::fmt;
 use std::time::{Duration, Instant};
 
 use crate::gpu::{Context, DeviceInfo, GpuError};
+use crate::inclusion::InclusionError;
+use crate::render::RenderError;
+use crate::subdiv::SubdivError;
+use crate::voxel::VoxelError;
 
 /// The first difference between what a pass produced and the CPU reference.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,47 +95,26 @@ impl From<GpuError> for Stop {
     }
 }
 
-impl From<crate::voxel::VoxelError> for Stop {
-    fn from(e: crate::voxel::VoxelError) -> Stop {
-        use crate::voxel::VoxelError;
-        match e {
-            VoxelError::Gpu(g) => g.into(),
-            e @ VoxelError::Resolution { .. } => Stop::Unsupported(e.to_string()),
-            e => Stop::error(e.to_string()),
+/// `From` a module's error for `?`: its GPU error as a [`GpuError`] is taken, the listed
+/// variant (what this device or these sizes cannot do) is not supported, anything else fails.
+macro_rules! stop_from {
+    ($error:ident, $gpu:ident $(, $unsupported:pat)?) => {
+        impl From<$error> for Stop {
+            fn from(e: $error) -> Stop {
+                match e {
+                    $error::$gpu(g) => g.into(),
+                    $(e @ $unsupported => Stop::Unsupported(e.to_string()),)?
+                    e => Stop::error(e.to_string()),
+                }
+            }
         }
-    }
+    };
 }
 
-impl From<crate::inclusion::InclusionError> for Stop {
-    fn from(e: crate::inclusion::InclusionError) -> Stop {
-        use crate::inclusion::InclusionError;
-        match e {
-            InclusionError::Gpu(g) => g.into(),
-            e @ InclusionError::TooLarge(_) => Stop::Unsupported(e.to_string()),
-            e => Stop::error(e.to_string()),
-        }
-    }
-}
-
-impl From<crate::subdiv::SubdivError> for Stop {
-    fn from(e: crate::subdiv::SubdivError) -> Stop {
-        use crate::subdiv::SubdivError;
-        match e {
-            SubdivError::Gpu(g) => g.into(),
-            e @ SubdivError::GpuLimit(_) => Stop::Unsupported(e.to_string()),
-            e => Stop::error(e.to_string()),
-        }
-    }
-}
-
-impl From<crate::render::RenderError> for Stop {
-    fn from(e: crate::render::RenderError) -> Stop {
-        match e {
-            crate::render::RenderError::Gpu(g) => g.into(),
-            e => Stop::error(e.to_string()),
-        }
-    }
-}
+stop_from!(VoxelError, Gpu, VoxelError::Resolution { .. });
+stop_from!(InclusionError, Gpu, InclusionError::TooLarge(_));
+stop_from!(SubdivError, Gpu, SubdivError::GpuLimit(_));
+stop_from!(RenderError, Gpu);
 
 impl From<crate::mesh::MeshError> for Stop {
     fn from(e: crate::mesh::MeshError) -> Stop {

@@ -745,22 +745,14 @@ impl Context {
             // SAFETY: valid device.
             let fence = unsafe { dev.raw.create_fence(&fence_info, None) }.vk("vkCreateFence")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let waits: Vec<_> = sync
-                .iter()
-                .map(|&(wait, _)| {
-                    vk::SemaphoreSubmitInfo::default()
-                        .semaphore(wait)
-                        .stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                })
-                .collect();
-            let signals: Vec<_> = sync
-                .iter()
-                .map(|&(_, signal)| {
-                    vk::SemaphoreSubmitInfo::default()
-                        .semaphore(signal)
-                        .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-                })
-                .collect();
+            let semaphores =
+                |stage: vk::PipelineStageFlags2,
+                 pick: fn(&(vk::Semaphore, vk::Semaphore)) -> vk::Semaphore| {
+                    let info = |s| vk::SemaphoreSubmitInfo::default().semaphore(s).stage_mask(stage);
+                    sync.iter().map(|pair| info(pick(pair))).collect::<Vec<_>>()
+                };
+            let waits = semaphores(vk::PipelineStageFlags2::ALL_TRANSFER, |&(wait, _)| wait);
+            let signals = semaphores(vk::PipelineStageFlags2::ALL_COMMANDS, |&(_, signal)| signal);
             let submit = [vk::SubmitInfo2::default()
                 .command_buffer_infos(&cmds)
                 .wait_semaphore_infos(&waits)

@@ -613,17 +613,26 @@ impl<'p> RenderScope<'_, 'p> {
                     .image_info(info)
             })
             .collect();
-        // SAFETY: views and sampler are alive for the submission; layout matches the pipeline.
+        // SAFETY: views and sampler are alive for the submission.
+        unsafe { self.push_descriptors(p, &writes) };
+        Ok(())
+    }
+
+    /// Pushes set-0 descriptors of the bound pipeline `p`.
+    ///
+    /// # Safety
+    /// What `writes` names must stay alive for the submission.
+    unsafe fn push_descriptors(&self, p: &Pipeline, writes: &[vk::WriteDescriptorSet]) {
+        // SAFETY: the layout is the bound pipeline's; the caller keeps the resources alive.
         unsafe {
             self.dev.push_descriptor.cmd_push_descriptor_set(
                 self.cmd,
                 vk::PipelineBindPoint::GRAPHICS,
                 p.layout,
                 0,
-                &writes,
+                writes,
             )
-        };
-        Ok(())
+        }
     }
 
     /// Binds a uniform block at set-0 binding `binding`.
@@ -639,16 +648,8 @@ impl<'p> RenderScope<'_, 'p> {
             .dst_binding(binding)
             .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
             .buffer_info(&info)];
-        // SAFETY: as in `textures`.
-        unsafe {
-            self.dev.push_descriptor.cmd_push_descriptor_set(
-                self.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                p.layout,
-                0,
-                &write,
-            )
-        };
+        // SAFETY: the buffer is alive for the submission.
+        unsafe { self.push_descriptors(p, &write) };
         Ok(())
     }
 

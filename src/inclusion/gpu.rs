@@ -318,34 +318,53 @@ pub(crate) fn classify_pipeline(ctx: &Context, grid: bool) -> Result<Pipeline> {
     )?)
 }
 
-/// Sorts points into those the GPU must classify and those decided on the host: Outside
-/// outside the grown bounding box (exactly as on the CPU), flagged near a flat tetrahedron.
-pub(crate) fn triage(ft: &FeitoTorres, set: &TetraSet, points: &[DVec3]) -> (Vec<usize>, Vec<usize>) {
-    let mut gpu = Vec::new();
-    let mut flagged = Vec::new();
-    for (i, &p) in points.iter().enumerate() {
-        if !ft.surface().in_bounds(p) {
-            continue;
-        }
-        if set.near_flat(p) { flagged.push(i) } else { gpu.push(i) }
-    }
-    (gpu, flagged)
+/// The bookkeeping of one GPU classification, shared by every GPU method: each point's
+/// class (Outside until decided), those flagged for the exact CPU test, and where the time
+/// went.
+pub(crate) struct Work {
+    out: Vec<Class>,
+    flagged: Vec<usize>,
+    pub stats: GpuStats,
 }
 
-/// Answers the flagged points exactly; records the time.
-pub(crate) fn fall_back(
-    exact: &GridClassifier,
-    points: &[DVec3],
-    flagged: &[usize],
-    out: &mut [Class],
-    stats: &mut GpuStats,
-) {
-    let t = Instant::now();
-    for &i in flagged {
-        out[i] = exact.classify(points[i]);
+impl Work {
+    /// Sorts points into those the GPU must classify (returned) and those decided on the
+    /// host: Outside outside the grown bounding box (exactly as on the CPU), flagged near a
+    /// flat tetrahedron.
+    pub fn triage(ft: &FeitoTorres, set: &TetraSet, points: &[DVec3]) -> (Work, Vec<usize>) {
+        let mut todo = Vec::new();
+        let mut flagged = Vec::new();
+        for (i, &p) in points.iter().enumerate() {
+            if !ft.surface().in_bounds(p) {
+                continue;
+            }
+            if set.near_flat(p) { flagged.push(i) } else { todo.push(i) }
+        }
+        (Work { out: vec![Class::Outside; points.len()], flagged, stats: GpuStats::default() }, todo)
     }
-    stats.flagged = flagged.len();
-    stats.fallback = t.elapsed();
+
+    /// Point `order[k]` takes the class its inclusion sum `sums[k]` decodes to, or is
+    /// flagged for the exact test when the sum is not a clear answer.
+    pub fn take(&mut self, order: &[usize], sums: &[f32]) {
+        for (&i, &sum) in order.iter().zip(sums) {
+            match decode(sum) {
+                Some(c) => self.out[i] = c,
+                None => self.flagged.push(i),
+            }
+        }
+    }
+
+    /// Answers the flagged points exactly (recording the time): every point's class, and
+    /// the statistics.
+    pub fn finish(mut self, exact: &GridClassifier, points: &[DVec3]) -> (Vec<Class>, GpuStats) {
+        let t = Instant::now();
+        for &i in &self.flagged {
+            self.out[i] = exact.classify(points[i]);
+        }
+        self.stats.flagged = self.flagged.len();
+        self.stats.fallback = t.elapsed();
+        (self.out, self.stats)
+    }
 }
 
 /// The `gpu` and `cpu+gpu` methods: every tetrahedron against every query point.
@@ -431,22 +450,15 @@ impl GpuInclusion {
 
     /// Classifies every point; where the time went lands in [`Self::stats`].
     pub fn classify_all(&mut self, points: &[DVec3]) -> Result<Vec<Class>> {
-        let mut stats = GpuStats::default();
-        let mut out = vec![Class::Outside; points.len()];
-        let (todo, mut flagged) = triage(self.exact.base(), &self.set, points);
-        stats.gpu_points = todo.len();
+        let (mut work, todo) = Work::triage(self.exact.base(), &self.set, points);
+        work.stats.gpu_points = todo.len();
         let per_submit = GROUP_POINTS * self.options.groups_per_draw as usize;
         for chunk in todo.chunks(per_submit) {
             let chunk_points: Vec<DVec3> = chunk.iter().map(|&i| points[i]).collect();
-            let sums = self.run_chunk(&chunk_points, &mut stats)?;
-            for (k, &i) in chunk.iter().enumerate() {
-                match decode(sums[k]) {
-                    Some(c) => out[i] = c,
-                    None => flagged.push(i),
-                }
-            }
+            let sums = self.run_chunk(&chunk_points, &mut work.stats)?;
+            work.take(chunk, &sums);
         }
-        fall_back(&self.exact, points, &flagged, &mut out, &mut stats);
+        let (out, stats) = work.finish(&self.exact, points);
         self.stats = stats;
         Ok(out)
     }

@@ -13,9 +13,7 @@ use glam::DVec3;
 
 use super::classifier::Class;
 use super::error::{InclusionError, Result};
-use super::gpu::{
-    GROUP_POINTS, GpuStats, LAYERS, MAX_POINTS, TetraSet, classify_pipeline, decode, fall_back, triage,
-};
+use super::gpu::{GROUP_POINTS, GpuStats, LAYERS, MAX_POINTS, TetraSet, Work, classify_pipeline};
 use super::tetragrid::GridClassifier;
 use crate::gpu::{Attachment, Buffer, Context, Load, Pipeline, Reducer, TexFormat, Texture};
 
@@ -104,9 +102,7 @@ impl GpuGridInclusion {
 
     /// Classifies every point; where the time went lands in [`Self::stats`].
     pub fn classify_all(&mut self, points: &[DVec3]) -> Result<Vec<Class>> {
-        let mut stats = GpuStats::default();
-        let mut out = vec![Class::Outside; points.len()];
-        let (todo, mut flagged) = triage(self.grid.base(), &self.set, points);
+        let (mut work, todo) = Work::triage(self.grid.base(), &self.set, points);
         // Points by cell; points outside the grid's cube, or in cells no tetrahedron
         // reaches, are Outside (their inclusion sum is 0).
         let mut by_cell: Vec<(u32, usize)> = todo
@@ -117,7 +113,7 @@ impl GpuGridInclusion {
             })
             .collect();
         by_cell.sort_unstable();
-        stats.gpu_points = by_cell.len();
+        work.stats.gpu_points = by_cell.len();
         let tile_capacity = TILES_WIDE * TILES_HIGH;
         let per_tile = TILE * TILE * self.batch;
         let mut k = 0;
@@ -149,15 +145,10 @@ impl GpuGridInclusion {
                 jobs.push([start, list, first as u32, (order.len() - first) as u32]);
                 tiles += need;
             }
-            let sums = self.run_jobs(points, &order, &jobs, &mut stats)?;
-            for (slot, &i) in order.iter().enumerate() {
-                match decode(sums[slot]) {
-                    Some(c) => out[i] = c,
-                    None => flagged.push(i),
-                }
-            }
+            let sums = self.run_jobs(points, &order, &jobs, &mut work.stats)?;
+            work.take(&order, &sums);
         }
-        fall_back(&self.grid, points, &flagged, &mut out, &mut stats);
+        let (out, stats) = work.finish(&self.grid, points);
         self.stats = stats;
         Ok(out)
     }

@@ -193,12 +193,10 @@ impl Classifier for Jordan {
         if !surface.in_bounds(p) {
             return Class::Outside;
         }
-        let n = surface.covering().triangles.len();
-        if (0..n).any(|t| surface.on_boundary_near(t, p)) {
-            return Class::OnBoundary;
+        match surface.off_boundary(p, 0..surface.covering().triangles.len()) {
+            Some(p) => cast(surface, p, |p, d, reach| self.crossings(p, d, reach)),
+            None => Class::OnBoundary,
         }
-        let p = surface.off_polygon_planes(p, 0..n);
-        cast(surface, p, |p, d, reach| self.crossings(p, d, reach))
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -216,13 +216,10 @@ impl Classifier for JordanOctree {
         }
         // Every triangle within ε of p has a grown box holding p, hence is in p's leaf.
         let p = match self.leaf_of(p) {
-            Some(leaf) => {
-                let items = self.leaf_items(leaf);
-                if items.iter().any(|&t| surface.on_boundary_near(t as usize, p)) {
-                    return Class::OnBoundary;
-                }
-                surface.off_polygon_planes(p, items.iter().map(|&t| t as usize))
-            }
+            Some(leaf) => match surface.off_boundary(p, self.leaf_items(leaf).iter().map(|&t| t as usize)) {
+                Some(p) => p,
+                None => return Class::OnBoundary,
+            },
             None => p,
         };
         cast(surface, p, |p, d, reach| self.crossings(p, d, reach))

@@ -188,6 +188,19 @@ impl Surface {
     /// face) nothing changes within ε/2, so classifying the moved point is exact and makes
     /// those triangles agree. Triangle faces need no such care: within rounding of their
     /// plane and over them, a point is on the boundary.
+    /// `None` when `p` lies within ε of one of `triangles` (on the boundary); else `p`,
+    /// moved off the plane of a non-convex face among them ([`Self::off_polygon_planes`]).
+    pub fn off_boundary<I: IntoIterator<Item = usize> + Clone>(
+        &self,
+        p: DVec3,
+        triangles: I,
+    ) -> Option<DVec3> {
+        if triangles.clone().into_iter().any(|t| self.on_boundary_near(t, p)) {
+            return None;
+        }
+        Some(self.off_polygon_planes(p, triangles))
+    }
+
     pub fn off_polygon_planes(&self, p: DVec3, triangles: impl IntoIterator<Item = usize>) -> DVec3 {
         let c = &self.covering;
         if self.face_planes.is_empty() {

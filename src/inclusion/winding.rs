@@ -26,23 +26,21 @@ pub fn winding_number(surface: &Surface, p: DVec3) -> f64 {
 /// ambiguous: OnBoundary within ε of a face, else their rule, Inside iff w is non-zero
 /// (|w| ≥ ½). On a valid solid this is [`classify`]'s answer.
 pub fn classify_nonzero(surface: &Surface, p: DVec3) -> Class {
-    let n = surface.covering().triangles.len();
-    if (0..n).any(|t| surface.on_boundary_near(t, p)) {
-        return Class::OnBoundary;
+    match surface.off_boundary(p, 0..surface.covering().triangles.len()) {
+        Some(p) if winding_number(surface, p).abs() >= 0.5 => Class::Inside,
+        Some(_) => Class::Outside,
+        None => Class::OnBoundary,
     }
-    let p = surface.off_polygon_planes(p, 0..n);
-    if winding_number(surface, p).abs() >= 0.5 { Class::Inside } else { Class::Outside }
 }
 
 /// OnBoundary within ε of a face, else Inside iff w ≥ ½ (measured from a point moved
 /// off the plane of a non-convex face if `p` lies in one, see [`Surface::off_polygon_planes`]).
 pub fn classify(surface: &Surface, p: DVec3) -> Class {
-    let n = surface.covering().triangles.len();
-    if (0..n).any(|t| surface.on_boundary_near(t, p)) {
-        return Class::OnBoundary;
+    match surface.off_boundary(p, 0..surface.covering().triangles.len()) {
+        Some(p) if winding_number(surface, p) >= 0.5 => Class::Inside,
+        Some(_) => Class::Outside,
+        None => Class::OnBoundary,
     }
-    let p = surface.off_polygon_planes(p, 0..n);
-    if winding_number(surface, p) >= 0.5 { Class::Inside } else { Class::Outside }
 }
 
 /// The winding-number oracle as a [`Classifier`].

@@ -207,19 +207,20 @@ pub struct Models {
 }
 
 impl Models {
-    /// (thesis model, name, mesh) for each model to run.
-    fn load(
+    /// `model(thesis model, name, mesh)` for each model to run.
+    fn load<M>(
         &self,
         stand_ins: &[(&'static str, &'static str)],
-    ) -> anyhow::Result<Vec<(&'static str, String, Mesh)>> {
+        model: impl Fn(&'static str, String, Mesh) -> anyhow::Result<M>,
+    ) -> anyhow::Result<Vec<M>> {
         if !self.models.is_empty() {
-            return self.models.iter().map(|m| Ok(("–", m.to_string(), crate::mesh::load(m)?))).collect();
+            return self.models.iter().map(|m| model("–", m.to_string(), crate::mesh::load(m)?)).collect();
         }
         let mut out = Vec::new();
         for &(thesis, spec) in stand_ins {
             let arg = MeshArg::from(spec).in_folder(&self.models_dir);
             if arg.file().is_none_or(std::path::Path::exists) {
-                out.push((thesis, spec.to_string(), crate::mesh::load(&arg)?));
+                out.push(model(thesis, spec.to_string(), crate::mesh::load(&arg)?)?);
             } else {
                 note!("texgeo: {arg} not found (run tools/fetch-models); skipping the {thesis} stand-in");
             }
@@ -371,12 +372,9 @@ fn measure(ctx: &Context, cmd: Command, around: &Around) -> anyhow::Result<()> {
 }
 
 fn measure_inclusion(ctx: &Context, a: InclusionArgs, around: &Around) -> anyhow::Result<()> {
-    let models = a
-        .models
-        .load(bench::inclusion::STAND_INS)?
-        .into_iter()
-        .map(|(thesis, name, mesh)| bench::inclusion::Model { thesis, name, mesh })
-        .collect::<Vec<_>>();
+    let models = a.models.load(bench::inclusion::STAND_INS, |thesis, name, mesh| {
+        Ok(bench::inclusion::Model { thesis, name, mesh })
+    })?;
     let cfg = bench::inclusion::Config { sets: a.sets, points: a.points, resolutions: a.resolutions };
     finish(around.run(|| bench::inclusion::run(ctx, &models, &cfg))?, &Common { runs: 0, out: a.out })
 }
@@ -386,12 +384,9 @@ fn measure_voxelize(ctx: &Context, a: VoxelizeArgs, around: &Around) -> anyhow::
     for &n in &a.sizes {
         texgeo::voxel::grid::check_resolution(n)?;
     }
-    let models = a
-        .models
-        .load(bench::voxelize::STAND_INS)?
-        .into_iter()
-        .map(|(thesis, name, mesh)| bench::voxelize::Model { thesis, name, mesh })
-        .collect::<Vec<_>>();
+    let models = a.models.load(bench::voxelize::STAND_INS, |thesis, name, mesh| {
+        Ok(bench::voxelize::Model { thesis, name, mesh })
+    })?;
     anyhow::ensure!(!models.is_empty(), "no models to measure");
     let cfg = bench::voxelize::Config { resolutions: a.sizes, methods, runs: a.runs, zone: a.zone };
     finish(around.run(|| bench::voxelize::run(ctx, &models, &cfg))?, &Common { runs: a.runs, out: a.out })
@@ -425,11 +420,7 @@ fn measure_boolean(ctx: &Context, a: BooleanArgs, around: &Around) -> anyhow::Re
     let pairs = if a.scaling_only {
         Vec::new()
     } else {
-        a.models
-            .load(STAND_INS)?
-            .into_iter()
-            .map(|(thesis, name, mesh)| Ok(Pair::with_turned_copy(thesis, name, mesh)?))
-            .collect::<anyhow::Result<Vec<_>>>()?
+        a.models.load(STAND_INS, |thesis, name, mesh| Ok(Pair::with_turned_copy(thesis, name, mesh)?))?
     };
     if let Some(dir) = &a.write_scaling {
         write_scaling_pairs(dir, &a.scaling)?;

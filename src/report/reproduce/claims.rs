@@ -45,29 +45,38 @@ impl From<bool> for Decision {
 impl Decision {
     /// Holds when every part holds, does not hold when any part does not, else inconclusive.
     fn all(parts: impl IntoIterator<Item = Decision>) -> Decision {
-        let mut out = Decision::Holds;
-        for d in parts {
-            match d {
-                Decision::DoesNotHold => return Decision::DoesNotHold,
-                Decision::Inconclusive => out = Decision::Inconclusive,
-                Decision::Holds => {}
-            }
-        }
-        out
+        Decision::unless(Decision::DoesNotHold, Decision::Holds, parts)
     }
 
     /// Holds when any part holds, does not hold when every part does not, else inconclusive.
     fn any(parts: impl IntoIterator<Item = Decision>) -> Decision {
-        let mut out = Decision::DoesNotHold;
+        Decision::unless(Decision::Holds, Decision::DoesNotHold, parts)
+    }
+
+    /// `decisive` as soon as a part is; else `otherwise` when every part is, or
+    /// inconclusive.
+    fn unless(
+        decisive: Decision,
+        otherwise: Decision,
+        parts: impl IntoIterator<Item = Decision>,
+    ) -> Decision {
+        let mut out = otherwise;
         for d in parts {
-            match d {
-                Decision::Holds => return Decision::Holds,
-                Decision::Inconclusive => out = Decision::Inconclusive,
-                Decision::DoesNotHold => {}
+            if d == decisive {
+                return decisive;
+            }
+            if d == Decision::Inconclusive {
+                out = Decision::Inconclusive;
             }
         }
         out
     }
+}
+
+/// What is missing, in words; `why` when no model has the quantity at all (its source
+/// never measured it).
+fn unless_measured(why: &'static str) -> impl Fn(Missing) -> String {
+    move |e| if matches!(e, Missing::NoModel(_)) { why.to_string() } else { e.into() }
 }
 
 /// The interval [lo, hi] against "at least t".
@@ -337,13 +346,9 @@ fn tetragrid_beyond_64(f: &Facts) -> Measure {
 }
 
 fn tetragrid_discards(f: &Facts) -> Measure {
-    let s = f.series("inclusion", "tested:tetragrid-32").map_err(|e| {
-        if matches!(e, Missing::NoModel(_)) {
-            "the thesis gives no count of tests".to_string()
-        } else {
-            e.into()
-        }
-    })?;
+    let s = f
+        .series("inclusion", "tested:tetragrid-32")
+        .map_err(unless_measured("the thesis gives no count of tests"))?;
     let worst = s.iter().map(|p| p.2.value).fold(0f64, f64::max);
     Ok(Found::from((
         format!("at least {} discarded (worst of {} models; counted, no noise)", pct(1.0 - worst), s.len()),
@@ -490,13 +495,9 @@ fn octants_cheapest(f: &Facts) -> Measure {
 }
 
 fn bsp_costliest(f: &Facts) -> Measure {
-    let s = f.series("inclusion", "build:bsp").map_err(|e| {
-        if matches!(e, Missing::NoModel(_)) {
-            "texgeo has no BSP method (a BVH stands in)".to_string()
-        } else {
-            e.into()
-        }
-    })?;
+    let s = f
+        .series("inclusion", "build:bsp")
+        .map_err(unless_measured("texgeo has no BSP method (a BVH stands in)"))?;
     let mut fails = Vec::new();
     for (m, _, v) in &s {
         for o in ["octants", "tetragrid", "jordan-octree"] {
@@ -1200,11 +1201,8 @@ fn gpu_beats_cpu_l5(f: &Facts) -> Measure {
 }
 
 fn gpu_beats_osd_l5(f: &Facts) -> Measure {
-    match f.series("subdivide", "time:osd") {
-        Err(Missing::NoModel(_)) => Err("the thesis compared with CGAL only".into()),
-        Err(e) => Err(e.into()),
-        Ok(_) => min_ratio(f, "subdivide", "time:osd", "time:gpu-path", 1.0, true),
-    }
+    f.series("subdivide", "time:osd").map_err(unless_measured("the thesis compared with CGAL only"))?;
+    min_ratio(f, "subdivide", "time:osd", "time:gpu-path", 1.0, true)
 }
 
 /// The lowest level from which the GPU path beats `rival` at every measured level.
@@ -1271,13 +1269,9 @@ fn crossover_osd(f: &Facts) -> Measure {
 }
 
 fn one_pass_per_level(f: &Facts) -> Measure {
-    let p = f.pairs("subdivide", "passes", "gpu-levels").map_err(|e| {
-        if matches!(e, Missing::NoModel(_)) {
-            "the thesis gives no pass counts".to_string()
-        } else {
-            e.into()
-        }
-    })?;
+    let p = f
+        .pairs("subdivide", "passes", "gpu-levels")
+        .map_err(unless_measured("the thesis gives no pass counts"))?;
     let ok = p.iter().filter(|q| q.2.value == q.3.value).count();
     Ok((format!("one pass per GPU level on {ok} of {} models", p.len()), (ok == p.len()).into()).into())
 }

@@ -55,6 +55,26 @@ pub struct FigureRecord {
     pub note: String,
 }
 
+impl FigureRecord {
+    /// A picture's record before it is written (the file and its size are filled in then).
+    fn new(
+        kind: &str,
+        model: impl Into<String>,
+        level: u32,
+        camera: impl Into<CameraRecord>,
+        note: String,
+    ) -> FigureRecord {
+        FigureRecord {
+            kind: kind.into(),
+            model: model.into(),
+            level,
+            camera: camera.into(),
+            note,
+            ..FigureRecord::default()
+        }
+    }
+}
+
 /// The orbit camera of a picture (`render::Camera`).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct CameraRecord {
@@ -194,14 +214,13 @@ pub fn valence_levels(run: &mut Run) -> Result<Vec<Block>> {
     ];
     for level in 0..=3 {
         let (picture, vertices, faces) = draw(run, Content::Mesh(base.clone()), level, look, camera)?;
-        let record = FigureRecord {
-            kind: "valence".into(),
-            model: "geodesic sphere (report::reproduce::valence_model)".into(),
+        let record = FigureRecord::new(
+            "valence",
+            "geodesic sphere (report::reproduce::valence_model)",
             level,
-            camera: camera.into(),
-            note: format!("{vertices} vertices, {faces} faces"),
-            ..FigureRecord::default()
-        };
+            camera,
+            format!("{vertices} vertices, {faces} faces"),
+        );
         let caption = format!(
             "Geodesic sphere, level {level}: {vertices} vertices, {faces} faces, coloured by valence"
         );
@@ -241,14 +260,13 @@ pub fn crease_sharpness(run: &mut Run) -> Result<Vec<Block>> {
     let look = Look { valence: false, wireframe: false, shading: Shading::Smooth, colour: colour::SURFACE };
     let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
     let (picture, vertices, faces) = draw(run, Content::Surface(surface), level, look, camera)?;
-    let record = FigureRecord {
-        kind: "creases".into(),
-        model: "builtin:cube".into(),
+    let record = FigureRecord::new(
+        "creases",
+        "builtin:cube",
         level,
-        camera: camera.into(),
-        note: format!("{creases} creased edges at sharpness 1, 2, 4, 10; {vertices} vertices, {faces} faces"),
-        ..FigureRecord::default()
-    };
+        camera,
+        format!("{creases} creased edges at sharpness 1, 2, 4, 10; {vertices} vertices, {faces} faces"),
+    );
     let caption = format!(
         "Cube, level {level} on the GPU: its {creases} edges creased at sharpness 1, 2, 4 and 10, crease edges \
          coloured by sharpness"
@@ -307,13 +325,13 @@ pub fn voxel_aspect(run: &mut Run) -> Result<Vec<Block>> {
             scene.bounds().ok_or_else(|| super::ReproduceError::Usage("empty voxel volume".into()))?;
         let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
         let picture = render(run, &scene, camera)?;
-        let record = FigureRecord {
-            kind: "voxels".into(),
-            model: name.into(),
-            camera: camera.into(),
-            note: format!("{res}³, {occupied} voxels, {method}{why}, Perlin marble"),
-            ..FigureRecord::default()
-        };
+        let record = FigureRecord::new(
+            "voxels",
+            name,
+            0,
+            camera,
+            format!("{res}³, {occupied} voxels, {method}{why}, Perlin marble"),
+        );
         let caption = format!(
             "{name} voxelized at {res}³ by `{method}`{why}, {what}, coloured by the Perlin aspect (marble)"
         );
@@ -380,19 +398,19 @@ pub fn inclusion_slice(run: &mut Run) -> Result<Vec<Block>> {
     }
     let camera = Camera::fit(DVec3::new(lo.x, lo.y, z), DVec3::new(hi.x, hi.y, z), 0.0, 0.0, aspect());
     let picture = render(run, &scene, camera)?;
-    let record = FigureRecord {
-        kind: "inclusion-slice".into(),
-        model: "builtin:knot".into(),
-        camera: camera.into(),
-        note: format!(
+    let record = FigureRecord::new(
+        "inclusion-slice",
+        "builtin:knot",
+        0,
+        camera,
+        format!(
             "{} points on z = {z} by `{method}`: {} inside, {} outside, {} on the boundary",
             points.len(),
             counts.0,
             counts.1,
             counts.2
         ),
-        ..FigureRecord::default()
-    };
+    );
     let caption = format!(
         "Inclusion slice: {side}×{side} points on the plane z = {z} through the torus knot, classified by `{method}`: \
          {} inside (green), {} outside (grey), {} on the boundary (red); the plane's cut through the surface in yellow",
@@ -464,17 +482,13 @@ pub fn fragment_layout(run: &mut Run) -> Result<Vec<Block>> {
     let camera = Camera::fit(plo, phi, d.x.atan2(d.z), d.y.clamp(-1.0, 1.0).asin(), aspect());
     let picture = render(run, &scene, camera)?;
     let k = frag.class.valence;
-    let record = FigureRecord {
-        kind: "fragment-layout".into(),
-        model: "builtin:cube".into(),
-        level: 3,
-        camera: camera.into(),
-        note: format!(
-            "fragment of vertex {} (valence {k}), ring radius {radius}, {len} entries",
-            frag.centre
-        ),
-        ..FigureRecord::default()
-    };
+    let record = FigureRecord::new(
+        "fragment-layout",
+        "builtin:cube",
+        3,
+        camera,
+        format!("fragment of vertex {} (valence {k}), ring radius {radius}, {len} entries", frag.centre),
+    );
     let caption = format!(
         "The fragment around a cube corner (valence {k}) after two fragment passes: {len} entries of ring radius \
          {radius} = 2²+1 over the level-3 surface; the centre white, the owned rings 1–4 one colour per sector (the \
@@ -521,13 +535,13 @@ pub fn boolean_results(run: &mut Run) -> Result<Vec<Block>> {
         let camera = Camera::fit(lo, hi, Camera::YAW, Camera::PITCH, aspect());
         let picture = render(run, &scene, camera)?;
         let faces = ev.result(op, true)?.num_faces();
-        let record = FigureRecord {
-            kind: "boolean".into(),
-            model: "builtin torus, sphere".into(),
-            camera: camera.into(),
-            note: format!("{} ({}): {faces} result triangles", op.name(), op.symbol()),
-            ..FigureRecord::default()
-        };
+        let record = FigureRecord::new(
+            "boolean",
+            "builtin torus, sphere",
+            0,
+            camera,
+            format!("{} ({}): {faces} result triangles", op.name(), op.symbol()),
+        );
         let caption = format!("A {} B: torus and sphere, {faces} result triangles", op.symbol());
         blocks.push(run.picture(&picture, &format!("boolean-{}", op.name()), &caption, record)?);
         blocks.push(legend(&[

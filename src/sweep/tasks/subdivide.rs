@@ -178,11 +178,10 @@ mod tests {
 
     #[test]
     fn options_keep_their_spelling_and_auto_picks_the_reference_by_method() {
-        let o = Options::default();
-        let text = serde_json::to_string(&o).unwrap();
-        assert_eq!(text, r#"{"method":"gpu","level":2,"reference":"auto","tolerance":null}"#);
-        assert_eq!(serde_json::from_str::<Options>(&text).unwrap(), o);
-        assert_eq!(o.reference(), Some(Reference::Cpu));
+        let text = r#"{"method":"gpu","level":2,"reference":"auto","tolerance":null}"#;
+        assert_eq!(serde_json::to_string(&Options::default()).unwrap(), text);
+        assert_eq!(serde_json::from_str::<Options>(text).unwrap(), Options::default());
+        assert_eq!(Options::default().reference(), Some(Reference::Cpu));
         let cpu: Options = serde_json::from_str(r#"{"method":"cpu"}"#).unwrap();
         assert_eq!(cpu.reference(), Some(Reference::Osd));
         let fixed: Options = serde_json::from_str(r#"{"method":"cpu","reference":"cpu"}"#).unwrap();

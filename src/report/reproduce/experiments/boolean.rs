@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use super::{Model, Quantity, both, comparison, curve, models_table, num, ratio_curve, stand_ins};
+use super::{Model, Quantity, Speedup, both, comparison, curve, models_table, num, speedup_plot, stand_ins};
 use crate::boolean::{Grouping, cgal};
 use crate::inclusion::Method;
 use crate::mesh::{Mesh, procedural};
@@ -400,24 +400,22 @@ fn plots(r: &mut Run) -> Result<Vec<Block>> {
         series,
     );
     let mut blocks = r.plot(&chart, "boolean-time")?;
-    let mut series = both(
-        "phase 2 plain / grouped",
-        0,
-        ratio_curve(r.facts, EXP, "time:phase2-plain", "time:phase2-cpu"),
-        ratio_curve(r.thesis, EXP, "time:phase2-plain", "time:phase2-grouped"),
-    );
-    series.extend(both(
-        "phase 2 CPU / GPU",
-        1,
-        ratio_curve(r.facts, EXP, "time:phase2-cpu", "time:phase2-gpu"),
-        Vec::new(),
-    ));
-    let chart = Chart::loglog(
+    let speedups: [Speedup; 2] = [
+        (
+            "phase 2 plain / grouped".into(),
+            0,
+            ["time:phase2-plain", "time:phase2-cpu"],
+            Some(["time:phase2-plain", "time:phase2-grouped"]),
+        ),
+        ("phase 2 CPU / GPU".into(), 1, ["time:phase2-cpu", "time:phase2-gpu"], None),
+    ];
+    blocks.extend(speedup_plot(
+        r,
+        EXP,
+        &speedups,
         "Boolean operations: grouped classification's and the GPU's speed-ups in phase 2",
         "triangles (both operands)",
-        "speed-up (×)",
-        series,
-    );
-    blocks.extend(r.plot(&chart, "boolean-speedup")?);
+        "boolean-speedup",
+    )?);
     Ok(blocks)
 }

@@ -2,8 +2,8 @@
 //! measuring code.
 
 use super::{
-    Model, Quantity, both, comparison, curve, details, models_table, quick_models, ratio_curve, stand_ins,
-    today_or_thesis,
+    Model, Quantity, Speedup, both, comparison, curve, details, models_table, quick_models, speedup_plot,
+    stand_ins, today_or_thesis,
 };
 use crate::report::Environment;
 use crate::report::bench::inclusion::{self, Config, Measured, STAND_INS};
@@ -244,25 +244,22 @@ fn time_plots(r: &mut Run, points: usize) -> Result<Vec<Block>> {
         );
         blocks.extend(r.plot(&chart, stem)?);
     }
-    let mut series = Vec::new();
-    for (i, (key, label)) in
-        [("gpu", "GPU"), ("gpu+tetragrid", "GPU + TetraGrid"), ("tetragrid", "TetraGrid")].iter().enumerate()
-    {
-        let k = format!("time:{key}");
-        series.extend(both(
-            &format!("cpu / {label}"),
-            i,
-            ratio_curve(r.facts, EXP, "time:cpu", &k),
-            ratio_curve(r.thesis, EXP, "time:cpu", &k),
-        ));
-    }
-    let chart = Chart::loglog(
+    let speedups: Vec<Speedup> =
+        [("time:gpu", "GPU"), ("time:gpu+tetragrid", "GPU + TetraGrid"), ("time:tetragrid", "TetraGrid")]
+            .into_iter()
+            .enumerate()
+            .map(|(i, (key, label))| {
+                (format!("cpu / {label}"), i, ["time:cpu", key], Some(["time:cpu", key]))
+            })
+            .collect();
+    blocks.extend(speedup_plot(
+        r,
+        EXP,
+        &speedups,
         "Point in solid: speed-up over the CPU test against triangles",
         "triangles",
-        "speed-up (×)",
-        series,
-    );
-    blocks.extend(r.plot(&chart, "inclusion-speedup")?);
+        "inclusion-speedup",
+    )?);
     Ok(blocks)
 }
 

@@ -17,7 +17,7 @@ use super::{Result, Run};
 use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, procedural};
 use crate::report::Table;
-use crate::report::plot::Series;
+use crate::report::plot::{Chart, Series};
 
 /// Runs an experiment: measures, adds facts, returns the section's blocks.
 pub type Runner = fn(&mut Run) -> Result<Vec<Block>>;
@@ -269,6 +269,29 @@ pub fn ratio_curve(facts: &Facts, experiment: &str, a: &str, b: &str) -> Vec<(f6
         .pairs(experiment, a, b)
         .map(|s| s.into_iter().map(|p| (p.1, p.2.value / p.3.value)).collect())
         .unwrap_or_default()
+}
+
+/// One curve of a speed-up chart: its label, its colour, today's ratio of two keys and
+/// the thesis' (when the thesis has both quantities).
+pub type Speedup<'a> = (String, usize, [&'a str; 2], Option<[&'a str; 2]>);
+
+/// A log-log chart of speed-ups against size (`x`), today's beside the thesis'.
+pub fn speedup_plot(
+    r: &mut Run,
+    experiment: &str,
+    curves: &[Speedup],
+    title: impl Into<String>,
+    x: &str,
+    stem: &str,
+) -> Result<Vec<Block>> {
+    let series = curves
+        .iter()
+        .flat_map(|(label, colour, [a, b], thesis)| {
+            let thesis = thesis.map_or_else(Vec::new, |[ta, tb]| ratio_curve(r.thesis, experiment, ta, tb));
+            both(label, *colour, ratio_curve(r.facts, experiment, a, b), thesis)
+        })
+        .collect();
+    r.plot(&Chart::loglog(title, x, "speed-up (×)", series), stem)
 }
 
 /// Today's curve and, when the thesis has points, the thesis' in the same colour.

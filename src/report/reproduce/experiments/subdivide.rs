@@ -1,7 +1,7 @@
 //! Catmull-Clark with fragment meshes (2010 §3.4, Table 5) through `texgeo bench
 //! subdivide`'s measuring code, plus a level sweep: where the GPU starts to win.
 
-use super::{Quantity, both, comparison, curve, details, ratio_curve};
+use super::{Quantity, Speedup, both, comparison, curve, details, speedup_plot};
 use crate::mesh::spec::MeshSpec;
 use crate::mesh::{Mesh, formats, procedural};
 use crate::report::bench::subdiv::{self, LevelTimes, Measured, Model, Settings, default_models};
@@ -217,24 +217,18 @@ fn face_plots(r: &mut Run) -> Result<Vec<Block>> {
     let chart =
         Chart::loglog(format!("Table 5: level-{LEVEL} time against faces"), "faces at level 5", "s", series);
     let mut blocks = r.plot(&chart, "subdivide-time-vs-faces")?;
-    let mut series = both(
-        "CPU / GPU path",
-        0,
-        ratio_curve(r.facts, EXP, "time:tcpu2", "time:gpu-path"),
-        ratio_curve(r.thesis, EXP, "time:tcpu2", "time:gpu-path"),
-    );
-    series.extend(both(
-        "OpenSubdiv / GPU path",
-        2,
-        ratio_curve(r.facts, EXP, "time:osd", "time:gpu-path"),
-        Vec::new(),
-    ));
-    let chart = Chart::loglog(
+    let cpu = ["time:tcpu2", "time:gpu-path"];
+    let speedups: [Speedup; 2] = [
+        ("CPU / GPU path".into(), 0, cpu, Some(cpu)),
+        ("OpenSubdiv / GPU path".into(), 2, ["time:osd", "time:gpu-path"], None),
+    ];
+    blocks.extend(speedup_plot(
+        r,
+        EXP,
+        &speedups,
         format!("Subdivision: GPU speed-up at level {LEVEL} against faces"),
         "faces at level 5",
-        "speed-up (×)",
-        series,
-    );
-    blocks.extend(r.plot(&chart, "subdivide-speedup")?);
+        "subdivide-speedup",
+    )?);
     Ok(blocks)
 }
