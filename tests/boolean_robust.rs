@@ -6,7 +6,7 @@
 //! vol(A−B) = vol(A) − vol(A∩B).
 
 use glam::{DAffine3, DVec3};
-use texgeo::boolean::{self, Evaluation, Names, Operation, Options, cgal};
+use texgeo::boolean::{self, Evaluation, Names, Operation, Options, Transform, cgal};
 use texgeo::inclusion::Method;
 use texgeo::mesh::covering::Covering;
 use texgeo::mesh::frame::Frame;
@@ -319,4 +319,38 @@ fn sphere_against_its_exact_quarter_turn() {
     let v = volume(&a);
     assert!((vu - v).abs() <= REL * v && (vi - v).abs() <= REL * v, "{vu} {vi}");
     assert!(vd <= REL * v && vs <= REL * v, "{vd} {vs}");
+}
+
+/// S = A − B, then S against B and against A, every operation: each result must be a
+/// valid operand (the full check, as when its file is read back) and the volumes must add
+/// up. S's corners that were intersection points are now input vertices within an ulp of
+/// B's faces and edges, and S carries B's faces reversed with those corners among theirs.
+fn reuse_difference(name: &str, a: &Mesh, b: &Mesh) {
+    let (ev, _) = check_exact(&format!("{name}: A − B"), a, b, false);
+    let s = ev.result(Operation::Difference, true).unwrap();
+    assert!(volume(&s) > 0.0, "{name}: {}", volume(&s));
+    check_exact(&format!("{name}: (A − B) against B"), &s, b, false);
+    check_exact(&format!("{name}: (A − B) against A"), &s, a, false);
+}
+
+/// A thin result used again against the solids that made it: the star prism minus its
+/// copy turned 1e-6° about a skew axis through its centre (as `--transform-b` turns it)
+/// is slivers, whose faces meet B's at creases of ~1e-8 rad and whose corners lie a few
+/// 1e-9 from B's vertices; S − A is empty up to specks that carry no volume.
+#[test]
+fn a_sliver_difference_reused_against_the_solids_that_made_it() {
+    let a = procedural::star_prism();
+    let turn = Transform::parse("translate 0 0 -0.5; rotate 1 2 3 1e-6; translate 0 0 0.5").unwrap();
+    reuse_difference("star prism, B turned 1e-6°", &a, &turn.apply(&a).unwrap());
+}
+
+/// A difference used again against the solid that cut it, B shifted by half the width:
+/// corners of A − B that were intersection points on B's edges lie an ulp beside them.
+#[test]
+fn a_half_shifted_difference_reused_against_the_solids_that_made_it() {
+    let a = procedural::sphere(16, 32);
+    let (lo, hi) = a.bounds();
+    assert_eq!(hi.x - lo.x, 2.0);
+    let shift = Transform::parse("translate 1 0 0").unwrap();
+    reuse_difference("sphere, B shifted by half", &a, &shift.apply(&a).unwrap());
 }

@@ -344,7 +344,16 @@ impl Evaluation {
             .map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
         let from_a = done.origin.iter().filter(|&&o| (o as usize) < from_a).count();
         let repair = Repair { moved: self.frame.length_out(done.repair.moved), ..done.repair };
-        Ok(Output { mesh: select::assemble(&done.positions, &done.triangles), from_a, repair })
+        let mesh = select::assemble(&done.positions, &done.triangles);
+        if !repair.is_clean() {
+            // What the repair changed gets the whole operand check (nesting and orientation
+            // of shells included): never a result texgeo would refuse as an operand.
+            input::check(&mesh, self.frame, false).map_err(|e| BooleanError::Invalid {
+                op,
+                reason: InvalidResult::NotOperand { reason: e.to_string() },
+            })?;
+        }
+        Ok(Output { mesh, from_a, repair })
     }
 
     /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its

@@ -25,10 +25,17 @@
 //! ulps ([`snap_distance`]; the lowest id stays: A's vertices, then B's, then
 //! intersection points), with the same clean-up: nearly coincident points of the two
 //! operands (a copy turned a quarter in floating point) then meet instead of crossing.
+//! A corner within those few ulps of an edge it is not on (a point that lay on an edge of
+//! the other operand before rounding, in a result used again against the solid that cut
+//! it) splits that edge there, in every triangle on it, where that leaves fewer crossings
+//! and triangles without area around it ([`local_split`]); the pieces that come to
+//! coincide with opposite orientations then cancel, uncut input triangles among them.
 //! Then, for every crossing pair or flat triangle, its shortest edge with an
 //! intersection point at one end is collapsed if it is shorter than [`COLLAPSE`] × the
-//! operands' diagonal: the intersection point moves onto the other end (an input vertex
-//! moves only by a snap). A flat triangle with no such edge (a corner on its opposite edge) is
+//! operands' diagonal: the intersection point moves onto the other end. Only where its
+//! triangles have no such edge does an edge between two input vertices go (the two
+//! operands' vertices a hair apart, as where a result is used again against the solid
+//! that cut it): either onto the other. A flat triangle with no such edge (a corner on its opposite edge) is
 //! removed by splitting its neighbour across that edge at the corner. A collapse keeps every directed edge balanced — the triangles on the
 //! edge vanish and their other edges pair up — so the result stays closed and oriented;
 //! two triangles that come to coincide with opposite orientations cancel. The moved
@@ -37,8 +44,12 @@
 //! its triangles' corners to a neighbouring f64 position, each coordinate by an ulp or two,
 //! where the exact tests around that point find nothing crossing ([`nudge`]); then
 //! everything is checked again. A shell that encloses no volume by the
-//! operand rule (a sliver flattened by rounding) is dropped whole. Anything still
-//! invalid is an error naming the faces and the place: never a silently invalid result.
+//! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
+//! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
+//! volume over its area) than a flat region's thickness, is dropped whole. A result the
+//! repair changed gets the whole operand check once assembled (the caller,
+//! [`InvalidResult::NotOperand`]). Anything still invalid is an error naming the faces and
+//! the place: never a silently invalid result.
 
 use std::collections::HashMap;
 
@@ -58,8 +69,12 @@ use crate::mesh::triangulate::{self, Projection};
 /// times the sliver's length), far above the slivers' widths near the cut curve.
 pub const COLLAPSE: f64 = 1e-7;
 
-/// Rounds of collapse and re-check before giving up.
-const ROUNDS: usize = 8;
+/// Rounds of snaps, splits and collapses before only ulp moves are left (each round
+/// repairs every defect it can at once; one repair may uncover the next one beside it).
+const ROUNDS: usize = 32;
+
+/// Rounds of ulp moves before giving up.
+const NUDGES: usize = 16;
 
 /// How thin a region between two nearly coincident faces may be to count as flat, for
 /// points with coordinates up to `max_abs` and operands of bounding-box diagonal
@@ -88,6 +103,9 @@ pub struct Repair {
     /// Points snapped onto a point a few ulps away (the corners of crossing or flat
     /// triangles: nearly coincident points of the two operands and the cut).
     pub snapped: usize,
+    /// Edges split at a corner within a few ulps of them (a corner of a crossing or flat
+    /// triangle that lay on the edge before rounding).
+    pub split_edges: usize,
     /// Intersection points moved to a neighbouring f64 position (each coordinate by an ulp
     /// or two) where a crossing remained that no snap or collapse removed.
     pub ulp_moves: usize,
@@ -104,7 +122,8 @@ pub struct Repair {
     /// Long flat triangles (a corner on the opposite edge once rounded) removed by
     /// splitting the neighbour across that edge at the corner.
     pub flipped: usize,
-    /// Shells dropped because they enclose no volume.
+    /// Shells dropped because they enclose no volume (or are specks no wider than the
+    /// longest edge a repair collapses, or sheets thinner on average than a flat region).
     pub dropped_shells: usize,
     /// Farthest any point moved.
     pub moved: f64,
@@ -116,6 +135,7 @@ impl Repair {
         self.crossings == 0
             && self.flat_triangles == 0
             && self.removed_triangles == 0
+            && self.split_edges == 0
             && self.pockets == 0
             && self.flipped == 0
             && self.dropped_shells == 0
@@ -127,12 +147,13 @@ impl std::fmt::Display for Repair {
         write!(
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
-             {} points moved by an ulp or two, {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
+             {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
              ({} triangles rebuilt), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
             self.snapped,
+            self.split_edges,
             self.ulp_moves,
             self.collapsed_edges,
             self.removed_triangles,
@@ -160,6 +181,8 @@ pub enum InvalidResult {
     Flat { face: usize, near: DVec3 },
     #[error("it encloses no volume once rounded to f64 (volume {volume}) but is not empty")]
     NoVolume { volume: f64 },
+    #[error("once rounded to f64 and repaired it is not a solid texgeo accepts as an operand: {reason}")]
+    NotOperand { reason: String },
 }
 
 impl InvalidResult {
@@ -173,6 +196,7 @@ impl InvalidResult {
             InvalidResult::NoVolume { volume } => {
                 InvalidResult::NoVolume { volume: frame.volume_out(volume) }
             }
+            InvalidResult::NotOperand { reason } => InvalidResult::NotOperand { reason },
         }
     }
 }
@@ -213,8 +237,9 @@ pub fn finish(
         });
     }
     let mut c = Cleanup::new(points, first_new, tris, changed, diagonal);
-    // Welding is a collapse of edges of length zero: the same clean-up.
-    c.collapse(&HashMap::new());
+    // Welding is a collapse of edges of length zero: the same clean-up (among the changed
+    // triangles: uncut ones of one operand do not coincide with another's).
+    collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
     let mut nudges = 0;
     for round in 0.. {
@@ -227,7 +252,7 @@ pub fn finish(
             break;
         }
         let more = round < ROUNDS;
-        if more && c.snap(&crossings, &flat) {
+        if more && (c.snap(&crossings, &flat) || c.split_edges(&crossings, &flat)) {
             continue;
         }
         let plan = c.plan(&crossings, &flat);
@@ -241,7 +266,7 @@ pub fn finish(
                 .stuck
                 .or_else(|| crossings.first().map(|x| c.crossing(x)))
                 .unwrap_or_else(|| c.flat_face(flat[0]));
-            if nudges < ROUNDS && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.repair) {
+            if nudges < NUDGES && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.repair) {
                 nudges += 1;
                 continue;
             }
@@ -342,25 +367,32 @@ impl Cleanup {
         true
     }
 
-    /// The shortest collapsible edge of `faces` (one end an intersection point, at most
-    /// `limit` long): (length, the end kept, the end that goes).
+    /// The shortest collapsible edge of `faces` (at most `limit` long): (length, the end
+    /// kept, the end that goes). Edges with an intersection point at an end come first;
+    /// an edge between two input vertices (of the two operands, a hair apart, as where a
+    /// result is used again against the solid that cut it) only where there is none.
     fn shortest_edge(&self, faces: &[usize]) -> Option<(f64, u32, u32)> {
-        faces
-            .iter()
-            .flat_map(|&f| {
+        let length =
+            |(p, q): (u32, u32)| self.soup.positions[p as usize].distance(self.soup.positions[q as usize]);
+        let edges = || {
+            faces.iter().flat_map(|&f| {
                 let t = self.soup.triangles[f];
                 (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
             })
-            .filter(|&(p, q)| self.is_new(p) || self.is_new(q))
+        };
+        let with_new =
+            edges().any(|(p, q)| (self.is_new(p) || self.is_new(q)) && length((p, q)) <= self.limit);
+        edges()
+            .filter(|&(p, q)| !with_new || self.is_new(p) || self.is_new(q))
             .map(|(p, q)| {
-                let (keep, gone) = if !self.is_new(p) {
-                    (p, q)
-                } else if !self.is_new(q) {
-                    (q, p)
-                } else {
+                let (keep, gone) = if self.is_new(p) == self.is_new(q) {
                     (p.min(q), p.max(q))
+                } else if !self.is_new(p) {
+                    (p, q)
+                } else {
+                    (q, p)
                 };
-                (self.soup.positions[p as usize].distance(self.soup.positions[q as usize]), keep, gone)
+                (length((p, q)), keep, gone)
             })
             .filter(|e| e.0 <= self.limit)
             .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
@@ -424,8 +456,14 @@ impl Cleanup {
             if gone[a] || gone[b] {
                 continue;
             }
-            let Some(f) = flatten(&self.soup, &by_edge, &self.origin, a, self.thickness) else { continue };
-            if f.removed.iter().any(|&t| gone[t]) || !(f.removed.contains(&a) && f.removed.contains(&b)) {
+            // The region in the plane of either triangle.
+            let Some(f) = [a, b].into_iter().find_map(|seed| {
+                flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness)
+                    .filter(|f| f.removed.contains(&a) && f.removed.contains(&b))
+            }) else {
+                continue;
+            };
+            if f.removed.iter().any(|&t| gone[t]) {
                 continue;
             }
             for &t in &f.removed {
@@ -459,8 +497,12 @@ impl Cleanup {
             if busy.contains(&keep) || busy.contains(&gone) {
                 continue;
             }
-            let ways: &[(u32, u32)] =
-                if self.is_new(keep) { &[(keep, gone), (gone, keep)] } else { &[(keep, gone)] };
+            // Onto either end when both are intersection points or both input vertices.
+            let ways: &[(u32, u32)] = if self.is_new(keep) == self.is_new(gone) {
+                &[(keep, gone), (gone, keep)]
+            } else {
+                &[(keep, gone)]
+            };
             let Some((_, keep, gone)) = ways
                 .iter()
                 .filter_map(|&(keep, gone)| {
@@ -481,7 +523,35 @@ impl Cleanup {
     }
 
     fn collapse(&mut self, map: &HashMap<u32, u32>) {
-        collapse(&mut self.soup, &mut self.origin, &mut self.changed, map, &mut self.repair);
+        collapse(&mut self.soup, &mut self.origin, &mut self.changed, map, true, &mut self.repair);
+    }
+
+    /// Splits the edges that pass within a few ulps of a corner of the defects' triangles
+    /// ([`edge_splits`]) at that corner, each only where it leaves fewer crossings and
+    /// triangles without area around it than before (as a collapse); faces that then
+    /// coincide with opposite orientations cancel. True when any edge was split.
+    fn split_edges(&mut self, crossings: &[(usize, usize)], flat: &[usize]) -> bool {
+        let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
+        let candidates = edge_splits(&self.soup, corners, self.snap);
+        if candidates.is_empty() {
+            return false;
+        }
+        let boxes = self.soup.boxes();
+        let mut chosen: Vec<((u32, u32), u32)> = candidates
+            .into_par_iter()
+            .filter(|&(edge, at)| {
+                let (before, after) = local_split(&self.soup, &boxes, edge, at);
+                after < before
+            })
+            .collect();
+        if chosen.is_empty() {
+            return false;
+        }
+        chosen.sort_unstable();
+        self.repair.split_edges += chosen.len();
+        split_edges(&mut self.soup, &mut self.origin, &mut self.changed, &chosen.into_iter().collect());
+        self.collapse(&HashMap::new());
+        true
     }
 
     /// The repaired triangles in their origins' order, flat shells dropped.
@@ -493,7 +563,7 @@ impl Cleanup {
             self.soup.triangles = order.iter().map(|&k| self.soup.triangles[k]).collect();
             self.origin = order.iter().map(|&k| self.origin[k]).collect();
         }
-        drop_flat_shells(&mut self.soup, &mut self.origin, &mut self.repair)?;
+        drop_flat_shells(&mut self.soup, &mut self.origin, self.limit, self.thickness, &mut self.repair)?;
         Ok(Finished {
             positions: self.soup.positions,
             triangles: self.soup.triangles,
@@ -548,6 +618,105 @@ fn snap_map(soup: &TriangleSoup, faces: impl Iterator<Item = usize>, snap: f64) 
             (keep != v).then_some((v, keep))
         })
         .collect()
+}
+
+/// The edges to split for the corners of `faces`: an edge of the soup that passes within
+/// `snap` (per coordinate) of such a corner, strictly between its ends and not within
+/// `snap` of either (those are snaps), with the corner to split it at (a point that lay on
+/// the edge before rounding: a corner of a result used again against the solid that cut
+/// it). Nearest first, and none that shares a point with one taken before (so no triangle
+/// has two of them, and no split point is on another split edge).
+fn edge_splits(
+    soup: &TriangleSoup,
+    faces: impl Iterator<Item = usize>,
+    snap: f64,
+) -> HashMap<(u32, u32), u32> {
+    let mut corners: Vec<u32> = faces.flat_map(|f| soup.triangles[f]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    if corners.is_empty() {
+        return HashMap::new();
+    }
+    let boxes = soup.boxes();
+    let within = |a: DVec3, b: DVec3| (a - b).abs().max_element() <= snap;
+    let mut found: Vec<(f64, (u32, u32), u32)> = corners
+        .par_iter()
+        .flat_map_iter(|&v| {
+            let x = soup.positions[v as usize];
+            let mut hits = Vec::new();
+            for (t, tri) in soup.triangles.iter().enumerate() {
+                let (lo, hi) = boxes[t];
+                if (lo - x).max_element() > snap || (x - hi).max_element() > snap || tri.contains(&v) {
+                    continue;
+                }
+                for k in 0..3 {
+                    let (p, q) = (tri[k], tri[(k + 1) % 3]);
+                    let (pp, pq) = (soup.positions[p as usize], soup.positions[q as usize]);
+                    let d = pq - pp;
+                    let s = (x - pp).dot(d) / d.length_squared();
+                    if !(s > 0.0 && s < 1.0) || within(x, pp) || within(x, pq) {
+                        continue;
+                    }
+                    let off = (x - (pp + s * d)).abs().max_element();
+                    if off <= snap {
+                        hits.push((off, (p.min(q), p.max(q)), v));
+                    }
+                }
+            }
+            hits
+        })
+        .collect();
+    found.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut busy = std::collections::HashSet::new();
+    let mut splits = HashMap::new();
+    for (_, (p, q), v) in found {
+        if busy.contains(&p) || busy.contains(&q) || busy.contains(&v) {
+            continue;
+        }
+        busy.extend([p, q, v]);
+        splits.insert((p, q), v);
+    }
+    splits
+}
+
+/// Splits every triangle with an edge in `splits` (ends in increasing order) at the point
+/// given for it (no triangle has two): each use of the edge becomes a path through the
+/// point, so every directed edge stays balanced. Pieces with a repeated corner (of a
+/// triangle whose own corner is the split point) are left to [`collapse`] to remove.
+fn split_edges(
+    soup: &mut TriangleSoup,
+    origin: &mut Vec<u32>,
+    changed: &mut Vec<bool>,
+    splits: &HashMap<(u32, u32), u32>,
+) {
+    let n = soup.triangles.len();
+    let (mut triangles, mut origins, mut flags) =
+        (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    for (t, &tri) in soup.triangles.iter().enumerate() {
+        let on = (0..3).find_map(|k| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            splits.get(&(a.min(b), a.max(b))).map(|&m| (k, m))
+        });
+        match on {
+            Some((k, m)) => {
+                let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                for piece in [[a, m, c], [m, b, c]] {
+                    triangles.push(piece);
+                    origins.push(origin[t]);
+                    flags.push(true);
+                }
+            }
+            None => {
+                triangles.push(tri);
+                origins.push(origin[t]);
+                flags.push(changed[t]);
+            }
+        }
+    }
+    soup.triangles = triangles;
+    *origin = origins;
+    *changed = flags;
+    soup.face_of = (0..soup.triangles.len() as u32).collect();
 }
 
 /// For a flat triangle f (a, b, m) whose corner m lies strictly inside its edge ab once
@@ -723,8 +892,33 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
     let before = count(&sub, &[g, k]);
     let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
     let mut changed = vec![true; sub.triangles.len()];
-    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), &mut Repair::default());
+    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), true, &mut Repair::default());
     (before, count(&sub, &[k]))
+}
+
+/// Crossings and triangles without area at the ends of `edge` and at `at` before and after
+/// the edge is split at `at` (and faces that then coincide with opposite orientations
+/// cancel): their triangles against those whose boxes meet theirs.
+fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), at: u32) -> (usize, usize) {
+    let ends = [edge.0, edge.1, at];
+    let (lo, hi) = (0..soup.triangles.len())
+        .filter(|&t| soup.triangles[t].iter().any(|v| ends.contains(v)))
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
+    let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
+    let count = |sub: &TriangleSoup, at: &[u32]| {
+        let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
+        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
+        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
+    };
+    let local = ends.map(|v| ids[&v]);
+    let before = count(&sub, &local);
+    let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
+    let mut changed = vec![true; sub.triangles.len()];
+    let (p, q) = (local[0], local[1]);
+    let splits = HashMap::from([((p.min(q), p.max(q)), local[2])]);
+    split_edges(&mut sub, &mut origin, &mut changed, &splits);
+    collapse(&mut sub, &mut origin, &mut changed, &HashMap::new(), true, &mut Repair::default());
+    (before, count(&sub, &local))
 }
 
 /// The triangles of `soup` whose boxes meet the box `lo`..`hi`, as a soup of their own
@@ -892,12 +1086,14 @@ fn nudge(
 
 /// Applies `map` (point → the point it collapses onto) to every triangle, removes the
 /// triangles left without three distinct corners and pairs of opposite coinciding
-/// triangles, and marks every triangle at a kept point changed.
+/// triangles (with `uncut_too`, an uncut input triangle with a changed one too), and marks
+/// every triangle at a kept point changed.
 fn collapse(
     soup: &mut TriangleSoup,
     origin: &mut Vec<u32>,
     changed: &mut Vec<bool>,
     map: &HashMap<u32, u32>,
+    uncut_too: bool,
     repair: &mut Repair,
 ) {
     let kept: std::collections::HashSet<u32> = map.values().copied().collect();
@@ -912,11 +1108,23 @@ fn collapse(
     }
     // Coinciding triangles with opposite orientations cancel (their edges balance).
     let mut by_corners: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    let sorted = |t: [u32; 3]| {
+        let mut key = t;
+        key.sort_unstable();
+        key
+    };
     for (k, (t, _, c)) in next.iter().enumerate() {
         if *c {
-            let mut key = *t;
-            key.sort_unstable();
-            by_corners.entry(key).or_default().push(k);
+            by_corners.entry(sorted(*t)).or_default().push(k);
+        }
+    }
+    // A face of one operand that was a face of the other reversed, in a result used again
+    // against that other, meets it again once a split or snap has made their corners one.
+    if uncut_too && !by_corners.is_empty() {
+        for (k, (t, _, c)) in next.iter().enumerate() {
+            if !*c && let Some(group) = by_corners.get_mut(&sorted(*t)) {
+                group.push(k);
+            }
         }
     }
     let mut gone = vec![false; next.len()];
@@ -976,11 +1184,16 @@ fn retain_marked<T>(v: &mut Vec<T>, keep: &[bool]) {
     });
 }
 
-/// Drops every shell that encloses no volume by the operand rule, then applies the rule
-/// to what is left.
+/// Drops every shell that encloses no volume by the operand rule, that is no wider than
+/// `speck` (the longest edge a repair collapses) in every direction, or whose mean
+/// thickness (twice its volume over its area) is at most `thickness` (a sheet between two
+/// nearly coincident surfaces, too thin for f64): what rounding left of a sliver, whose
+/// orientation it may have turned. Then applies the rule to what is left.
 fn drop_flat_shells(
     soup: &mut TriangleSoup,
     origin: &mut Vec<u32>,
+    speck: f64,
+    thickness: f64,
     repair: &mut Repair,
 ) -> Result<(), InvalidResult> {
     let mut sets = UnionFind::new(soup.positions.len());
@@ -993,18 +1206,24 @@ fn drop_flat_shells(
             (lo.min(soup.positions[v as usize]), hi.max(soup.positions[v as usize]))
         });
     let apex = (lo + hi) * 0.5;
-    // Per shell root: volume and box.
-    let mut shells: HashMap<u32, (f64, DVec3, DVec3)> = HashMap::new();
+    // Per shell root: volume, box and area.
+    let mut shells: HashMap<u32, (f64, DVec3, DVec3, f64)> = HashMap::new();
     let roots: Vec<u32> = soup.triangles.iter().map(|t| sets.find(t[0])).collect();
     for (t, &r) in soup.triangles.iter().zip(&roots) {
         let [a, b, c] = t.map(|v| soup.positions[v as usize]);
-        let e = shells.entry(r).or_insert((0.0, DVec3::INFINITY, DVec3::NEG_INFINITY));
+        let e = shells.entry(r).or_insert((0.0, DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0));
         e.0 += signed_tetra_volume(apex, a, b, c);
         e.1 = e.1.min(a.min(b).min(c));
         e.2 = e.2.max(a.max(b).max(c));
+        e.3 += 0.5 * (b - a).cross(c - a).length();
     }
-    let flat: std::collections::HashSet<u32> =
-        shells.iter().filter(|(_, s)| is_flat(s.0, s.1, s.2)).map(|(&r, _)| r).collect();
+    let flat: std::collections::HashSet<u32> = shells
+        .iter()
+        .filter(|(_, s)| {
+            is_flat(s.0, s.1, s.2) || (s.2 - s.1).max_element() <= speck || 2.0 * s.0.abs() <= thickness * s.3
+        })
+        .map(|(&r, _)| r)
+        .collect();
     if !flat.is_empty() {
         repair.dropped_shells = flat.len();
         let keep: Vec<bool> = roots.iter().map(|r| !flat.contains(r)).collect();

@@ -211,6 +211,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "crossings": r.crossings,
         "flat_triangles": r.flat_triangles,
         "snapped": r.snapped,
+        "split_edges": r.split_edges,
         "ulp_moves": r.ulp_moves,
         "collapsed_edges": r.collapsed_edges,
         "removed_triangles": r.removed_triangles,
