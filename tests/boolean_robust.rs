@@ -354,3 +354,26 @@ fn a_half_shifted_difference_reused_against_the_solids_that_made_it() {
     let shift = Transform::parse("translate 1 0 0").unwrap();
     reuse_difference("sphere, B shifted by half", &a, &shift.apply(&a).unwrap());
 }
+
+/// A result far smaller than the operands is a result, not what rounding left of a sliver:
+/// a cube 1e-8 the size of the other, straddling its face or beside it, is kept whole by
+/// every operation (its corners, rounded at coordinates near 1, are good to ~1e-8 of its
+/// size, hence the volume's tolerance).
+#[test]
+fn a_tiny_solid_is_kept_whole() {
+    let a = procedural::cube();
+    let s = 1e-8;
+    let small =
+        |centre: DVec3| moved(&a, DAffine3::from_translation(centre) * DAffine3::from_scale(DVec3::splat(s)));
+    let v_small = 8.0 * s * s * s;
+    // Straddling the face x = 1: half of it inside.
+    let (ev, [_, vi, ..]) = check_exact("tiny straddling", &a, &small(DVec3::new(1.0, 0.1, 0.2)), false);
+    assert!(ev.result(Operation::Intersection, true).unwrap().num_faces() > 0, "A ∩ B dropped");
+    assert!((vi - v_small / 2.0).abs() <= 1e-6 * v_small, "A ∩ B {vi} vs {}", v_small / 2.0);
+    // Beside it: A ∪ B keeps both shells.
+    let b = small(DVec3::new(1.0 + 3.0 * s, 0.1, 0.2));
+    let (ev, [_, vi, ..]) = check_exact("tiny beside", &a, &b, false);
+    assert_eq!(vi, 0.0);
+    let union = ev.result(Operation::Union, true).unwrap();
+    assert_eq!(union.num_faces(), a.num_faces() + b.num_faces(), "B dropped from A ∪ B");
+}

@@ -563,7 +563,10 @@ impl Cleanup {
             self.soup.triangles = order.iter().map(|&k| self.soup.triangles[k]).collect();
             self.origin = order.iter().map(|&k| self.origin[k]).collect();
         }
-        drop_flat_shells(&mut self.soup, &mut self.origin, self.limit, self.thickness, &mut self.repair)?;
+        // Specks and sheets are what a repair leaves of a sliver; a result that needed none
+        // keeps every shell that encloses volume, however small next to the operands.
+        let leftovers = (!self.repair.is_clean()).then_some((self.limit, self.thickness));
+        drop_flat_shells(&mut self.soup, &mut self.origin, leftovers, &mut self.repair)?;
         Ok(Finished {
             positions: self.soup.positions,
             triangles: self.soup.triangles,
@@ -1184,16 +1187,16 @@ fn retain_marked<T>(v: &mut Vec<T>, keep: &[bool]) {
     });
 }
 
-/// Drops every shell that encloses no volume by the operand rule, that is no wider than
-/// `speck` (the longest edge a repair collapses) in every direction, or whose mean
-/// thickness (twice its volume over its area) is at most `thickness` (a sheet between two
-/// nearly coincident surfaces, too thin for f64): what rounding left of a sliver, whose
-/// orientation it may have turned. Then applies the rule to what is left.
+/// Drops every shell that encloses no volume by the operand rule and, after a repair
+/// (`leftovers` = (speck, thickness)), every shell no wider than `speck` (the longest edge
+/// a repair collapses) in every direction or whose mean thickness (twice its volume over
+/// its area) is at most `thickness` (a sheet between two nearly coincident surfaces, too
+/// thin for f64): what rounding left of a sliver, whose orientation it may have turned.
+/// Then applies the rule to what is left.
 fn drop_flat_shells(
     soup: &mut TriangleSoup,
     origin: &mut Vec<u32>,
-    speck: f64,
-    thickness: f64,
+    leftovers: Option<(f64, f64)>,
     repair: &mut Repair,
 ) -> Result<(), InvalidResult> {
     let mut sets = UnionFind::new(soup.positions.len());
@@ -1220,7 +1223,10 @@ fn drop_flat_shells(
     let flat: std::collections::HashSet<u32> = shells
         .iter()
         .filter(|(_, s)| {
-            is_flat(s.0, s.1, s.2) || (s.2 - s.1).max_element() <= speck || 2.0 * s.0.abs() <= thickness * s.3
+            is_flat(s.0, s.1, s.2)
+                || leftovers.is_some_and(|(speck, thickness)| {
+                    (s.2 - s.1).max_element() <= speck || 2.0 * s.0.abs() <= thickness * s.3
+                })
         })
         .map(|(&r, _)| r)
         .collect();
