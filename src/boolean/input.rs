@@ -119,15 +119,16 @@ pub fn piece_boxes(soup: &TriangleSoup) -> Vec<(DVec3, DVec3)> {
         sets.union(t[0], t[1]);
         sets.union(t[0], t[2]);
     }
-    let mut boxes: std::collections::HashMap<u32, (DVec3, DVec3)> = std::collections::HashMap::new();
+    // Per root (a vertex id): its piece's box, in the order of the roots' ids.
+    let mut boxes: Vec<Option<(DVec3, DVec3)>> = vec![None; soup.positions.len()];
     for t in &soup.triangles {
-        let e = boxes.entry(sets.find(t[0])).or_insert((DVec3::INFINITY, DVec3::NEG_INFINITY));
+        let e = boxes[sets.find(t[0]) as usize].get_or_insert((DVec3::INFINITY, DVec3::NEG_INFINITY));
         for &v in t {
             let p = soup.positions[v as usize];
             *e = (e.0.min(p), e.1.max(p));
         }
     }
-    boxes.into_values().collect()
+    boxes.into_iter().flatten().collect()
 }
 
 #[cfg(test)]

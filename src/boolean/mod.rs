@@ -202,11 +202,14 @@ pub fn evaluate(
 ) -> Result<Evaluation> {
     let mut timings = Timings::default();
     let start = Instant::now();
-    let memory = options.remember_verdicts.then(|| [Memory::of(a), Memory::of(b)]);
+    let memory = options.remember_verdicts.then(|| {
+        let (x, y) = rayon::join(|| Memory::of(a), || Memory::of(b));
+        [x, y]
+    });
     let known = memory.as_ref().map_or([None, None], |m| m.each_ref().map(Memory::recall));
     let fresh = known.each_ref().map(Option::is_none);
     let frame = Frame::of(&[a, b]);
-    let (framed_a, framed_b) = (frame.mesh_in_ref(a), frame.mesh_in_ref(b));
+    let (framed_a, framed_b) = rayon::join(|| frame.mesh_in_ref(a), || frame.mesh_in_ref(b));
     let [(sa, va), (sb, vb)] =
         check_operands(&framed_a, &framed_b, names, frame, options.allow_self_intersections, known)?;
     if let Some(memory) = &memory {
@@ -221,7 +224,8 @@ pub fn evaluate(
     // from its triangles on a non-planar face whose centroid fan folds, by up to the
     // face's distance from a plane: a vertex of the other operand in that gap would take
     // the wrong side, and the groups around it with it.)
-    let (a, b) = (&sa.to_mesh()?, &sb.to_mesh()?);
+    let (a, b) = rayon::join(|| sa.to_mesh(), || sb.to_mesh());
+    let (a, b) = (&a?, &b?);
     timings.check = start.elapsed();
 
     // The operands' closure is checked above.

@@ -51,7 +51,7 @@
 //! [`InvalidResult::NotOperand`]). Anything still invalid is an error naming the faces and
 //! the place: never a silently invalid result.
 
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -491,7 +491,7 @@ impl Cleanup {
     fn choose_collapses(&mut self, mut edges: Vec<(f64, u32, u32)>) -> HashMap<u32, u32> {
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         let mut map: HashMap<u32, u32> = HashMap::new();
-        let mut busy = std::collections::HashSet::new();
+        let mut busy = HashSet::new();
         let boxes = if edges.is_empty() { Vec::new() } else { self.soup.boxes() };
         for (length, keep, gone) in edges {
             if busy.contains(&keep) || busy.contains(&gone) {
@@ -794,7 +794,7 @@ fn flatten(
     let within = |t: usize| soup.triangle(t).iter().all(|&p| (p - a).dot(unit).abs() <= thickness);
     // The faces in the plane, connected to the seed.
     let mut region = vec![seed];
-    let mut seen = std::collections::HashSet::from([seed]);
+    let mut seen = HashSet::from_iter([seed]);
     let mut next = 0;
     while next < region.len() {
         let tri = soup.triangles[region[next]];
@@ -895,7 +895,7 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
     let before = count(&sub, &[g, k]);
     let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
     let mut changed = vec![true; sub.triangles.len()];
-    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from([(g, k)]), true, &mut Repair::default());
+    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from_iter([(g, k)]), true, &mut Repair::default());
     (before, count(&sub, &[k]))
 }
 
@@ -918,7 +918,7 @@ fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), 
     let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
     let mut changed = vec![true; sub.triangles.len()];
     let (p, q) = (local[0], local[1]);
-    let splits = HashMap::from([((p.min(q), p.max(q)), local[2])]);
+    let splits = HashMap::from_iter([((p.min(q), p.max(q)), local[2])]);
     split_edges(&mut sub, &mut origin, &mut changed, &splits);
     collapse(&mut sub, &mut origin, &mut changed, &HashMap::new(), true, &mut Repair::default());
     (before, count(&sub, &local))
@@ -1006,7 +1006,7 @@ fn nudge(
 ) -> bool {
     let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
     let mut star: HashMap<u32, Vec<usize>> = HashMap::new();
-    let mut taken = std::collections::HashSet::new();
+    let mut taken = HashSet::new();
     for (t, tri) in soup.triangles.iter().enumerate() {
         for &v in tri {
             star.entry(v).or_default().push(t);
@@ -1014,7 +1014,7 @@ fn nudge(
         }
     }
     let mut boxes = soup.boxes();
-    let mut moved = std::collections::HashSet::new();
+    let mut moved = HashSet::new();
     let defects = crossings.iter().map(|&(a, b)| vec![a, b]).chain(flat.iter().map(|&f| vec![f]));
     for faces in defects {
         let mut corners: Vec<u32> =
@@ -1099,7 +1099,7 @@ fn collapse(
     uncut_too: bool,
     repair: &mut Repair,
 ) {
-    let kept: std::collections::HashSet<u32> = map.values().copied().collect();
+    let kept: HashSet<u32> = map.values().copied().collect();
     let before = soup.triangles.len();
     let mut next = Vec::with_capacity(before);
     for (k, t) in soup.triangles.iter().enumerate() {
@@ -1220,7 +1220,7 @@ fn drop_flat_shells(
         e.2 = e.2.max(a.max(b).max(c));
         e.3 += 0.5 * (b - a).cross(c - a).length();
     }
-    let flat: std::collections::HashSet<u32> = shells
+    let flat: HashSet<u32> = shells
         .iter()
         .filter(|(_, s)| {
             is_flat(s.0, s.1, s.2)

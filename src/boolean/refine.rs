@@ -471,6 +471,29 @@ fn cut_curve(a: &[TriangleSegment], b: &[TriangleSegment], id_of: &dyn Fn(&Key) 
     curve
 }
 
+/// An input edge's chain of point ids: its lower vertex, the points inside it in order,
+/// its higher vertex.
+struct Chain<'a> {
+    first: u32,
+    inner: &'a [u32],
+    last: u32,
+}
+
+impl Chain<'_> {
+    fn at(&self, k: usize) -> u32 {
+        match k {
+            0 => self.first,
+            k if k <= self.inner.len() => self.inner[k - 1],
+            _ => self.last,
+        }
+    }
+
+    /// The first place of `id` in the chain.
+    fn position(&self, id: u32) -> Option<usize> {
+        (0..self.inner.len() + 2).find(|&k| self.at(k) == id)
+    }
+}
+
 /// What refining one side needs to know about it.
 struct SideInput<'a> {
     side: Side,
@@ -508,20 +531,23 @@ fn refine_side<'p>(
         let along = (0..3).find_map(|e| {
             let (p, q) = (tri[e], tri[(e + 1) % 3]);
             let (lo, hi) = (p.min(q), p.max(q));
-            let mut chain = vec![(input.vertex_id)(lo)];
-            chain.extend_from_slice(input.edges.get(lo, hi));
-            chain.push((input.vertex_id)(hi));
-            let x = chain.iter().position(|&c| c == i0)?;
-            let y = chain.iter().position(|&c| c == i1)?;
+            let chain = Chain {
+                first: (input.vertex_id)(lo),
+                inner: input.edges.get(lo, hi),
+                last: (input.vertex_id)(hi),
+            };
+            let x = chain.position(i0)?;
+            let y = chain.position(i1)?;
             Some((chain, x, y))
         });
         match along {
             None => constraints.push((s.triangle, [i0, i1])),
             Some((chain, x, y)) => {
                 // Mark the pieces of the edge's chain between the two ends.
-                for w in chain[x.min(y)..=x.max(y)].windows(2) {
-                    if w[0] != w[1] {
-                        cut_edges.push(edge_key(w[0], w[1]));
+                for k in x.min(y)..x.max(y) {
+                    let (u, v) = (chain.at(k), chain.at(k + 1));
+                    if u != v {
+                        cut_edges.push(edge_key(u, v));
                     }
                 }
             }

@@ -20,7 +20,9 @@
 //! The result covers the triangle exactly, every triangle counter-clockwise by the exact
 //! orientation, every segment (split at the points it passes through) an edge.
 
-use std::collections::{HashMap, HashSet, VecDeque};
+use std::collections::VecDeque;
+
+use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
 use glam::DVec2;
 

@@ -431,7 +431,7 @@ fn split_at_t_junctions(soup: &TriangleSoup) -> Option<TriangleSoup> {
     // Exactly collinear points are in line order when ordered lexicographically.
     let order = |x: &u32, y: &u32| pos(*x).partial_cmp(&pos(*y)).unwrap_or(std::cmp::Ordering::Equal);
     let flat = |t: [u32; 3]| t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
-    let mut on_edge: std::collections::HashMap<(u32, u32), Vec<u32>> = std::collections::HashMap::new();
+    let mut on_edge: foldhash::HashMap<(u32, u32), Vec<u32>> = foldhash::HashMap::default();
     let mut degenerate = vec![false; soup.triangles.len()];
     for (t, &tri) in soup.triangles.iter().enumerate() {
         if !is_degenerate(soup.triangle(t)) {
@@ -693,7 +693,7 @@ fn crossings(
         })
         .collect();
     // Keep the first occurrence of each face pair, in discovery order.
-    let mut seen = std::collections::HashSet::new();
+    let mut seen = foldhash::HashSet::default();
     faces.retain(|p| seen.insert(*p));
     found.extend(faces);
     found.truncate(limit);

@@ -301,14 +301,16 @@ pub fn run_expression(
     })?;
     let booleans = total.elapsed() - read;
     let write = Instant::now();
-    write_mesh(output, &result)?;
+    // The volume reported is measured while the file is written.
+    let (written, volume) = rayon::join(|| write_mesh(output, &result), || volume(&result));
+    written?;
     let write = write.elapsed();
-    say!("{title}: {} triangles, volume {} -> {}", result.num_faces(), volume(&result), output.display());
+    say!("{title}: {} triangles, volume {} -> {}", result.num_faces(), volume, output.display());
     if evaluate.json {
         let mut object = serde_json::json!({
             "expr": title,
             "triangles": result.num_faces(),
-            "volume": volume(&result),
+            "volume": volume,
             "output": output.display().to_string(),
         });
         if evaluate.stats {
@@ -416,9 +418,12 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
         .collect::<anyhow::Result<_>>()?;
     let assemble = assemble.elapsed();
     let write = Instant::now();
-    for (_, path, out) in &results {
-        write_mesh(path, &out.mesh)?;
-    }
+    // The volumes reported are measured while the files are written.
+    let (written, volumes) = rayon::join(
+        || results.iter().try_for_each(|(_, path, out)| write_mesh(path, &out.mesh)),
+        || results.iter().map(|(_, _, out)| volume(&out.mesh)).collect::<Vec<f64>>(),
+    );
+    written?;
     if let Some(dir) = &args.pictures {
         let ctx = match &ctx {
             Some(ctx) => ctx.clone(),
@@ -432,19 +437,24 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
     }
     let write = write.elapsed();
 
-    for (op, path, out) in &results {
-        let mesh = &out.mesh;
+    for ((op, path, out), volume) in results.iter().zip(&volumes) {
         say!(
             "A {} B{}: {} triangles, volume {} -> {}",
             op.symbol(),
             if regularized { "" } else { " (non-regularized)" },
-            mesh.num_faces(),
-            volume(mesh),
+            out.mesh.num_faces(),
+            volume,
             path.display()
         );
     }
-    let run =
-        Finished { names: [&a_name, &b_name], ev: &ev, results: &results, regularized, ctx: ctx.as_ref() };
+    let run = Finished {
+        names: [&a_name, &b_name],
+        ev: &ev,
+        results: &results,
+        volumes: &volumes,
+        regularized,
+        ctx: ctx.as_ref(),
+    };
     let phases = Phases { read, assemble, write, total };
     if args.evaluate.json {
         texgeo::json::print(&run.json(args.evaluate.stats, &phases));
@@ -499,6 +509,8 @@ struct Finished<'a> {
     names: [&'a str; 2],
     ev: &'a Evaluation,
     results: &'a [Written],
+    /// Each result's volume.
+    volumes: &'a [f64],
     regularized: bool,
     ctx: Option<&'a Context>,
 }
@@ -511,12 +523,13 @@ impl Finished<'_> {
         let operations: Vec<serde_json::Value> = self
             .results
             .iter()
-            .map(|(op, path, out)| {
+            .zip(self.volumes)
+            .map(|((op, path, out), volume)| {
                 let mut o = serde_json::json!({
                     "op": op.name(),
                     "regularized": self.regularized,
                     "triangles": out.mesh.num_faces(),
-                    "volume": volume(&out.mesh),
+                    "volume": volume,
                     "output": path.display().to_string(),
                 });
                 if stats && self.regularized {
