@@ -1110,25 +1110,27 @@ fn collapse(
         next.push((t, origin[k], changed[k] || t.iter().any(|v| kept.contains(v))));
     }
     // Coinciding triangles with opposite orientations cancel (their edges balance).
-    let mut by_corners: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    // Changed triangles by their sorted corners (then by place): coinciding ones in a run.
     let sorted = |t: [u32; 3]| {
         let mut key = t;
         key.sort_unstable();
         key
     };
-    for (k, (t, _, c)) in next.iter().enumerate() {
-        if *c {
-            by_corners.entry(sorted(*t)).or_default().push(k);
-        }
-    }
+    let mut by_corners: Vec<([u32; 3], bool, usize)> =
+        next.iter().enumerate().filter(|(_, (_, _, c))| *c).map(|(k, (t, _, _))| (sorted(*t), false, k)).collect();
+    by_corners.sort_unstable();
     // A face of one operand that was a face of the other reversed, in a result used again
-    // against that other, meets it again once a split or snap has made their corners one.
+    // against that other, meets it again once a split or snap has made their corners one
+    // (after the changed ones of its run).
     if uncut_too && !by_corners.is_empty() {
-        for (k, (t, _, c)) in next.iter().enumerate() {
-            if !*c && let Some(group) = by_corners.get_mut(&sorted(*t)) {
-                group.push(k);
-            }
-        }
+        let uncut: Vec<([u32; 3], bool, usize)> = next
+            .iter()
+            .enumerate()
+            .filter(|(_, (t, _, c))| !*c && by_corners.binary_search_by(|x| x.0.cmp(&sorted(*t))).is_ok())
+            .map(|(k, (t, _, _))| (sorted(*t), true, k))
+            .collect();
+        by_corners.extend(uncut);
+        by_corners.sort_unstable();
     }
     let mut gone = vec![false; next.len()];
     let parity = |t: [u32; 3]| {
@@ -1136,8 +1138,9 @@ fn collapse(
         let m = t.iter().position(|v| *v == *t.iter().min().unwrap_or(&0)).unwrap_or(0);
         t[(m + 1) % 3] < t[(m + 2) % 3]
     };
-    for group in by_corners.values().filter(|g| g.len() > 1) {
-        let (up, down): (Vec<usize>, Vec<usize>) = group.iter().partition(|&&k| parity(next[k].0));
+    for group in by_corners.chunk_by(|x, y| x.0 == y.0).filter(|g| g.len() > 1) {
+        let (up, down): (Vec<usize>, Vec<usize>) =
+            group.iter().map(|x| x.2).partition(|&k| parity(next[k].0));
         for (&u, &d) in up.iter().zip(&down) {
             gone[u] = true;
             gone[d] = true;

@@ -564,13 +564,25 @@ fn refine_side<'p>(
         let hi = constraints.partition_point(|x| x.0 <= t);
         lo..hi
     };
-    let is_cut = |t: u32| {
-        let tri = soup.triangles[t as usize];
-        !range_of(input.inside, t).is_empty()
-            || !constraint_range(t).is_empty()
-            || (0..3).any(|e| !input.edges.get(tri[e], tri[(e + 1) % 3]).is_empty())
-    };
-    let cut: Vec<bool> = (0..n as u32).into_par_iter().with_min_len(4096).map(is_cut).collect();
+    // Cut: points inside, constraints, or points on an edge. Only edges between two
+    // vertices that end an edge with points are looked up.
+    let mut ends = vec![false; soup.positions.len()];
+    for &(p, q) in &input.edges.edges {
+        ends[p as usize] = true;
+        ends[q as usize] = true;
+    }
+    let mut cut = vec![false; n];
+    for t in input.inside.iter().map(|x| x.0).chain(constraints.iter().map(|x| x.0)) {
+        cut[t as usize] = true;
+    }
+    cut.par_iter_mut().with_min_len(4096).enumerate().for_each(|(t, c)| {
+        let tri = soup.triangles[t];
+        *c = *c
+            || (0..3).any(|e| {
+                let (p, q) = (tri[e], tri[(e + 1) % 3]);
+                ends[p as usize] && ends[q as usize] && !input.edges.get(p, q).is_empty()
+            });
+    });
     let cut_ids: Vec<u32> = (0..n as u32).filter(|&t| cut[t as usize]).collect();
     let pieces: Vec<Result<(u32, Constrained), RefineError>> = cut_ids
         .par_iter()

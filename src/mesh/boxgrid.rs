@@ -147,11 +147,16 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
         .with_min_len(4096)
         .fold(Vec::new, |mut acc, cell| {
             let run = &entries[start[cell] as usize..start[cell + 1] as usize];
+            // Two sets: a cell's boxes of `a` come before those of `b` (filled in the order
+            // of `all`), and each box of `a` is compared with those of `b` only.
+            let split = if b.is_some() { run.partition_point(|(_, t)| t >> 31 == 0) } else { run.len() };
             for (k, (bx, tx)) in run.iter().enumerate() {
-                for (by, ty) in &run[k + 1..] {
-                    if b.is_some() && (tx >> 31) == (ty >> 31) {
-                        continue;
-                    }
+                let others = match b {
+                    None => &run[k + 1..],
+                    Some(_) if k < split => &run[split..],
+                    Some(_) => break,
+                };
+                for (by, ty) in others {
                     if !overlaps(bx, by) {
                         continue;
                     }

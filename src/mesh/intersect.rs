@@ -349,18 +349,15 @@ impl TriangleSoup {
 /// For every vertex, the first vertex with exactly the same position (−0 equals +0).
 pub fn weld_by_position(positions: &[DVec3]) -> Vec<u32> {
     let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
-    let mut order: Vec<u32> = (0..positions.len() as u32).collect();
-    order.par_sort_unstable_by_key(|&i| (key(positions[i as usize]), i));
+    // (position's bits, id), sorted: each position's ids in a run, the lowest first.
+    let mut order: Vec<([u64; 3], u32)> =
+        positions.par_iter().with_min_len(4096).enumerate().map(|(i, &p)| (key(p), i as u32)).collect();
+    order.par_sort_unstable();
     let mut weld: Vec<u32> = (0..positions.len() as u32).collect();
-    let mut k = 0;
-    while k < order.len() {
-        let first = order[k];
-        let mut j = k + 1;
-        while j < order.len() && key(positions[order[j] as usize]) == key(positions[first as usize]) {
-            weld[order[j] as usize] = first;
-            j += 1;
+    for run in order.chunk_by(|x, y| x.0 == y.0) {
+        for &(_, i) in &run[1..] {
+            weld[i as usize] = run[0].1;
         }
-        k = j;
     }
     weld
 }
