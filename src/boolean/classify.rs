@@ -460,10 +460,21 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
         let offsets: Vec<usize> = (0..=n).map(|t| 3 * t).collect();
         let (start, items) =
             half_edges_by_lower_vertex(&offsets, refined.triangles.as_flattened(), r.points.len());
+        // The points on the cut curve: only an edge between two of them is looked up.
+        let mut on_curve = vec![false; r.points.len()];
+        for &e in &r.cut_edges {
+            on_curve[(e >> 32) as usize] = true;
+            on_curve[(e & 0xffff_ffff) as usize] = true;
+        }
+        let is_cut_edge = |lo: usize, hi: u32| {
+            on_curve[lo]
+                && on_curve[hi as usize]
+                && r.cut_edges.binary_search(&edge_key(lo as u32, hi)).is_ok()
+        };
         for lo in 0..r.points.len() {
             for run in items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32) {
                 let hi = (run[0] >> 32) as u32;
-                if run.len() > 1 && r.cut_edges.binary_search(&edge_key(lo as u32, hi)).is_err() {
+                if run.len() > 1 && !is_cut_edge(lo, hi) {
                     let triangle = |item: u64| (item & 0xffff_ffff) as u32 / 3;
                     let s = triangle(run[0]);
                     for &item in &run[1..] {

@@ -200,7 +200,8 @@ impl<O: Fn(u32, u32, u32) -> Sign> Mesh2<'_, O> {
     /// The triangles around vertex a, by rotation from its recorded triangle both ways.
     fn star(&self, a: u32) -> Vec<u32> {
         let start = self.around[a as usize];
-        let mut out = vec![start];
+        let mut out = Vec::with_capacity(16);
+        out.push(start);
         for dir in 0..2 {
             let mut t = start;
             for _ in 0..self.tris.len() {
