@@ -272,7 +272,7 @@ pub fn evaluate(
             Side::A => &mut solver_a,
             Side::B => &mut solver_b,
         };
-        solver.classify_fine(points, 64)
+        solver.classify_fine(points, 4)
     };
     let classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
     timings.classify = start.elapsed();
@@ -323,10 +323,6 @@ impl Evaluation {
             let mesh = select::assemble(&r.points, &tris);
             return Ok(Output { mesh, from_a, repair: Repair::default() });
         }
-        let (boundary, misoriented) = crate::mesh::validate::edge_defects(&tris);
-        if boundary > 0 || misoriented > 0 {
-            return Err(BooleanError::NotClosed { op, boundary, misoriented });
-        }
         // The same walk as `select`: which selected triangles are uncut input triangles.
         let mut changed = Vec::with_capacity(tris.len());
         for (from_a, side, classes) in [(true, &r.a, &c.a), (false, &r.b, &c.b)] {
@@ -344,8 +340,15 @@ impl Evaluation {
             .chain(&self.b.positions)
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let diagonal = (hi - lo).length();
-        let done = output::finish(&r.points, first_new, &tris, &changed, diagonal)
-            .map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
+        // The closure test runs beside the check after rounding; its verdict comes first.
+        let ((boundary, misoriented), done) = rayon::join(
+            || crate::mesh::validate::edge_defects(&tris),
+            || output::finish(&r.points, first_new, &tris, &changed, diagonal),
+        );
+        if boundary > 0 || misoriented > 0 {
+            return Err(BooleanError::NotClosed { op, boundary, misoriented });
+        }
+        let done = done.map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
         let from_a = done.origin.iter().filter(|&&o| (o as usize) < from_a).count();
         let repair = Repair { moved: self.frame.length_out(done.repair.moved), ..done.repair };
         let mesh = select::assemble(&done.positions, &done.triangles);
