@@ -341,9 +341,9 @@ impl Evaluation {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let diagonal = (hi - lo).length();
         // The closure test runs beside the check after rounding; its verdict comes first.
-        let ((boundary, misoriented), done) = rayon::join(
-            || crate::mesh::validate::edge_defects(&tris),
+        let (done, (boundary, misoriented)) = rayon::join(
             || output::finish(&r.points, first_new, &tris, &changed, diagonal),
+            || crate::mesh::validate::edge_defects(&tris),
         );
         if boundary > 0 || misoriented > 0 {
             return Err(BooleanError::NotClosed { op, boundary, misoriented });
