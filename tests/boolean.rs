@@ -3,6 +3,9 @@
 //! (volume and area to 1e-9 relative), against the volume identity and against the
 //! inclusion oracle at random points; regularized vs plain; GPU vs CPU classification.
 
+mod common;
+
+use common::{moved, volume};
 use glam::{DAffine3, DVec3};
 use texgeo::boolean::{self, Class, Evaluation, Names, Operation, Options, cgal};
 use texgeo::gpu::Context;
@@ -25,14 +28,6 @@ fn boxed(lo: [f64; 3], hi: [f64; 3], other_diagonal: bool) -> Mesh {
     }
     let faces = m.faces().map(|f| vec![f[1], f[2], f[3], f[0]]).collect();
     Mesh::new(m.positions().to_vec(), faces).unwrap()
-}
-
-fn moved(m: &Mesh, t: DAffine3) -> Mesh {
-    m.map_positions(|p| t.transform_point3(p)).unwrap()
-}
-
-fn volume(m: &Mesh) -> f64 {
-    if m.num_faces() == 0 { 0.0 } else { Covering::new(m).volume() }
 }
 
 fn area(m: &Mesh) -> f64 {

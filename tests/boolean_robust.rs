@@ -5,24 +5,18 @@
 //! and the volumes must satisfy vol(A∪B) + vol(A∩B) = vol(A) + vol(B) and
 //! vol(A−B) = vol(A) − vol(A∩B).
 
+mod common;
+
+use common::{moved, volume};
 use glam::{DAffine3, DVec3};
 use texgeo::boolean::{self, Evaluation, Names, Operation, Options, Transform, cgal};
 use texgeo::inclusion::Method;
-use texgeo::mesh::covering::Covering;
 use texgeo::mesh::frame::Frame;
 use texgeo::mesh::{Mesh, procedural};
 use texgeo::random::Rng;
 use texgeo::report::bench::boolean::turned_copy;
 
 const REL: f64 = 1e-9;
-
-fn volume(m: &Mesh) -> f64 {
-    if m.num_faces() == 0 { 0.0 } else { Covering::new(m).volume() }
-}
-
-fn moved(m: &Mesh, t: DAffine3) -> Mesh {
-    m.map_positions(|p| t.transform_point3(p)).unwrap()
-}
 
 /// All four operations closed and oriented, the volume identities; returns the evaluation
 /// and the volumes of ∪, ∩, −, ⊖.

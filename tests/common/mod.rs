@@ -116,3 +116,13 @@ pub fn assert_refused(o: &Output, needles: &[&str]) {
         assert!(err.contains(n), "expected '{n}' in: {err}");
     }
 }
+
+/// The volume of a closed mesh (0 for the empty solid).
+pub fn volume(m: &texgeo::mesh::Mesh) -> f64 {
+    if m.num_faces() == 0 { 0.0 } else { texgeo::mesh::covering::Covering::new(m).volume() }
+}
+
+/// `m` with every point moved by `t`.
+pub fn moved(m: &texgeo::mesh::Mesh, t: glam::DAffine3) -> texgeo::mesh::Mesh {
+    m.map_positions(|p| t.transform_point3(p)).expect("a moved test mesh is a mesh")
+}
