@@ -895,7 +895,14 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
     let before = count(&sub, &[g, k]);
     let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
     let mut changed = vec![true; sub.triangles.len()];
-    collapse(&mut sub, &mut origin, &mut changed, &HashMap::from_iter([(g, k)]), true, &mut Repair::default());
+    collapse(
+        &mut sub,
+        &mut origin,
+        &mut changed,
+        &HashMap::from_iter([(g, k)]),
+        true,
+        &mut Repair::default(),
+    );
     (before, count(&sub, &[k]))
 }
 
@@ -1116,8 +1123,12 @@ fn collapse(
         key.sort_unstable();
         key
     };
-    let mut by_corners: Vec<([u32; 3], bool, usize)> =
-        next.iter().enumerate().filter(|(_, (_, _, c))| *c).map(|(k, (t, _, _))| (sorted(*t), false, k)).collect();
+    let mut by_corners: Vec<([u32; 3], bool, usize)> = next
+        .iter()
+        .enumerate()
+        .filter(|(_, (_, _, c))| *c)
+        .map(|(k, (t, _, _))| (sorted(*t), false, k))
+        .collect();
     by_corners.sort_unstable();
     // A face of one operand that was a face of the other reversed, in a result used again
     // against that other, meets it again once a split or snap has made their corners one
