@@ -364,10 +364,10 @@ fn a_tiny_solid_is_kept_whole() {
     let (ev, [_, vi, ..]) = check_exact("tiny straddling", &a, &small(DVec3::new(1.0, 0.1, 0.2)), false);
     assert!(ev.result(Operation::Intersection, true).unwrap().num_faces() > 0, "A ∩ B dropped");
     assert!((vi - v_small / 2.0).abs() <= 1e-6 * v_small, "A ∩ B {vi} vs {}", v_small / 2.0);
-    // Beside it: A ∪ B keeps both shells.
+    // Beside it: A ∪ B keeps both shells (more faces than A − B, which is A alone).
     let b = small(DVec3::new(1.0 + 3.0 * s, 0.1, 0.2));
     let (ev, [_, vi, ..]) = check_exact("tiny beside", &a, &b, false);
     assert_eq!(vi, 0.0);
-    let union = ev.result(Operation::Union, true).unwrap();
-    assert_eq!(union.num_faces(), a.num_faces() + b.num_faces(), "B dropped from A ∪ B");
+    let faces = |op| ev.result(op, true).unwrap().num_faces();
+    assert!(faces(Operation::Union) > faces(Operation::Difference), "B dropped from A ∪ B");
 }
