@@ -214,7 +214,7 @@ fn voxelize_defaults_to_auto_which_names_its_pick_and_gives_the_exact_voxels() {
     let err = stderr(&o);
     let line = err.lines().find(|l| l.contains("--method auto: ")).unwrap_or_else(|| panic!("{err}"));
     let picked = line.split("--method auto: ").nth(1).unwrap().split(' ').next().unwrap();
-    assert!(texgeo::voxel::Method::parse(picked).is_some(), "{line}");
+    assert!(texgeo::choice::parse::<texgeo::voxel::Method>(picked).is_some(), "{line}");
     assert!(stdout(&o).contains(&format!("method {picked} in")), "{}", stdout(&o));
     let auto = std::fs::read(&auto).unwrap();
     for method in ["scanline", "cpu", "fang", "auto"] {

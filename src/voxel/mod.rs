@@ -91,10 +91,6 @@ impl Method {
         }
     }
 
-    pub fn parse(s: &str) -> Option<Method> {
-        Method::ALL.into_iter().find(|m| m.name() == s)
-    }
-
     /// Whether the method needs a Vulkan device.
     pub fn uses_gpu(self) -> bool {
         matches!(self, Method::Fgpu | Method::Pgpu | Method::Zoned | Method::Fang)
@@ -442,4 +438,20 @@ pub fn voxelize(ctx: Option<&Context>, mesh: &Mesh, n: usize, method: Method) ->
     let grid = Grid::for_mesh(mesh, n)?;
     let solid = Solid::new(mesh)?;
     Voxelizer::new(ctx.cloned()).run(&solid, &grid, method)
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::Method;
+
+    /// `name` is the spelling `--method` accepts, for every method, in one order.
+    #[test]
+    fn names_are_the_command_line_ones() {
+        assert_eq!(Method::value_variants(), Method::ALL);
+        for m in Method::ALL {
+            assert_eq!(m.to_possible_value().unwrap().get_name(), m.name());
+        }
+    }
 }
