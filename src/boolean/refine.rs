@@ -509,15 +509,63 @@ struct SideInput<'a> {
 /// edges found on this side.
 fn refine_side<'p>(
     input: &SideInput,
-    mut segments: Vec<TriangleSegment>,
+    segments: Vec<TriangleSegment>,
     points: &[DVec3],
     point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
     id_of: &(dyn Fn(&Key) -> u32 + Sync),
 ) -> (Result<Refined, RefineError>, Vec<u64>) {
+    let (constraints, mut cut_edges) = constraints_and_edge_pieces(input, segments, id_of);
+    let cut = cut_triangles(input, &constraints);
+    let cut_ids: Vec<u32> = (0..cut.len() as u32).filter(|&t| cut[t as usize]).collect();
+    let pieces: Vec<Result<(u32, Constrained), RefineError>> = cut_ids
+        .par_iter()
+        .with_min_len(16)
+        .map(|&t| {
+            let soup = input.soup;
+            let tri = soup.triangles[t as usize];
+            let corners = tri.map(|v| (input.vertex_id)(v));
+            let chains = [0, 1, 2].map(|e| {
+                let (p, q) = (tri[e], tri[(e + 1) % 3]);
+                (input.edges.get(p, q), p > q)
+            });
+            let inside: Vec<u32> = input.inside[run_of(input.inside, t)].iter().map(|x| x.1).collect();
+            let mut cons: Vec<[u32; 2]> = constraints[run_of(&constraints, t)]
+                .iter()
+                .map(|x| [x.1[0].min(x.1[1]), x.1[0].max(x.1[1])])
+                .collect();
+            cons.sort_unstable();
+            cons.dedup();
+            retriangulate(soup.triangle(t as usize), corners, chains, &inside, &cons, points, point)
+                .map(|pieces| (t, pieces))
+                .map_err(|(reason, near)| RefineError::Triangulate {
+                    side: input.side,
+                    triangle: t,
+                    face: soup.face_of[t as usize],
+                    near,
+                    reason,
+                })
+        })
+        .collect();
+    match assemble_side(input, cut, pieces, &mut cut_edges) {
+        Ok(refined) => (Ok(refined), cut_edges),
+        Err(e) => (Err(e), cut_edges),
+    }
+}
+
+/// The entries of `list` (sorted by triangle) that belong to triangle `t`.
+fn run_of<T>(list: &[(u32, T)], t: u32) -> std::ops::Range<usize> {
+    list.partition_point(|x| x.0 < t)..list.partition_point(|x| x.0 <= t)
+}
+
+/// The segments of one side as constraints (point id pairs) per triangle, sorted by
+/// triangle, and the pieces of the triangles' edges that segments run along (as edge keys).
+fn constraints_and_edge_pieces(
+    input: &SideInput,
+    mut segments: Vec<TriangleSegment>,
+    id_of: &(dyn Fn(&Key) -> u32 + Sync),
+) -> (Vec<(u32, [u32; 2])>, Vec<u64>) {
     let soup = input.soup;
-    let n = soup.triangles.len();
     segments.par_sort_unstable_by_key(|s| s.triangle);
-    // Constraints (point id pairs) per triangle, and the pieces along its edges.
     let mut constraints: Vec<(u32, [u32; 2])> = Vec::with_capacity(segments.len());
     let mut cut_edges: Vec<u64> = Vec::new();
     for s in &segments {
@@ -553,25 +601,19 @@ fn refine_side<'p>(
             }
         }
     }
-    drop(segments);
-    let range_of = |list: &[(u32, u32)], t: u32| {
-        let lo = list.partition_point(|x| x.0 < t);
-        let hi = list.partition_point(|x| x.0 <= t);
-        lo..hi
-    };
-    let constraint_range = |t: u32| {
-        let lo = constraints.partition_point(|x| x.0 < t);
-        let hi = constraints.partition_point(|x| x.0 <= t);
-        lo..hi
-    };
-    // Cut: points inside, constraints, or points on an edge. Only edges between two
-    // vertices that end an edge with points are looked up.
+    (constraints, cut_edges)
+}
+
+/// Which triangles are cut: points inside, constraints, or points on an edge. Only edges
+/// between two vertices that end an edge with points are looked up.
+fn cut_triangles(input: &SideInput, constraints: &[(u32, [u32; 2])]) -> Vec<bool> {
+    let soup = input.soup;
     let mut ends = vec![false; soup.positions.len()];
     for &(p, q) in &input.edges.edges {
         ends[p as usize] = true;
         ends[q as usize] = true;
     }
-    let mut cut = vec![false; n];
+    let mut cut = vec![false; soup.triangles.len()];
     for t in input.inside.iter().map(|x| x.0).chain(constraints.iter().map(|x| x.0)) {
         cut[t as usize] = true;
     }
@@ -583,46 +625,30 @@ fn refine_side<'p>(
                 ends[p as usize] && ends[q as usize] && !input.edges.get(p, q).is_empty()
             });
     });
-    let cut_ids: Vec<u32> = (0..n as u32).filter(|&t| cut[t as usize]).collect();
-    let pieces: Vec<Result<(u32, Constrained), RefineError>> = cut_ids
-        .par_iter()
-        .with_min_len(16)
-        .map(|&t| {
-            let tri = soup.triangles[t as usize];
-            let corners = tri.map(|v| (input.vertex_id)(v));
-            let chains = [0, 1, 2].map(|e| {
-                let (p, q) = (tri[e], tri[(e + 1) % 3]);
-                (input.edges.get(p, q), p > q)
-            });
-            let inside: Vec<u32> = input.inside[range_of(input.inside, t)].iter().map(|x| x.1).collect();
-            let mut cons: Vec<[u32; 2]> = constraints[constraint_range(t)]
-                .iter()
-                .map(|x| [x.1[0].min(x.1[1]), x.1[0].max(x.1[1])])
-                .collect();
-            cons.sort_unstable();
-            cons.dedup();
-            retriangulate(soup.triangle(t as usize), corners, chains, &inside, &cons, points, point)
-                .map(|pieces| (t, pieces))
-                .map_err(|(reason, near)| RefineError::Triangulate {
-                    side: input.side,
-                    triangle: t,
-                    face: soup.face_of[t as usize],
-                    near,
-                    reason,
-                })
-        })
-        .collect();
+    cut
+}
+
+/// The side's triangles in order: each cut one replaced by its pieces (whose segment edges
+/// join `cut_edges`), the others kept with their welded corners.
+fn assemble_side(
+    input: &SideInput,
+    cut: Vec<bool>,
+    pieces: Vec<Result<(u32, Constrained), RefineError>>,
+    cut_edges: &mut Vec<u64>,
+) -> Result<Refined, RefineError> {
+    let soup = input.soup;
+    let n = soup.triangles.len();
+    let extra = 4 * (pieces.len());
     let mut refined = Refined {
-        triangles: Vec::with_capacity(n + 4 * cut_ids.len()),
-        parent: Vec::with_capacity(n + 4 * cut_ids.len()),
+        triangles: Vec::with_capacity(n + extra),
+        parent: Vec::with_capacity(n + extra),
         cut: Vec::new(),
     };
-    let mut pieces = pieces.into_iter().peekable();
+    let mut pieces = pieces.into_iter();
     for t in 0..n as u32 {
         if cut[t as usize] {
             let next = match pieces.next() {
-                Some(Ok(x)) => x,
-                Some(Err(e)) => return (Err(e), cut_edges),
+                Some(x) => x?,
                 None => unreachable!("one result per cut triangle"),
             };
             debug_assert_eq!(next.0, t);
@@ -637,7 +663,7 @@ fn refine_side<'p>(
         }
     }
     refined.cut = cut;
-    (Ok(refined), cut_edges)
+    Ok(refined)
 }
 
 /// The two coordinate axes of the projection that drops the largest component of the
