@@ -15,6 +15,9 @@ use rayon::prelude::*;
 /// An axis-aligned box (lower corner, upper corner), closed: touching counts.
 pub type Box3 = (DVec3, DVec3);
 
+/// A box in one cell, with its id (a box of the second set tagged in the top bit).
+type Entry = (Box3, u32);
+
 /// Entries per box allowed on average before the cells are made coarser.
 const MAX_ENTRIES_PER_BOX: usize = 12;
 
@@ -63,6 +66,19 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
 /// around one vertex, long parallel slivers — make the grid quadratic, and this says so
 /// for the price of counting.
 pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Option<Vec<(u32, u32)>> {
+    let Some((region, all)) = entries_in_region(a, b) else {
+        return Some(Vec::new());
+    };
+    let grid = fit_grid(&region, &all);
+    let (start, entries) = sort_by_cell(&grid, &region, all, max_tests)?;
+    let pairs = pairs_in_cells(&grid, &region, &start, &entries, b.is_some());
+    Some(pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect())
+}
+
+/// The region where pairs can be (the boxes' hull, or where the hulls of `a` and `b`
+/// overlap) and the boxes inside it with their ids (`b`'s tagged in the top bit); `None`
+/// when no pair can be.
+fn entries_in_region<'x>(a: &'x [Box3], b: Option<&'x [Box3]>) -> Option<(Box3, Vec<(u32, &'x Box3)>)> {
     let hull = |boxes: &[Box3]| -> Box3 {
         boxes.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(x.0), hi.max(x.1)))
     };
@@ -74,9 +90,8 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
         }
     };
     if a.is_empty() || region.0.cmpgt(region.1).any() || !region.0.is_finite() || !region.1.is_finite() {
-        return Some(Vec::new());
+        return None;
     }
-    // Entries: (cell key, id with the set in the top bit). Boxes outside the region are left out.
     let inside = |x: &Box3| overlaps(x, &region);
     let all: Vec<(u32, &Box3)> = a
         .iter()
@@ -87,28 +102,41 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
             b.iter().enumerate().filter(|(_, x)| inside(x)).map(|(j, x)| (j as u32 | 1 << 31, x))
         }))
         .collect();
-    if all.is_empty() {
-        return Some(Vec::new());
-    }
+    (!all.is_empty()).then_some((region, all))
+}
+
+/// The grid over `region`: cells of the boxes' mean extent, made coarser until there are
+/// about as many cells as entries at most and few entries per box.
+fn fit_grid(region: &Box3, all: &[(u32, &Box3)]) -> Grid {
     let extent = region.1 - region.0;
     let mean = all.iter().map(|(_, x)| (x.1 - x.0).max_element()).sum::<f64>() / all.len() as f64;
     let mut side = mean.max(extent.max_element() / 1e6).max(f64::MIN_POSITIVE);
-    // Cells: about as many as entries at most, and few entries per box.
-    let grid = loop {
+    loop {
         let dims = ((extent / side).floor().as_uvec3() + UVec3::ONE).min(UVec3::splat(1 << 20));
         let grid = Grid { origin: region.0, inv: 1.0 / side, dims };
         let cells = dims.x as usize * dims.y as usize * dims.z as usize;
         let entries: usize =
-            all.par_iter().with_min_len(4096).map(|(_, x)| grid.count(&x.clamp_to(&region))).sum();
+            all.par_iter().with_min_len(4096).map(|(_, x)| grid.count(&x.clamp_to(region))).sum();
         if (entries <= MAX_ENTRIES_PER_BOX * all.len() && cells <= (4 * entries).max(1 << 16)) || cells == 1 {
-            break grid;
+            return grid;
         }
         side *= 1.5;
-    };
+    }
+}
+
+/// Counting sort of the entries by cell: `entries[start[c]..start[c + 1]]` are cell c's
+/// boxes (with their tagged ids), copied next to each other so the pair loop reads memory
+/// in order, in the order of `all`. `None` when the cells would take more than
+/// `max_tests` pair tests.
+fn sort_by_cell(
+    grid: &Grid,
+    region: &Box3,
+    all: Vec<(u32, &Box3)>,
+    max_tests: u64,
+) -> Option<(Vec<u32>, Vec<Entry>)> {
     let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
-    // Counting sort of the entries by cell: `ids[start[c]..start[c + 1]]` are cell c's boxes.
     let ranges: Vec<(UVec3, UVec3)> =
-        all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(&region))).collect();
+        all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(region))).collect();
     let each_cell = |(lo, hi): (UVec3, UVec3), f: &mut dyn FnMut(usize)| {
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
@@ -130,31 +158,40 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
     for c in 0..cells {
         start[c + 1] += start[c];
     }
-    // Each cell's boxes copied next to each other (with their tagged ids), so the pair
-    // loop reads memory in order.
     let mut fill = start.clone();
-    let mut entries: Vec<(Box3, u32)> = vec![((DVec3::ZERO, DVec3::ZERO), 0); start[cells] as usize];
+    let mut entries: Vec<Entry> = vec![((DVec3::ZERO, DVec3::ZERO), 0); start[cells] as usize];
     for (&r, &(id, x)) in ranges.iter().zip(&all) {
         each_cell(r, &mut |c| {
             entries[fill[c] as usize] = (*x, id);
             fill[c] += 1;
         });
     }
-    drop(fill);
-    drop(all);
-    let pairs: Vec<u64> = (0..cells)
+    Some((start, entries))
+}
+
+/// The overlapping pairs of each cell's boxes (ids packed high/low), each reported by the
+/// cell of its overlap's lower corner only; with `two_sets`, pairs of one box of each set.
+fn pairs_in_cells(
+    grid: &Grid,
+    region: &Box3,
+    start: &[u32],
+    entries: &[(Box3, u32)],
+    two_sets: bool,
+) -> Vec<u64> {
+    let cells = start.len() - 1;
+    (0..cells)
         .into_par_iter()
         .with_min_len(4096)
         .fold(Vec::new, |mut acc, cell| {
             let run = &entries[start[cell] as usize..start[cell + 1] as usize];
             // Two sets: a cell's boxes of `a` come before those of `b` (filled in the order
             // of `all`), and each box of `a` is compared with those of `b` only.
-            let split = if b.is_some() { run.partition_point(|(_, t)| t >> 31 == 0) } else { run.len() };
+            let split = if two_sets { run.partition_point(|(_, t)| t >> 31 == 0) } else { run.len() };
             for (k, (bx, tx)) in run.iter().enumerate() {
-                let others = match b {
-                    None => &run[k + 1..],
-                    Some(_) if k < split => &run[split..],
-                    Some(_) => break,
+                let others = match two_sets {
+                    false => &run[k + 1..],
+                    true if k < split => &run[split..],
+                    true => break,
                 };
                 for (by, ty) in others {
                     if !overlaps(bx, by) {
@@ -164,7 +201,7 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
                     if grid.key(grid.cell(bx.0.max(by.0).max(region.0))) as usize != cell {
                         continue;
                     }
-                    let (i, j) = if b.is_none() {
+                    let (i, j) = if !two_sets {
                         (*tx.min(ty), *tx.max(ty))
                     } else if tx >> 31 == 0 {
                         (*tx, ty & !(1 << 31))
@@ -182,8 +219,7 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
             }
             x.extend(y);
             x
-        });
-    Some(pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect())
+        })
 }
 
 trait ClampTo {
