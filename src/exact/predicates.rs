@@ -128,8 +128,41 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     match orient3d_filter(a, b, c, d) {
         Some(det) => sign_of(det),
         None if in_axis_plane(a, b, c, d) => 0,
-        None => -orient3d_exact(a, b, c, d).sign(),
+        None => -orient3d_exact_sign(a, b, c, d),
     }
+}
+
+/// The sign of det((a−d, b−d, c−d)), exactly. When the nine differences round to
+/// nothing (points close together, as the near-coplanar ones the filter leaves are), the
+/// determinant is a sum of three products of a 2×2 minor and one difference: at most
+/// 3 · 8 components, on small fixed buffers. Otherwise the full expansion of
+/// [`orient3d_exact`].
+fn orient3d_exact_sign(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+    use super::expansion::{scale_into, sign, sum_into, two_prod, two_sum};
+    let exact_diff = |p: DVec3| -> Option<DVec3> {
+        let tails = [two_sum(p.x, -d.x).1, two_sum(p.y, -d.y).1, two_sum(p.z, -d.z).1];
+        (tails == [0.0; 3]).then(|| p - d)
+    };
+    let (Some(ad), Some(bd), Some(cd)) = (exact_diff(a), exact_diff(b), exact_diff(c)) else {
+        return orient3d_exact(a, b, c, d).sign();
+    };
+    // w.z · (u.x·v.y − v.x·u.y), exactly, into `h` (8 slots); returns the length.
+    let term = |u: DVec3, v: DVec3, w: DVec3, h: &mut [f64; 8]| -> usize {
+        let (p1, e1) = two_prod(u.x, v.y);
+        let (p2, e2) = two_prod(v.x, u.y);
+        let mut minor = [0.0; 4];
+        let m = sum_into(&[e1, p1], &[-e2, -p2], &mut minor);
+        scale_into(&minor[..m], w.z, h)
+    };
+    let (mut t1, mut t2, mut t3) = ([0.0; 8], [0.0; 8], [0.0; 8]);
+    let n1 = term(bd, cd, ad, &mut t1);
+    let n2 = term(cd, ad, bd, &mut t2);
+    let n3 = term(ad, bd, cd, &mut t3);
+    let mut s12 = [0.0; 16];
+    let n12 = sum_into(&t1[..n1], &t2[..n2], &mut s12);
+    let mut det = [0.0; 24];
+    let n = sum_into(&s12[..n12], &t3[..n3], &mut det);
+    sign(&det[..n])
 }
 
 /// The four points have one coordinate in common, so they lie in a plane normal to an axis
@@ -259,6 +292,7 @@ mod tests {
         let above = DVec3::new(d.x, d.y, f64::from_bits(d.z.to_bits() + 1));
         assert!(!in_axis_plane(a, b, c, above));
         assert_eq!(orient3d(a, b, c, above), -orient3d_exact(a, b, c, above).sign());
+        assert_eq!(orient3d_exact_sign(a, b, c, above), orient3d_exact(a, b, c, above).sign());
         assert_ne!(orient3d(a, b, c, above), 0);
     }
 
@@ -284,6 +318,7 @@ mod tests {
             // Far from the origin (still exact integers): same sign.
             let t = DVec3::new(2f64.powi(40), -(2f64.powi(45)), 2f64.powi(50));
             assert_eq!(orient3d(f(a) + t, f(b) + t, f(c) + t, f(d) + t), want);
+            assert_eq!(-orient3d_exact_sign(f(a) + t, f(b) + t, f(c) + t, f(d) + t), want);
             // The 2D predicate on the xy projections.
             let o2 = (a[0] as i128 - c[0] as i128) * (b[1] as i128 - c[1] as i128)
                 - (a[1] as i128 - c[1] as i128) * (b[0] as i128 - c[0] as i128);
@@ -345,6 +380,9 @@ mod tests {
             let down = DVec3::new(d.x.next_down(), d.y, d.z);
             assert_eq!(orient3d(a, b, c, up), nx);
             assert_eq!(orient3d(a, b, c, down), -nx);
+            for e in [d, up, down, a + DVec3::new(0.1, 0.2, 0.3)] {
+                assert_eq!(orient3d_exact_sign(a, b, c, e), orient3d_exact(a, b, c, e).sign());
+            }
             assert_eq!(orient3d_perturbed(a, b, c, d), nx);
         }
         // Collinear in exact arithmetic despite the rounding of every difference.
