@@ -58,6 +58,7 @@ use rayon::prelude::*;
 
 use super::input::{flatness_bound, is_flat};
 use crate::exact::orient2d;
+use crate::mesh::boxgrid::{Box3, box_pairs};
 use crate::mesh::covering::signed_tetra_volume;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
@@ -642,16 +643,20 @@ fn edge_splits(
     }
     let boxes = soup.boxes();
     let within = |a: DVec3, b: DVec3| (a - b).abs().max_element() <= snap;
-    let mut found: Vec<(f64, (u32, u32), u32)> = corners
-        .par_iter()
-        .flat_map_iter(|&v| {
-            let x = soup.positions[v as usize];
+    // Candidates from the grid, with room to spare; the test below decides.
+    let reach = DVec3::splat(2.0 * snap);
+    let around: Vec<Box3> = corners
+        .iter()
+        .map(|&v| (soup.positions[v as usize] - reach, soup.positions[v as usize] + reach))
+        .collect();
+    let mut found: Vec<(f64, (u32, u32), u32)> = box_pairs(&around, Some(&boxes))
+        .into_par_iter()
+        .flat_map_iter(|(i, t)| {
+            let (v, t) = (corners[i as usize], t as usize);
+            let (x, tri) = (soup.positions[v as usize], soup.triangles[t]);
             let mut hits = Vec::new();
-            for (t, tri) in soup.triangles.iter().enumerate() {
-                let (lo, hi) = boxes[t];
-                if (lo - x).max_element() > snap || (x - hi).max_element() > snap || tri.contains(&v) {
-                    continue;
-                }
+            let (lo, hi) = boxes[t];
+            if !((lo - x).max_element() > snap || (x - hi).max_element() > snap || tri.contains(&v)) {
                 for k in 0..3 {
                     let (p, q) = (tri[k], tri[(k + 1) % 3]);
                     let (pp, pq) = (soup.positions[p as usize], soup.positions[q as usize]);
@@ -670,7 +675,7 @@ fn edge_splits(
         })
         .collect();
     found.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-    let mut busy = std::collections::HashSet::new();
+    let mut busy = HashSet::new();
     let mut splits = HashMap::new();
     for (_, (p, q), v) in found {
         if busy.contains(&p) || busy.contains(&q) || busy.contains(&v) {
@@ -878,41 +883,38 @@ fn flatten(
 /// Crossings and triangles without area at `gone` and `keep` before and after `gone`
 /// collapses onto `keep`: their triangles against those whose boxes meet theirs.
 fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gone: u32) -> (usize, usize) {
-    let around: Vec<usize> = (0..soup.triangles.len())
-        .filter(|&t| soup.triangles[t].contains(&gone) || soup.triangles[t].contains(&keep))
-        .collect();
-    let (lo, hi) = around.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &t| {
-        (lo.min(boxes[t].0), hi.max(boxes[t].1))
-    });
-    // The collapse moves the triangles at `gone` towards `keep`, inside this box.
-    let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
-    let count = |sub: &TriangleSoup, at: &[u32]| {
-        let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
-        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
-        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
-    };
-    let (k, g) = (ids[&keep], ids[&gone]);
-    let before = count(&sub, &[g, k]);
-    let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
-    let mut changed = vec![true; sub.triangles.len()];
-    collapse(
-        &mut sub,
-        &mut origin,
-        &mut changed,
-        &HashMap::from_iter([(g, k)]),
-        true,
-        &mut Repair::default(),
-    );
-    (before, count(&sub, &[k]))
+    // The collapse moves the triangles at `gone` towards `keep`, inside their box.
+    local_defects(soup, boxes, &[keep, gone], |sub, origin, changed, local| {
+        let (k, g) = (local[0], local[1]);
+        collapse(sub, origin, changed, &HashMap::from_iter([(g, k)]), true, &mut Repair::default());
+        vec![k]
+    })
 }
 
 /// Crossings and triangles without area at the ends of `edge` and at `at` before and after
 /// the edge is split at `at` (and faces that then coincide with opposite orientations
 /// cancel): their triangles against those whose boxes meet theirs.
 fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), at: u32) -> (usize, usize) {
-    let ends = [edge.0, edge.1, at];
+    local_defects(soup, boxes, &[edge.0, edge.1, at], |sub, origin, changed, local| {
+        let (p, q) = (local[0], local[1]);
+        let splits = HashMap::from_iter([((p.min(q), p.max(q)), local[2])]);
+        split_edges(sub, origin, changed, &splits);
+        collapse(sub, origin, changed, &HashMap::new(), true, &mut Repair::default());
+        local.to_vec()
+    })
+}
+
+/// Crossings and triangles without area at the points `at` before and after `edit`, made
+/// on the triangles whose boxes meet the box of those at `at` (as a soup of their own:
+/// `edit` gets it with the points' ids in it, and returns the points to count at after).
+fn local_defects(
+    soup: &TriangleSoup,
+    boxes: &[(DVec3, DVec3)],
+    at: &[u32],
+    edit: impl FnOnce(&mut TriangleSoup, &mut Vec<u32>, &mut Vec<bool>, &[u32]) -> Vec<u32>,
+) -> (usize, usize) {
     let (lo, hi) = (0..soup.triangles.len())
-        .filter(|&t| soup.triangles[t].iter().any(|v| ends.contains(v)))
+        .filter(|&t| soup.triangles[t].iter().any(|v| at.contains(v)))
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
     let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
     let count = |sub: &TriangleSoup, at: &[u32]| {
@@ -920,15 +922,12 @@ fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), 
         let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
         soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
     };
-    let local = ends.map(|v| ids[&v]);
+    let local: Vec<u32> = at.iter().map(|v| ids[v]).collect();
     let before = count(&sub, &local);
     let mut origin: Vec<u32> = (0..sub.triangles.len() as u32).collect();
     let mut changed = vec![true; sub.triangles.len()];
-    let (p, q) = (local[0], local[1]);
-    let splits = HashMap::from_iter([((p.min(q), p.max(q)), local[2])]);
-    split_edges(&mut sub, &mut origin, &mut changed, &splits);
-    collapse(&mut sub, &mut origin, &mut changed, &HashMap::new(), true, &mut Repair::default());
-    (before, count(&sub, &local))
+    let after = edit(&mut sub, &mut origin, &mut changed, &local);
+    (before, count(&sub, &after))
 }
 
 /// The triangles of `soup` whose boxes meet the box `lo`..`hi`, as a soup of their own
