@@ -33,7 +33,7 @@ use crate::exact::orient3d;
 use crate::inclusion;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::intersect::{TriangleSoup, segment_meets_triangle};
-use crate::mesh::validate::half_edges_by_lower_vertex;
+use crate::mesh::validate::{HalfEdges, corner};
 
 /// Where a refined triangle lies relative to the other solid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -457,9 +457,7 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
         // The sides of every triangle bucketed by their lower point, each bucket ordered by
         // (higher point, corner): the triangles around an edge are adjacent, in increasing
         // order.
-        let offsets: Vec<usize> = (0..=n).map(|t| 3 * t).collect();
-        let (start, items) =
-            half_edges_by_lower_vertex(&offsets, refined.triangles.as_flattened(), r.points.len());
+        let half_edges = HalfEdges::of_triangles(&refined.triangles, r.points.len());
         // The points on the cut curve: only an edge between two of them is looked up.
         let mut on_curve = vec![false; r.points.len()];
         for &e in &r.cut_edges {
@@ -471,17 +469,14 @@ fn groups(refined: &Refined, on: &[Option<Class>], r: &Refinement) -> (Vec<u32>,
                 && on_curve[hi as usize]
                 && r.cut_edges.binary_search(&edge_key(lo as u32, hi)).is_ok()
         };
-        for lo in 0..r.points.len() {
-            for run in items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32) {
-                let hi = (run[0] >> 32) as u32;
-                if run.len() > 1 && !is_cut_edge(lo, hi) {
-                    let triangle = |item: u64| (item & 0xffff_ffff) as u32 / 3;
-                    let s = triangle(run[0]);
-                    for &item in &run[1..] {
-                        let t = triangle(item);
-                        if on[s as usize] == on[t as usize] {
-                            sets.union(s, t);
-                        }
+        for (lo, hi, run) in half_edges.edges() {
+            if run.len() > 1 && !is_cut_edge(lo, hi) {
+                let triangle = |item: u64| corner(item) as u32 / 3;
+                let s = triangle(run[0]);
+                for &item in &run[1..] {
+                    let t = triangle(item);
+                    if on[s as usize] == on[t as usize] {
+                        sets.union(s, t);
                     }
                 }
             }

@@ -352,21 +352,19 @@ impl Covering {
     pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
         // The uses of each edge are adjacent in its lower vertex's bucket, edges in
         // increasing order: the first unbalanced one is the smallest.
-        let indices = &self.polygon_indices;
-        let (start, items) =
-            super::validate::half_edges_by_lower_vertex(&self.polygon_offsets, indices, self.points.len());
-        (0..self.points.len()).find_map(|lo| {
-            items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32).find_map(|run| {
-                // A use leaving the lower vertex goes lo→hi.
-                let forward =
-                    run.iter().filter(|&&i| indices[(i & 0xffff_ffff) as usize] as usize == lo).count();
-                let backward = run.len() - forward;
-                (forward != backward).then(|| UnbalancedEdge {
-                    a: lo as u32,
-                    b: (run[0] >> 32) as u32,
-                    forward: forward as u32,
-                    backward: backward as u32,
-                })
+        let half_edges = super::validate::HalfEdges::of_faces(
+            &self.polygon_offsets,
+            &self.polygon_indices,
+            self.points.len(),
+        );
+        half_edges.edges().find_map(|(lo, hi, run)| {
+            let forward = half_edges.forward(lo, run);
+            let backward = run.len() - forward;
+            (forward != backward).then_some(UnbalancedEdge {
+                a: lo as u32,
+                b: hi,
+                forward: forward as u32,
+                backward: backward as u32,
             })
         })
     }

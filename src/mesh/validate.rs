@@ -70,65 +70,94 @@ impl Report {
     }
 }
 
-/// Every half-edge a→b (a ≠ b) of the faces `offsets`/`indices` (`nv` vertices),
-/// bucketed by its lower vertex (a counting sort): bucket `lo` is
-/// `items[start[lo]..start[lo + 1]]`, each item `higher << 32 | corner` (the corner the
-/// half-edge leaves), sorted, so the uses of one edge are adjacent and edges come in
-/// increasing (lower, higher) order.
-pub(crate) fn half_edges_by_lower_vertex(
-    offsets: &[usize],
-    indices: &[u32],
-    nv: usize,
-) -> (Vec<usize>, Vec<u64>) {
-    let each = |f: &mut dyn FnMut(u32, u32, usize)| {
-        for w in offsets.windows(2) {
-            let face = &indices[w[0]..w[1]];
-            for (k, &a) in face.iter().enumerate() {
-                let b = face[(k + 1) % face.len()];
-                if a != b {
-                    f(a, b, w[0] + k);
+/// Every half-edge a→b (a ≠ b) of some faces, bucketed by its lower vertex (a counting
+/// sort): bucket `lo` is `items[start[lo]..start[lo + 1]]`, each item `higher << 32 |
+/// corner` (the corner the half-edge leaves), sorted, so the uses of one edge are adjacent
+/// and edges come in increasing (lower, higher) order. The report, the covering's balance
+/// test, the Boolean's closure test and its grouping all walk edges this way.
+pub(crate) struct HalfEdges<'a> {
+    indices: &'a [u32],
+    start: Vec<usize>,
+    items: Vec<u64>,
+}
+
+impl<'a> HalfEdges<'a> {
+    /// The half-edges of the faces `offsets`/`indices` over `nv` vertices.
+    pub(crate) fn of_faces(offsets: &[usize], indices: &'a [u32], nv: usize) -> HalfEdges<'a> {
+        let each = |f: &mut dyn FnMut(u32, u32, usize)| {
+            for w in offsets.windows(2) {
+                let face = &indices[w[0]..w[1]];
+                for (k, &a) in face.iter().enumerate() {
+                    let b = face[(k + 1) % face.len()];
+                    if a != b {
+                        f(a, b, w[0] + k);
+                    }
                 }
             }
+        };
+        let mut start = vec![0usize; nv + 1];
+        each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
+        for v in 0..nv {
+            start[v + 1] += start[v];
         }
-    };
-    let mut start = vec![0usize; nv + 1];
-    each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
-    for v in 0..nv {
-        start[v + 1] += start[v];
+        let mut fill = start.clone();
+        let mut items = vec![0u64; start[nv]];
+        each(&mut |a, b, corner| {
+            let slot = &mut fill[a.min(b) as usize];
+            items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
+            *slot += 1;
+        });
+        for lo in 0..nv {
+            items[start[lo]..start[lo + 1]].sort_unstable();
+        }
+        HalfEdges { indices, start, items }
     }
-    let mut fill = start.clone();
-    let mut items = vec![0u64; start[nv]];
-    each(&mut |a, b, corner| {
-        let slot = &mut fill[a.min(b) as usize];
-        items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
-        *slot += 1;
-    });
-    for lo in 0..nv {
-        items[start[lo]..start[lo + 1]].sort_unstable();
+
+    /// The half-edges of `triangles` over `nv` vertices (corner `3t + k` is corner k of
+    /// triangle t).
+    pub(crate) fn of_triangles(triangles: &'a [[u32; 3]], nv: usize) -> HalfEdges<'a> {
+        let offsets: Vec<usize> = (0..=triangles.len()).map(|t| 3 * t).collect();
+        HalfEdges::of_faces(&offsets, triangles.as_flattened(), nv)
     }
-    (start, items)
+
+    /// Bucket `lo`: its items in order.
+    pub(crate) fn bucket(&self, lo: usize) -> &[u64] {
+        &self.items[self.start[lo]..self.start[lo + 1]]
+    }
+
+    /// Every edge as (lower, higher, its uses: items of that bucket), in increasing order.
+    pub(crate) fn edges(&self) -> impl Iterator<Item = (usize, u32, &[u64])> + '_ {
+        (0..self.start.len() - 1).flat_map(move |lo| {
+            self.bucket(lo)
+                .chunk_by(|x, y| x >> 32 == y >> 32)
+                .map(move |run| (lo, (run[0] >> 32) as u32, run))
+        })
+    }
+
+    /// How many of the uses `run` of an edge with lower vertex `lo` go lo → higher.
+    pub(crate) fn forward(&self, lo: usize, run: &[u64]) -> usize {
+        run.iter().filter(|&&item| self.indices[corner(item)] as usize == lo).count()
+    }
+}
+
+/// The corner an item of [`HalfEdges`] leaves.
+pub(crate) fn corner(item: u64) -> usize {
+    (item & 0xffff_ffff) as usize
 }
 
 /// The boundary and misoriented edges of `triangles`, counted as [`report`] counts them
 /// ([`Report::is_closed`] when both are 0), without the rest of the report: the closure
 /// test of a Boolean result.
 pub fn edge_defects(triangles: &[[u32; 3]]) -> (usize, usize) {
-    let indices = triangles.as_flattened();
-    let nv = indices.iter().max().map_or(0, |&v| v as usize + 1);
-    let offsets: Vec<usize> = (0..=triangles.len()).map(|t| 3 * t).collect();
-    let (start, items) = half_edges_by_lower_vertex(&offsets, indices, nv);
+    let nv = triangles.as_flattened().iter().max().map_or(0, |&v| v as usize + 1);
+    let half_edges = HalfEdges::of_triangles(triangles, nv);
     let (mut boundary, mut misoriented) = (0, 0);
-    for lo in 0..nv {
-        for run in items[start[lo]..start[lo + 1]].chunk_by(|x, y| x >> 32 == y >> 32) {
-            // Sides leaving the lower point (lo → hi) and the others, as `report` counts.
-            let forward =
-                run.iter().filter(|&&item| indices[(item & 0xffff_ffff) as usize] as usize == lo).count();
-            if run.len() == 1 {
-                boundary += 1;
-            }
-            if run.len() >= 2 && 2 * forward != run.len() {
-                misoriented += 1;
-            }
+    for (lo, _, run) in half_edges.edges() {
+        if run.len() == 1 {
+            boundary += 1;
+        }
+        if run.len() >= 2 && 2 * half_edges.forward(lo, run) != run.len() {
+            misoriented += 1;
         }
     }
     (boundary, misoriented)
@@ -156,17 +185,16 @@ pub fn report(mesh: &Mesh) -> Report {
             vertex_sets.union(a, b);
         }
     }
-    let (start, buckets) = half_edges_by_lower_vertex(offsets, indices, nv);
+    let half_edges = HalfEdges::of_faces(offsets, indices, nv);
     // Edges: runs of equal higher vertex in each sorted bucket. Half-edge counts per
     // edge are [lo→hi, hi→lo]; `corner_edge` is the edge leaving each corner (u32::MAX
     // for a side that is not an edge).
-    let mut counts: Vec<[u32; 2]> = Vec::with_capacity(buckets.len() / 2);
+    let mut counts: Vec<[u32; 2]> = Vec::with_capacity(half_edges.items.len() / 2);
     let mut corner_edge = vec![u32::MAX; indices.len()];
     for lo in 0..nv {
-        let bucket = &buckets[start[lo]..start[lo + 1]];
         let mut prev_hi = u64::MAX;
-        for &item in bucket.iter() {
-            let (hi, c) = (item >> 32, (item & 0xffff_ffff) as usize);
+        for &item in half_edges.bucket(lo) {
+            let (hi, c) = (item >> 32, corner(item));
             if hi != prev_hi {
                 counts.push([0, 0]);
                 prev_hi = hi;
@@ -176,8 +204,7 @@ pub fn report(mesh: &Mesh) -> Report {
             corner_edge[c] = e as u32;
         }
     }
-    drop(buckets);
-    drop(start);
+    drop(half_edges);
     r.edges = counts.len();
     let mut bad_edge = vec![false; counts.len()];
     for (e, &[fwd, bwd]) in counts.iter().enumerate() {
