@@ -15,9 +15,6 @@ use rayon::prelude::*;
 /// An axis-aligned box (lower corner, upper corner), closed: touching counts.
 pub type Box3 = (DVec3, DVec3);
 
-/// A box in one cell, with its id (a box of the second set tagged in the top bit).
-type Entry = (Box3, u32);
-
 /// Entries per box allowed on average before the cells are made coarser.
 const MAX_ENTRIES_PER_BOX: usize = 12;
 
@@ -51,6 +48,18 @@ impl Grid {
         let d = hi - lo + UVec3::ONE;
         d.x as usize * d.y as usize * d.z as usize
     }
+
+    /// Calls `f` with every cell of the range `(lo, hi)` (by key), in key order.
+    fn each_cell(&self, (lo, hi): (UVec3, UVec3), mut f: impl FnMut(usize)) {
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                let row = self.key(UVec3::new(lo.x, y, z)) as usize;
+                for c in row..=row + (hi.x - lo.x) as usize {
+                    f(c);
+                }
+            }
+        }
+    }
 }
 
 /// Pairs of overlapping boxes: `(i, j)` with i < j within `a` when `b` is `None`, else
@@ -70,8 +79,8 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
         return Some(Vec::new());
     };
     let grid = fit_grid(&region, &all);
-    let (start, entries) = sort_by_cell(&grid, &region, all, max_tests)?;
-    let pairs = pairs_in_cells(&grid, &region, &start, &entries, b.is_some());
+    let (start, entries) = sort_by_cell(&grid, &region, &all, max_tests)?;
+    let pairs = pairs_in_cells(&grid, &region, &start, &entries, &all, b.is_some());
     Some(pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect())
 }
 
@@ -124,32 +133,22 @@ fn fit_grid(region: &Box3, all: &[(u32, &Box3)]) -> Grid {
     }
 }
 
-/// Counting sort of the entries by cell: `entries[start[c]..start[c + 1]]` are cell c's
-/// boxes (with their tagged ids), copied next to each other so the pair loop reads memory
-/// in order, in the order of `all`. `None` when the cells would take more than
-/// `max_tests` pair tests.
+/// Counting sort of the entries by cell: `entries[start[c]..start[c + 1]]` are the places
+/// in `all` of cell c's boxes, in increasing order (4 bytes an entry, where a copy of the
+/// box would take 56: a box is in 8 cells or so, and the copies were most of the grid's
+/// memory traffic). `None` when the cells would take more than `max_tests` pair tests.
 fn sort_by_cell(
     grid: &Grid,
     region: &Box3,
-    all: Vec<(u32, &Box3)>,
+    all: &[(u32, &Box3)],
     max_tests: u64,
-) -> Option<(Vec<u32>, Vec<Entry>)> {
+) -> Option<(Vec<u32>, Vec<u32>)> {
     let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
     let ranges: Vec<(UVec3, UVec3)> =
         all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(region))).collect();
-    let each_cell = |(lo, hi): (UVec3, UVec3), f: &mut dyn FnMut(usize)| {
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                let row = grid.key(UVec3::new(lo.x, y, z)) as usize;
-                for x in 0..=(hi.x - lo.x) as usize {
-                    f(row + x);
-                }
-            }
-        }
-    };
     let mut start = vec![0u32; cells + 1];
     for &r in &ranges {
-        each_cell(r, &mut |c| start[c + 1] += 1);
+        grid.each_cell(r, |c| start[c + 1] += 1);
     }
     let tests = start.iter().map(|&c| u64::from(c) * u64::from(c.saturating_sub(1)) / 2).sum::<u64>();
     if tests > max_tests {
@@ -159,10 +158,10 @@ fn sort_by_cell(
         start[c + 1] += start[c];
     }
     let mut fill = start.clone();
-    let mut entries: Vec<Entry> = vec![((DVec3::ZERO, DVec3::ZERO), 0); start[cells] as usize];
-    for (&r, &(id, x)) in ranges.iter().zip(&all) {
-        each_cell(r, &mut |c| {
-            entries[fill[c] as usize] = (*x, id);
+    let mut entries = vec![0u32; start[cells] as usize];
+    for (k, &r) in ranges.iter().enumerate() {
+        grid.each_cell(r, |c| {
+            entries[fill[c] as usize] = k as u32;
             fill[c] += 1;
         });
     }
@@ -175,25 +174,32 @@ fn pairs_in_cells(
     grid: &Grid,
     region: &Box3,
     start: &[u32],
-    entries: &[(Box3, u32)],
+    entries: &[u32],
+    all: &[(u32, &Box3)],
     two_sets: bool,
 ) -> Vec<u64> {
     let cells = start.len() - 1;
+    // `a`'s boxes come first in `all`.
+    let in_a = all.partition_point(|(t, _)| t >> 31 == 0) as u32;
+    // Most cells hold no box or one: no pair to look at there.
     (0..cells)
         .into_par_iter()
         .with_min_len(4096)
+        .filter(|&cell| start[cell + 1] - start[cell] >= 2)
         .fold(Vec::new, |mut acc, cell| {
             let run = &entries[start[cell] as usize..start[cell + 1] as usize];
             // Two sets: a cell's boxes of `a` come before those of `b` (filled in the order
             // of `all`), and each box of `a` is compared with those of `b` only.
-            let split = if two_sets { run.partition_point(|(_, t)| t >> 31 == 0) } else { run.len() };
-            for (k, (bx, tx)) in run.iter().enumerate() {
+            let split = if two_sets { run.partition_point(|&e| e < in_a) } else { run.len() };
+            for (k, &ex) in run.iter().enumerate() {
+                let (tx, bx) = all[ex as usize];
                 let others = match two_sets {
                     false => &run[k + 1..],
                     true if k < split => &run[split..],
                     true => break,
                 };
-                for (by, ty) in others {
+                for &ey in others {
+                    let (ty, by) = all[ey as usize];
                     if !overlaps(bx, by) {
                         continue;
                     }
@@ -202,11 +208,11 @@ fn pairs_in_cells(
                         continue;
                     }
                     let (i, j) = if !two_sets {
-                        (*tx.min(ty), *tx.max(ty))
+                        (tx.min(ty), tx.max(ty))
                     } else if tx >> 31 == 0 {
-                        (*tx, ty & !(1 << 31))
+                        (tx, ty & !(1 << 31))
                     } else {
-                        (*ty, tx & !(1 << 31))
+                        (ty, tx & !(1 << 31))
                     };
                     acc.push((i as u64) << 32 | j as u64);
                 }
