@@ -146,25 +146,29 @@ fn sort_by_cell(
     let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
     let ranges: Vec<(UVec3, UVec3)> =
         all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(region))).collect();
-    let mut start = vec![0u32; cells + 1];
+    // Cell c counted at `start[c + 2]`; once summed, `start[c + 1]` is where cell c's
+    // entries begin, and as the cursor that fills them it ends where they end, which is
+    // where cell c + 1's begin: no second array of cells (they are mostly empty, and
+    // there are up to four per entry) is needed.
+    let mut start = vec![0u32; cells + 2];
     for &r in &ranges {
-        grid.each_cell(r, |c| start[c + 1] += 1);
+        grid.each_cell(r, |c| start[c + 2] += 1);
     }
     let tests = start.iter().map(|&c| u64::from(c) * u64::from(c.saturating_sub(1)) / 2).sum::<u64>();
     if tests > max_tests {
         return None;
     }
-    for c in 0..cells {
-        start[c + 1] += start[c];
+    for i in 2..cells + 2 {
+        start[i] += start[i - 1];
     }
-    let mut fill = start.clone();
-    let mut entries = vec![0u32; start[cells] as usize];
+    let mut entries = vec![0u32; start[cells + 1] as usize];
     for (k, &r) in ranges.iter().enumerate() {
         grid.each_cell(r, |c| {
-            entries[fill[c] as usize] = k as u32;
-            fill[c] += 1;
+            entries[start[c + 1] as usize] = k as u32;
+            start[c + 1] += 1;
         });
     }
+    start.truncate(cells + 1);
     Some((start, entries))
 }
 
