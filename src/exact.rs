@@ -14,6 +14,7 @@
 //! | [`predicates`] | [`orient2d`], [`orient3d`] (one sign convention, one result type [`Sign`]), their perturbed forms |
 //! | [`implicit`] | implicit points (an edge crossing a plane, two coplanar edges crossing) and exact predicates on them: [`orient3d_implicit`](implicit::orient3d_implicit), [`orient2d_implicit`](implicit::orient2d_implicit), [`compare_implicit`](implicit::compare_implicit) |
 //! | [`rounding`] | the correctly rounded f64 of a quotient X / W (implicit points' output coordinates) |
+//! | [`volume`] | the certified volume of a surface whose vertices are exact or implicit (double-double, with an error bound) |
 //! | [`distance`] | [`segment_within`], [`triangle_within`]: distance from a point ≤ ε, and closest points |
 //!
 //! Every mesh check, triangulation, voxel tie, inclusion test and Boolean decision calls
@@ -24,6 +25,7 @@ pub mod expansion;
 pub mod implicit;
 pub mod predicates;
 pub mod rounding;
+pub mod volume;
 
 pub use distance::{closest_point_on_segment, closest_point_on_triangle, segment_within, triangle_within};
 pub use expansion::{Exact, Exact3, two_prod, two_sum};

@@ -263,6 +263,28 @@ impl Point {
     }
 }
 
+impl Point {
+    /// The coordinates X/W as double-double balls ([`Ball`]) that certainly hold the exact
+    /// ones, each a few 2⁻¹⁰⁶ (relative) wide: for measures of an exact result (its
+    /// volume), never for decisions. Explicit points are exact; an implicit one takes its
+    /// homogeneous coordinates in double-double, or from expansions where W's ball is too
+    /// wide to divide by (W nearly cancelling).
+    pub fn coordinates(&self) -> [Ball; 3] {
+        if let Definition::Explicit(p) = self.definition {
+            return p.to_array().map(Ball::of);
+        }
+        let divide = |h: &[Ball; 4]| -> Option<[Ball; 3]> {
+            let [x, y, z] = [h[0].div(&h[3])?, h[1].div(&h[3])?, h[2].div(&h[3])?];
+            Some([x, y, z])
+        };
+        divide(&homogeneous::<Ball>(&self.definition)).unwrap_or_else(|| {
+            let exact = self.exact().each_ref().map(Ball::of_exact);
+            divide(&exact)
+                .unwrap_or_else(|| unreachable!("W ≠ 0 for a crossing point, and its ball is narrow"))
+        })
+    }
+}
+
 /// Each coordinate X/W rounded to nearest where double-double decides it.
 fn rounded_fast(d: &Definition) -> [Option<f64>; 3] {
     let h = homogeneous::<Ball>(d);

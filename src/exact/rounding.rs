@@ -96,6 +96,45 @@ impl Ball {
         Ball { hi, lo, rad }
     }
 
+    /// The double-double sum of an expansion's components (smallest first), with its
+    /// radius: a ball around an exact value, a few 2⁻¹⁰⁶ of it wide.
+    pub fn of_exact(e: &Exact) -> Ball {
+        e.components().iter().fold(Ball::of(0.0), |s, &c| s.add(&Ball::of(c)))
+    }
+
+    /// The f64 nearest the midpoint `hi + lo`.
+    #[inline]
+    pub fn value(&self) -> f64 {
+        self.hi + self.lo
+    }
+
+    /// An upper bound of how far every value of the ball lies from [`Ball::value`]: the
+    /// radius plus the rounding of `hi + lo` to f64 (at most u·|value|).
+    pub fn error(&self) -> f64 {
+        (self.rad + U * self.value().abs()) * RADIUS_UP
+    }
+
+    /// The quotient of every value of this ball by every value of `w`, as a ball: a
+    /// double-double quotient (the f64 one corrected by its residual) whose radius bounds
+    /// |X − q·W| / |W| over both balls. None when `w` holds zero (or a value too close to
+    /// it for the bound) or the quotient is not finite.
+    pub fn div(&self, w: &Ball) -> Option<Ball> {
+        // A lower bound of |W| over the ball: |hi + lo| ≥ |hi|·(1 − u) for a normalized
+        // pair; the last factor covers the rounding of the subtraction.
+        let w_low = (w.hi.abs() * (1.0 - 8.0 * U) - w.rad) * (1.0 - 4.0 * U);
+        if w_low.is_nan() || w_low <= 0.0 {
+            return None;
+        }
+        let q0 = self.hi / w.hi;
+        let q1 = self.sub(&w.mul(&Ball::of(q0))).hi / w.hi;
+        let (hi, lo) = two_sum(q0, q1);
+        // The residual X − (hi + lo)·W over both balls, products and differences each
+        // with its own radius.
+        let r = self.sub(&w.mul(&Ball::of(hi))).sub(&w.mul(&Ball::of(lo)));
+        let rad = (r.magnitude() + r.rad) / w_low * RADIUS_UP;
+        (hi.is_finite() && lo.is_finite() && rad.is_finite()).then_some(Ball { hi, lo, rad })
+    }
+
     /// Times a power of two: exact (no underflow in a normalized frame).
     #[inline]
     fn scaled(&self, two_power: f64) -> Ball {
