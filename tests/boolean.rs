@@ -8,6 +8,8 @@ mod common;
 use common::{moved, volume};
 use glam::{DAffine3, DVec3};
 use texgeo::boolean::{self, Class, Evaluation, Names, Operation, Options, cgal};
+use texgeo::exact::Exact;
+use texgeo::exact::rounding::{Ball, quotient_exact};
 use texgeo::gpu::Context;
 use texgeo::inclusion::winding::WindingNumber;
 use texgeo::inclusion::{self, Classifier, Method};
@@ -374,5 +376,73 @@ fn point_tests_answer_for_the_triangles_that_are_cut() {
             volume(&union)
         );
         assert_eq!(ev.result(Operation::Intersection, true).unwrap().num_faces(), 0, "{method:?}");
+    }
+}
+
+/// A prism over the quadrilateral `corners` (counter-clockwise seen from +z) between z = −1
+/// and z = 1, in outward triangles.
+fn prism(corners: [[f64; 2]; 4]) -> Mesh {
+    let positions = [-1.0, 1.0].iter().flat_map(|&z| corners.map(|[x, y]| DVec3::new(x, y, z))).collect();
+    let mut faces = vec![vec![0, 2, 1], vec![0, 3, 2], vec![4, 5, 6], vec![4, 6, 7]];
+    for i in 0..4u32 {
+        let j = (i + 1) % 4;
+        faces.push(vec![i, j, j + 4]);
+        faces.push(vec![i, j + 4, i + 4]);
+    }
+    Mesh::new(positions, faces).unwrap()
+}
+
+/// The volume of a mesh of triangles with f64 vertices, certified (double-double).
+fn certified_volume(m: &Mesh) -> texgeo::exact::volume::Volume {
+    let tris: Vec<[u32; 3]> = m.faces().map(|f| [f[0], f[1], f[2]]).collect();
+    let p = m.positions();
+    texgeo::exact::volume::signed_volume(&tris, |i| (p[i as usize].to_array().map(Ball::of), false))
+}
+
+#[test]
+fn a_sliver_difference_reports_the_exact_volume_before_rounding() {
+    // The cube [−1, 1]³ minus its copy turned 1e-6° about z, the copy's corners (a, b),
+    // (−b, a), (−a, −b), (b, −a) being exact quarter turns of each other (a square prism,
+    // whatever a and b round to). A − B is four thin prisms along A's vertical edges, each
+    // over the triangle that B's side line cuts off A's corner, with legs N/(a + b) and
+    // N/(b − a), N = 2b − a² − b²: the volume is 4·N²/(b² − a²), taken here exactly.
+    let t = 1e-6f64.to_radians();
+    let (a, b) = (t.cos() - t.sin(), t.cos() + t.sin());
+    let cube = prism([[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]]);
+    let turned = prism([[a, b], [-b, a], [-a, -b], [b, -a]]);
+    let (ea, eb) = (Exact::from_f64(a), Exact::from_f64(b));
+    let (aa, bb) = (&ea * &ea, &eb * &eb);
+    let n = &(&(&eb + &eb) - &aa) - &bb;
+    let want = quotient_exact(&(&(&n * &n) * &Exact::from_f64(4.0)), &(&bb - &aa));
+    assert!(want > 6e-8 && want < 8e-8, "{want}");
+    let half_ulp = want * f64::EPSILON / 2.0;
+
+    let ev = evaluate(&cube, &turned, Method::Octants, None);
+    let out = ev.output(Operation::Difference, true).unwrap_or_else(|e| panic!("{e}"));
+    let v = out.exact_volume;
+    // Within its certified bound (and the reference's rounding) of the exact value, and
+    // that bound far below 1e-12 relative.
+    assert!((v.value - want).abs() <= v.error + half_ulp, "{v:?} vs {want}");
+    assert!(v.error <= 1e-15 * want, "{v:?}");
+    // Rounding alone wrote this file (no repair): its volume, measured exactly, lies within
+    // the stated rounding bound of the exact one.
+    assert!(out.repair.is_clean(), "{}", out.repair);
+    let written = certified_volume(&out.mesh);
+    assert!(
+        (written.value - want).abs() <= v.rounding + written.error + half_ulp,
+        "{written:?} vs {want}: {v:?}"
+    );
+    assert!(v.rounding < 1e-6 * want, "{v:?}");
+
+    // The corpus' case: the same cube turned 1e-6° about (1, 2, 3), against CGAL's exact
+    // corefinement (its exact volume converted to f64).
+    let cube = procedural::cube();
+    let turned = moved(&cube, DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), t));
+    let reference = cgal::reference(&cube, &turned, None).unwrap_or_else(|e| panic!("{e}"));
+    let ev = evaluate(&cube, &turned, Method::Octants, None);
+    for op in [Operation::Difference, Operation::SymmetricDifference] {
+        let (cv, _) = reference.measures(op).unwrap_or_else(|| panic!("CGAL declined {op}"));
+        let v = ev.output(op, true).unwrap_or_else(|e| panic!("{op}: {e}")).exact_volume;
+        assert!((v.value - cv).abs() <= 1e-12 * cv, "{op}: {v:?} vs CGAL {cv}");
     }
 }

@@ -37,7 +37,11 @@
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
+use rayon::prelude::*;
 
+use crate::exact::implicit::Point;
+use crate::exact::rounding::Ball;
+use crate::exact::volume;
 use crate::gpu::Context;
 use crate::inclusion::{self, Choice, Method, solver::Solver};
 use crate::mesh::Mesh;
@@ -55,6 +59,7 @@ pub mod output;
 pub mod refine;
 pub mod select;
 
+pub use crate::exact::volume::Volume;
 pub use crate::mesh::transform::Transform;
 pub use classify::{Class, Classification, ClassifyStats, Grouping};
 pub use input::InputError;
@@ -288,6 +293,12 @@ pub struct Output {
     /// What the check after rounding found and repaired (nothing for non-regularized
     /// results, which are not checked).
     pub repair: Repair,
+    /// The volume of the exact result, before rounding to f64 and any repair: from the
+    /// selected triangles over the exact points (implicit intersection points in
+    /// double-double), with a certified error bound ([`crate::exact::volume`]; the bound is
+    /// of the order of 10⁻¹⁶ relative, slivers included). `rounding` bounds what rounding the
+    /// intersection points alone moves it by; a repair ([`Output::repair`]) may move it more.
+    pub exact_volume: Volume,
 }
 
 impl Evaluation {
@@ -311,7 +322,25 @@ impl Evaluation {
     /// ([`output`]; [`BooleanError::Invalid`] when it cannot be made valid).
     pub fn output(&self, op: Operation, regularized: bool) -> Result<Output> {
         let out = self.output_in_frame(op, regularized)?;
-        Ok(Output { mesh: self.frame.mesh_out(out.mesh)?, ..out })
+        let exact_volume = out.exact_volume.scaled(|x| self.frame.volume_out(x));
+        Ok(Output { mesh: self.frame.mesh_out(out.mesh)?, exact_volume, ..out })
+    }
+
+    /// The certified volume of `tris` (over the refinement's point ids) in the operands'
+    /// frame, from the exact points ([`Point::coordinates`]); the intersection points are
+    /// the ones rounded when written.
+    fn exact_volume(&self, tris: &[[u32; 3]]) -> Volume {
+        let r = &self.refinement;
+        let first = r.first_new;
+        let implicit: Vec<[Ball; 3]> =
+            r.implicit.par_iter().with_min_len(256).map(Point::coordinates).collect();
+        volume::signed_volume(tris, |id| {
+            if id < first {
+                (r.points[id as usize].to_array().map(Ball::of), false)
+            } else {
+                (implicit[(id - first) as usize], true)
+            }
+        })
     }
 
     /// [`Evaluation::output`] in the operands' frame (a power-of-two scale: the rounding,
@@ -320,8 +349,9 @@ impl Evaluation {
         let (r, c) = (&self.refinement, &self.classification);
         let (tris, from_a) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
         if !regularized {
-            let mesh = select::assemble(&r.points, &tris);
-            return Ok(Output { mesh, from_a, repair: Repair::default() });
+            let (mesh, exact_volume) =
+                rayon::join(|| select::assemble(&r.points, &tris), || self.exact_volume(&tris));
+            return Ok(Output { mesh, from_a, repair: Repair::default(), exact_volume });
         }
         // The same walk as `select`: which selected triangles are uncut input triangles.
         let mut changed = Vec::with_capacity(tris.len());
@@ -340,10 +370,11 @@ impl Evaluation {
             .chain(&self.b.positions)
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let diagonal = (hi - lo).length();
-        // The closure test runs beside the check after rounding; its verdict comes first.
-        let (done, (boundary, misoriented)) = rayon::join(
+        // The closure test and the exact volume run beside the check after rounding; the
+        // closure's verdict comes first.
+        let (done, ((boundary, misoriented), exact_volume)) = rayon::join(
             || output::finish(&r.points, first_new, &tris, &changed, diagonal),
-            || crate::mesh::validate::edge_defects(&tris),
+            || rayon::join(|| crate::mesh::validate::edge_defects(&tris), || self.exact_volume(&tris)),
         );
         if boundary > 0 || misoriented > 0 {
             return Err(BooleanError::NotClosed { op, boundary, misoriented });
@@ -360,7 +391,7 @@ impl Evaluation {
                 reason: InvalidResult::NotOperand { reason: e.to_string() },
             })?;
         }
-        Ok(Output { mesh, from_a, repair })
+        Ok(Output { mesh, from_a, repair, exact_volume })
     }
 
     /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its

@@ -227,6 +227,11 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
+/// The `--stats` line of a result's exact volume beside the written file's.
+fn volume_line(what: &str, exact: &boolean::Volume, written: f64) -> String {
+    format!("{what} volume {} exact (± {:.1e}; written, rounded to f64: {written})", exact.value, exact.error)
+}
+
 fn volume(mesh: &Mesh) -> f64 {
     if mesh.num_faces() == 0 { 0.0 } else { covering::measures(mesh).0 }
 }
@@ -259,7 +264,10 @@ pub fn run_expression(
     let mut lines = Vec::new();
     let mut steps_json = Vec::new();
     let steps = expr.operations();
+    // The last step computes the whole expression: its exact volume is the result's.
+    let mut exact = None;
     let result = expr::evaluate(expr, &named, &evaluate.options(), ctx.as_ref(), |s| {
+        exact = Some(s.exact_volume);
         if !evaluate.stats {
             return;
         }
@@ -269,6 +277,8 @@ pub fn run_expression(
             step["expr"] = s.expr.to_string().into();
             step["op"] = s.op.name().into();
             step["triangles"] = s.result.num_faces().into();
+            step["exact_volume"] = s.exact_volume.value.into();
+            step["exact_volume_error"] = s.exact_volume.error.into();
             step["repair"] = repair_json(&s.repair);
             step["time"] = serde_json::json!({
                 "check_ms": ms(t.check),
@@ -291,6 +301,10 @@ pub fn run_expression(
         lines.extend(evaluation_lines(s.names.a, s.names.b, s.evaluation).map(|l| format!("  {l}")));
         lines.push(format!("  after rounding to f64: {}", s.repair));
         lines.push(format!(
+            "  volume {} exact (± {:.1e}), before rounding to f64",
+            s.exact_volume.value, s.exact_volume.error
+        ));
+        lines.push(format!(
             "  time: checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms)",
             ms(t.check),
             ms(t.refine),
@@ -311,6 +325,8 @@ pub fn run_expression(
             "expr": title,
             "triangles": result.num_faces(),
             "volume": volume,
+            "exact_volume": exact.map(|v| v.value),
+            "exact_volume_error": exact.map(|v| v.error),
             "output": output.display().to_string(),
         });
         if evaluate.stats {
@@ -328,6 +344,9 @@ pub fn run_expression(
     if evaluate.stats {
         for l in &lines {
             say!("{l}");
+        }
+        if let Some(v) = exact {
+            say!("{}", volume_line(title, &v, volume));
         }
         say!(
             "time: read {:.1} ms, {steps} operation(s) {:.1} ms, write {:.1} ms, total {:.1} ms",
@@ -530,6 +549,8 @@ impl Finished<'_> {
                     "regularized": self.regularized,
                     "triangles": out.mesh.num_faces(),
                     "volume": volume,
+                    "exact_volume": out.exact_volume.value,
+                    "exact_volume_error": out.exact_volume.error,
                     "output": path.display().to_string(),
                 });
                 if stats && self.regularized {
@@ -567,6 +588,9 @@ impl Finished<'_> {
         }
         for (op, _, out) in self.results.iter().filter(|_| self.regularized) {
             say!("{op} after rounding to f64: {}", out.repair);
+        }
+        for ((op, _, out), &written) in self.results.iter().zip(self.volumes) {
+            say!("{}", volume_line(op.name(), &out.exact_volume, written));
         }
         say!(
             "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms), write {:.1} ms, total {:.1} ms",
