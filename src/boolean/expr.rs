@@ -296,8 +296,6 @@ pub struct Step<'a> {
     pub result: &'a Mesh,
     /// What the check of the result after rounding found and repaired.
     pub repair: Repair,
-    /// The exact result's volume, before rounding ([`super::Output::exact_volume`]).
-    pub exact_volume: super::Volume,
     /// Wall time of picking and assembling the result.
     pub assemble: std::time::Duration,
 }
@@ -356,7 +354,7 @@ fn eval<'o>(
             let ev = super::evaluate(&a, &b, names, options, ctx)?;
             drop((a, b));
             let start = std::time::Instant::now();
-            let super::Output { mesh: result, repair, exact_volume, .. } = ev.output(*op, true)?;
+            let super::Output { mesh: result, repair, .. } = ev.output(*op, true)?;
             *count += 1;
             step(&Step {
                 index: *count,
@@ -366,7 +364,6 @@ fn eval<'o>(
                 evaluation: &ev,
                 result: &result,
                 repair,
-                exact_volume,
                 assemble: start.elapsed(),
             });
             Ok((Cow::Owned(result), format!("({expr})")))

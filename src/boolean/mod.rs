@@ -293,12 +293,6 @@ pub struct Output {
     /// What the check after rounding found and repaired (nothing for non-regularized
     /// results, which are not checked).
     pub repair: Repair,
-    /// The volume of the exact result, before rounding to f64 and any repair: from the
-    /// selected triangles over the exact points (implicit intersection points in
-    /// double-double), with a certified error bound ([`crate::exact::volume`]; the bound is
-    /// of the order of 10⁻¹⁶ relative, slivers included). `rounding` bounds what rounding the
-    /// intersection points alone moves it by; a repair ([`Output::repair`]) may move it more.
-    pub exact_volume: Volume,
 }
 
 impl Evaluation {
@@ -322,25 +316,32 @@ impl Evaluation {
     /// ([`output`]; [`BooleanError::Invalid`] when it cannot be made valid).
     pub fn output(&self, op: Operation, regularized: bool) -> Result<Output> {
         let out = self.output_in_frame(op, regularized)?;
-        let exact_volume = out.exact_volume.scaled(|x| self.frame.volume_out(x));
-        Ok(Output { mesh: self.frame.mesh_out(out.mesh)?, exact_volume, ..out })
+        Ok(Output { mesh: self.frame.mesh_out(out.mesh)?, ..out })
     }
 
-    /// The certified volume of `tris` (over the refinement's point ids) in the operands'
-    /// frame, from the exact points ([`Point::coordinates`]); the intersection points are
-    /// the ones rounded when written.
-    fn exact_volume(&self, tris: &[[u32; 3]]) -> Volume {
-        let r = &self.refinement;
+    /// The volume of the exact result of `op`, before rounding to f64 and any repair, in the
+    /// operands' units: the selected triangles over the exact points (input vertices, and
+    /// the implicit intersection points divided out in double-double), with a certified
+    /// error bound ([`crate::exact::volume`]: of the order of 10⁻¹⁶ relative, slivers
+    /// included). Its `rounding` bounds what rounding the intersection points alone moves
+    /// it by; a repair ([`Output::repair`]) may move it more. Computed on request (a few %
+    /// of a plain evaluation's instructions for a large result): commands ask for it with
+    /// `--stats` or `--json`.
+    pub fn exact_volume(&self, op: Operation, regularized: bool) -> Volume {
+        let (r, c) = (&self.refinement, &self.classification);
+        let (tris, _) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
         let first = r.first_new;
         let implicit: Vec<[Ball; 3]> =
             r.implicit.par_iter().with_min_len(256).map(Point::coordinates).collect();
-        volume::signed_volume(tris, |id| {
+        // Intersection points are the ones rounded when written.
+        let v = volume::signed_volume(&tris, |id| {
             if id < first {
                 (r.points[id as usize].to_array().map(Ball::of), false)
             } else {
                 (implicit[(id - first) as usize], true)
             }
-        })
+        });
+        v.scaled(|x| self.frame.volume_out(x))
     }
 
     /// [`Evaluation::output`] in the operands' frame (a power-of-two scale: the rounding,
@@ -349,9 +350,8 @@ impl Evaluation {
         let (r, c) = (&self.refinement, &self.classification);
         let (tris, from_a) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
         if !regularized {
-            let (mesh, exact_volume) =
-                rayon::join(|| select::assemble(&r.points, &tris), || self.exact_volume(&tris));
-            return Ok(Output { mesh, from_a, repair: Repair::default(), exact_volume });
+            let mesh = select::assemble(&r.points, &tris);
+            return Ok(Output { mesh, from_a, repair: Repair::default() });
         }
         // The same walk as `select`: which selected triangles are uncut input triangles.
         let mut changed = Vec::with_capacity(tris.len());
@@ -370,11 +370,10 @@ impl Evaluation {
             .chain(&self.b.positions)
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let diagonal = (hi - lo).length();
-        // The closure test and the exact volume run beside the check after rounding; the
-        // closure's verdict comes first.
-        let (done, ((boundary, misoriented), exact_volume)) = rayon::join(
+        // The closure test runs beside the check after rounding; its verdict comes first.
+        let (done, (boundary, misoriented)) = rayon::join(
             || output::finish(&r.points, first_new, &tris, &changed, diagonal),
-            || rayon::join(|| crate::mesh::validate::edge_defects(&tris), || self.exact_volume(&tris)),
+            || crate::mesh::validate::edge_defects(&tris),
         );
         if boundary > 0 || misoriented > 0 {
             return Err(BooleanError::NotClosed { op, boundary, misoriented });
@@ -391,7 +390,7 @@ impl Evaluation {
                 reason: InvalidResult::NotOperand { reason: e.to_string() },
             })?;
         }
-        Ok(Output { mesh, from_a, repair, exact_volume })
+        Ok(Output { mesh, from_a, repair })
     }
 
     /// Refined operand A (`b` false) or B (`b` true) as a mesh, in the operands' frame: its

@@ -265,10 +265,11 @@ impl Point {
 
 impl Point {
     /// The coordinates X/W as double-double balls ([`Ball`]) that certainly hold the exact
-    /// ones, each a few 2⁻¹⁰⁶ (relative) wide: for measures of an exact result (its
-    /// volume), never for decisions. Explicit points are exact; an implicit one takes its
-    /// homogeneous coordinates in double-double, or from expansions where W's ball is too
-    /// wide to divide by (W nearly cancelling).
+    /// ones, each at most 2⁻⁸⁴·(|x| + 1) wide (a few 2⁻¹⁰⁶ of it where expansions serve):
+    /// for measures of an exact result (its volume), never for decisions. Explicit points
+    /// are exact; an implicit one takes its homogeneous coordinates in double-double, or
+    /// from expansions where that ball is wider (a segment grazing its plane makes X and W
+    /// small differences of large products) or W's ball cannot be divided by.
     pub fn coordinates(&self) -> [Ball; 3] {
         if let Definition::Explicit(p) = self.definition {
             return p.to_array().map(Ball::of);
@@ -277,13 +278,23 @@ impl Point {
             let [x, y, z] = [h[0].div(&h[3])?, h[1].div(&h[3])?, h[2].div(&h[3])?];
             Some([x, y, z])
         };
-        divide(&homogeneous::<Ball>(&self.definition)).unwrap_or_else(|| {
-            let exact = self.exact().each_ref().map(Ball::of_exact);
-            divide(&exact)
-                .unwrap_or_else(|| unreachable!("W ≠ 0 for a crossing point, and its ball is narrow"))
-        })
+        let narrow = |c: &[Ball; 3]| c.iter().all(|b| b.radius() <= NARROW * (b.value().abs() + 1.0));
+        match divide(&homogeneous::<Ball>(&self.definition)) {
+            Some(c) if narrow(&c) => c,
+            _ => {
+                let exact = self.exact().each_ref().map(Ball::of_exact);
+                divide(&exact)
+                    .unwrap_or_else(|| unreachable!("W ≠ 0 for a crossing point, and its ball is narrow"))
+            }
+        }
     }
 }
+
+/// The widest coordinate ball [`Point::coordinates`] takes from double-double, relative to
+/// |x| + 1 (frame coordinates are at most 2): 2⁻⁸⁴. Generic crossings of small triangles
+/// come out near 2⁻⁹³ (differences of coordinates near 1 that are 2⁻⁷ apart lose 7 bits);
+/// a segment grazing its plane loses more and takes the expansions.
+const NARROW: f64 = 1.0 / 19342813113834066795298816.0;
 
 /// Each coordinate X/W rounded to nearest where double-double decides it.
 fn rounded_fast(d: &Definition) -> [Option<f64>; 3] {

@@ -108,6 +108,12 @@ impl Ball {
         self.hi + self.lo
     }
 
+    /// The radius around `hi + lo`.
+    #[inline]
+    pub fn radius(&self) -> f64 {
+        self.rad
+    }
+
     /// An upper bound of how far every value of the ball lies from [`Ball::value`]: the
     /// radius plus the rounding of `hi + lo` to f64 (at most u·|value|).
     pub fn error(&self) -> f64 {

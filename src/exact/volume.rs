@@ -1,15 +1,15 @@
 //! The volume of a closed, oriented triangle surface whose vertices are known as
 //! double-double balls ([`Ball`]: exact f64 input vertices, or implicit intersection points
-//! divided out to about 2⁻¹⁰⁶ relative), with a certified error bound: Alg. 3-1's signed
+//! divided out to at most 2⁻⁸⁴ of |x| + 1), with a certified error bound: Alg. 3-1's signed
 //! tetrahedra with apex at the origin, each determinant and their sum in double-double.
 //!
 //! Accuracy: [`Volume::error`] bounds |value − exact volume| rigorously (every rounding of
 //! the double-double arithmetic and the width of every vertex ball are carried as ball
-//! radii, and the last rounding to f64 is added). It is of the order of 2⁻¹⁰⁰ times the
-//! sum of the determinants' absolute products (at most 2⁻⁹⁰ of it through the partial sums
-//! of a chunk) plus half an ulp of the value: for a sliver whose volume is 10⁻⁸ of the big
-//! cancelling terms, still about 10⁻¹⁶ relative, where an f64 sum of the same terms (or of
-//! the vertices rounded to f64) can be off by 10⁻⁸ relative.
+//! radii, and the last rounding to f64 is added). It is of the order of the vertex balls'
+//! widths (2⁻⁸⁴ at most) times the sum of the determinants' absolute products, plus half an
+//! ulp of the value: for a sliver whose volume is 10⁻⁸ of the big cancelling terms, still
+//! below 10⁻¹⁵ relative (e.g. 1e-16 for a cube minus its copy turned 1e-6°), where an f64
+//! sum of the same terms (or of the vertices rounded to f64) can be off by 10⁻⁸ relative.
 //!
 //! [`Volume::rounding`] bounds how far the volume of the same triangles moves when the
 //! vertices given as implicit are rounded to their nearest f64 (nothing else changed):
@@ -112,7 +112,8 @@ mod tests {
 
     #[test]
     fn exact_vertices_give_the_exact_volume_within_the_bound() {
-        for o in [0.0, -0.5, 0.1, 1e3 + 0.3] {
+        // Offsets whose sums with 0 and 1 are exact, so that the cube is exactly a unit cube.
+        for o in [0.0, -0.5, 0.375, 1024.25] {
             let (p, t) = cube(o);
             let v = signed_volume(&t, |i| (p[i as usize].map(Ball::of), false));
             assert!((v.value - 1.0).abs() <= v.error, "{v:?}");

@@ -267,7 +267,11 @@ pub fn run_expression(
     // The last step computes the whole expression: its exact volume is the result's.
     let mut exact = None;
     let result = expr::evaluate(expr, &named, &evaluate.options(), ctx.as_ref(), |s| {
-        exact = Some(s.exact_volume);
+        if !evaluate.stats && !evaluate.json {
+            return;
+        }
+        let exact_volume = s.evaluation.exact_volume(s.op, true);
+        exact = Some(exact_volume);
         if !evaluate.stats {
             return;
         }
@@ -277,8 +281,8 @@ pub fn run_expression(
             step["expr"] = s.expr.to_string().into();
             step["op"] = s.op.name().into();
             step["triangles"] = s.result.num_faces().into();
-            step["exact_volume"] = s.exact_volume.value.into();
-            step["exact_volume_error"] = s.exact_volume.error.into();
+            step["exact_volume"] = exact_volume.value.into();
+            step["exact_volume_error"] = exact_volume.error.into();
             step["repair"] = repair_json(&s.repair);
             step["time"] = serde_json::json!({
                 "check_ms": ms(t.check),
@@ -302,7 +306,7 @@ pub fn run_expression(
         lines.push(format!("  after rounding to f64: {}", s.repair));
         lines.push(format!(
             "  volume {} exact (± {:.1e}), before rounding to f64",
-            s.exact_volume.value, s.exact_volume.error
+            exact_volume.value, exact_volume.error
         ));
         lines.push(format!(
             "  time: checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms)",
@@ -466,11 +470,17 @@ pub fn run(device: Option<&str>, args: Args) -> anyhow::Result<()> {
             path.display()
         );
     }
+    let exact: Vec<boolean::Volume> = if args.evaluate.stats || args.evaluate.json {
+        results.iter().map(|(op, _, _)| ev.exact_volume(*op, regularized)).collect()
+    } else {
+        Vec::new()
+    };
     let run = Finished {
         names: [&a_name, &b_name],
         ev: &ev,
         results: &results,
         volumes: &volumes,
+        exact: &exact,
         regularized,
         ctx: ctx.as_ref(),
     };
@@ -530,6 +540,8 @@ struct Finished<'a> {
     results: &'a [Written],
     /// Each result's volume.
     volumes: &'a [f64],
+    /// Each result's exact volume before rounding (with --stats or --json; else empty).
+    exact: &'a [boolean::Volume],
     regularized: bool,
     ctx: Option<&'a Context>,
 }
@@ -543,14 +555,15 @@ impl Finished<'_> {
             .results
             .iter()
             .zip(self.volumes)
-            .map(|((op, path, out), volume)| {
+            .enumerate()
+            .map(|(i, ((op, path, out), volume))| {
                 let mut o = serde_json::json!({
                     "op": op.name(),
                     "regularized": self.regularized,
                     "triangles": out.mesh.num_faces(),
                     "volume": volume,
-                    "exact_volume": out.exact_volume.value,
-                    "exact_volume_error": out.exact_volume.error,
+                    "exact_volume": self.exact.get(i).map(|v| v.value),
+                    "exact_volume_error": self.exact.get(i).map(|v| v.error),
                     "output": path.display().to_string(),
                 });
                 if stats && self.regularized {
@@ -589,8 +602,10 @@ impl Finished<'_> {
         for (op, _, out) in self.results.iter().filter(|_| self.regularized) {
             say!("{op} after rounding to f64: {}", out.repair);
         }
-        for ((op, _, out), &written) in self.results.iter().zip(self.volumes) {
-            say!("{}", volume_line(op.name(), &out.exact_volume, written));
+        for (i, ((op, _, _), &written)) in self.results.iter().zip(self.volumes).enumerate() {
+            if let Some(exact) = self.exact.get(i) {
+                say!("{}", volume_line(op.name(), exact, written));
+            }
         }
         say!(
             "time: read {:.1} ms, checks {:.1} ms, phase 1 (index + refinement) {:.1} ms, phase 2 (classifiers {:.1} ms + tests {:.1} ms + assembly and output check {:.1} ms), write {:.1} ms, total {:.1} ms",
