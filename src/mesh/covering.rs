@@ -18,8 +18,9 @@ use super::disjoint_sets::UnionFind;
 use super::frame::Frame;
 use crate::exact::rounding::Ball;
 
-/// u = 2⁻⁵³, the unit roundoff of f64.
-const U: f64 = 1.0 / 9007199254740992.0;
+/// A shell whose volume is less than this share of the sum of its tetrahedra's absolute
+/// volumes is measured again in double-double ([`Covering::shell_measures`]): 2⁻²⁰.
+const SLIVER: f64 = 1.0 / 1048576.0;
 
 /// What [`Covering::shell_measures`] finds for one shell.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -258,12 +259,10 @@ impl Covering {
     /// exact however far the shell lies from the origin, and the determinants small. The
     /// moment Σ Vᵢ·(A+B+C−3O)/4 is taken about that apex, which is returned too.
     ///
-    /// The volume is summed in f64 with an error bound (each difference to the apex, each
-    /// determinant and the compensated sum: within 1.5·u of the sum of the determinants'
-    /// absolute products, plus 2·u of the value); when that bound exceeds 2⁻⁴³ (10⁻¹³) of
-    /// the value, as for a thin sliver whose volume is what is left of large cancelling
-    /// tetrahedra, it is summed again in double-double ([`crate::exact::volume`]), within
-    /// about 10⁻¹⁶ of it. Either way the volume is within 10⁻¹³ (relative) of the covering's.
+    /// The volume is summed in f64; when it is less than 2⁻²⁰ of the sum of the tetrahedra's
+    /// absolute volumes (a thin sliver, whose volume is what is left of large cancelling
+    /// tetrahedra, and whose f64 sum can be off by 10⁻⁸ of it), it is summed again in
+    /// double-double ([`crate::exact::volume`], within about 10⁻¹⁶ of it, certified).
     pub fn shell_measures(&self, faces: &[u32]) -> ShellMeasures {
         let (lo, hi) = faces.iter().flat_map(|&f| self.polygon(f as usize)).fold(
             (DVec3::INFINITY, DVec3::NEG_INFINITY),
@@ -275,7 +274,6 @@ impl Covering {
         let apex = if lo.cmple(hi).all() { (lo + hi) * 0.5 } else { DVec3::ZERO };
         let mut volume = Compensated::default();
         let mut magnitude = 0.0;
-        let mut products = 0.0;
         let mut moment = [Compensated::default(), Compensated::default(), Compensated::default()];
         for t in faces.iter().flat_map(|&f| self.face_triangles(f as usize)) {
             let [a, b, c] = self.triangle(t);
@@ -283,19 +281,13 @@ impl Covering {
             let v = a.dot(b.cross(c)) / 6.0;
             volume.add(v);
             magnitude += v.abs();
-            let (x, y, z) = (a.abs(), b.abs(), c.abs());
-            products +=
-                x.x * (y.y * z.z + y.z * z.y) + x.y * (y.z * z.x + y.x * z.z) + x.z * (y.x * z.y + y.y * z.x);
             let m = v * (a + b + c) * 0.25;
             for (k, sum) in moment.iter_mut().enumerate() {
                 sum.add(m[k]);
             }
         }
         let mut volume = volume.value();
-        // 3u for the differences, 5u for the determinant, u for the division (the sum of the
-        // six products is at least |6v|), the margin for the sums of non-negative terms.
-        let bound = products * (1.5 * U) * (1.0 + 1e-3) + 2.0 * U * volume.abs();
-        if bound.is_nan() || bound > volume.abs() * 2f64.powi(-43) {
+        if volume.abs() < magnitude * SLIVER {
             volume = self.shell_volume_double_double(faces, apex);
         }
         ShellMeasures {
