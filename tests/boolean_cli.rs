@@ -59,7 +59,15 @@ fn one_operation_and_all_of_them() {
     // Two 2×2×2 cubes overlapping in a unit cube.
     assert!((volume(&out) - 15.0).abs() < 1e-12, "{}", volume(&out));
     let text = stdout(&o);
-    for want in ["A ∪ B", "candidate pairs", "point tests", "saved", "phase 1", "phase 2"] {
+    for want in [
+        "A ∪ B",
+        "candidate pairs",
+        "point tests",
+        "saved",
+        "phase 1",
+        "phase 2",
+        "union volume 15 exact (± ",
+    ] {
         assert!(text.contains(want), "{want}: {text}");
     }
 

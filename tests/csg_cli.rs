@@ -45,7 +45,13 @@ fn an_expression_equals_its_operations_one_by_one() {
     args.extend(["-o", &out, "--stats"]);
     let text = ok(&args);
     assert!(text.starts_with(&format!("{expr}: ")), "{text}");
-    for want in ["step 1/4: a (builtin:cube) ∪ b (builtin:cube) = a | b:", "step 4/4: (", "operation(s)"] {
+    for want in [
+        "step 1/4: a (builtin:cube) ∪ b (builtin:cube) = a | b:",
+        "step 4/4: (",
+        "operation(s)",
+        "exact (± ",
+        "), before rounding to f64",
+    ] {
         assert!(text.contains(want), "{want}: {text}");
     }
 
