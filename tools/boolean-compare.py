@@ -17,8 +17,9 @@ three tools get the same two files. Per tool, pair and operation the outcome is 
 
 The volume compared is texgeo's exact one (its result before rounding to f64, which `texgeo
 boolean --json` reports with a certified error bound) and manifold's written file's; the
-written file's volume (`texgeo mesh stats`) is compared too, in the last columns: for thin
-results, rounding the intersection points to f64 alone moves it by more than 1e-9.
+written file's volume (`texgeo mesh stats`, which sums a thin sliver's tetrahedra in
+double-double) is compared too, in the last columns. CGAL's is its exact volume converted to
+f64 (tools/cgal-boolean.cpp).
 
 Writes results.csv (one row per tool, pair and operation) and table.md and table.csv (per tool and
 transform: counts of each outcome, invalid results, volumes more than 1e-9 (relative) from
