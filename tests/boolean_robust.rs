@@ -338,6 +338,40 @@ fn a_sliver_difference_reused_against_the_solids_that_made_it() {
     reuse_difference("star prism, B turned 1e-6°", &a, &turn.apply(&a).unwrap());
 }
 
+/// The sphere minus its copy turned 10° about a skew axis and shifted (as `--transform-b`
+/// places it), used again against the copy and against the sphere. The difference carries
+/// the copy's faces reversed with corners rounded a hair off their planes: where both
+/// layers are kept the exact result holds a sheet between them, whose outline has corners
+/// in line within an ulp (rebuilt with its cover counted by winding numbers, after splits
+/// at those corners and snaps of corners a few ulps apart: `Repair::sheets`); where both
+/// go, S ∩ B, what is left is such sheets
+/// only (dropped whole: they carry no volume). Every result re-reads as an operand.
+#[test]
+fn a_turned_difference_reused_against_its_cutter() {
+    let a = procedural::sphere(16, 32);
+    let turn = Transform::parse("rotate 1 2 3 10; translate 0.01 0.02 0.005").unwrap();
+    let b = turn.apply(&a).unwrap();
+    let options = Options::default();
+    let evaluate = |x: &Mesh, y: &Mesh| boolean::evaluate(x, y, Names::default(), &options, None).unwrap();
+    let s = evaluate(&a, &b).result(Operation::Difference, true).unwrap();
+    let against_b = evaluate(&s, &b);
+    let union = against_b.output(Operation::Union, true).unwrap_or_else(|e| panic!("S ∪ B: {e}"));
+    assert!(union.repair.sheets > 0, "{}", union.repair);
+    assert_operand("S ∪ B", &union.mesh);
+    let inter = against_b.result(Operation::Intersection, true).unwrap_or_else(|e| panic!("S ∩ B: {e}"));
+    assert!(volume(&inter).abs() <= 1e-12, "S ∩ B: {}", volume(&inter));
+    assert_operand("S ∩ B", &inter);
+    for op in [Operation::Difference, Operation::SymmetricDifference] {
+        let r = against_b.result(op, true).unwrap_or_else(|e| panic!("S {op} B: {e}"));
+        assert_operand(&format!("S {op} B"), &r);
+    }
+    let against_a = evaluate(&s, &a);
+    for op in Operation::ALL {
+        let r = against_a.result(op, true).unwrap_or_else(|e| panic!("S {op} A: {e}"));
+        assert_operand(&format!("S {op} A"), &r);
+    }
+}
+
 /// A difference used again against the solid that cut it, B shifted by half the width:
 /// corners of A − B that were intersection points on B's edges lie an ulp beside them.
 #[test]

@@ -43,7 +43,16 @@
 //! (rounding put it there by an ulp) goes by moving one of the intersection points among
 //! its triangles' corners to a neighbouring f64 position, each coordinate by an ulp or two,
 //! where the exact tests around that point find nothing crossing ([`nudge`]); then
-//! everything is checked again. A shell that encloses no volume by the
+//! everything is checked again. Where a crossing is still left, the flat region at it
+//! that holds faces of both orientations (a sheet between a face and a reversed copy of it
+//! a hair off its plane: a result used again against the solid that cut it carries that
+//! solid's faces with rounded corners) is rebuilt as a pocket is, its new triangles' cover
+//! counted by winding numbers across the region's outline instead of at their centroids
+//! (a sliver between corners in line within an ulp has a centroid that rounds out of it);
+//! where its outline's edges cross in the plane, first with its corners a few ulps apart
+//! snapped together and its outline's edges split at the corners a few ulps beside them.
+//! Each such rebuild is made only where it leaves fewer crossings and triangles without
+//! area around it ([`Repair::sheets`]). A shell that encloses no volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
 //! volume over its area) than a flat region's thickness, is dropped whole. A result the
@@ -120,6 +129,16 @@ pub struct Repair {
     pub pockets: usize,
     /// Triangles those regions had.
     pub pocket_triangles: usize,
+    /// Sheets between a face and a reversed copy of it a hair off its plane (a result
+    /// used again against the solid that cut it) rebuilt as one surface where nothing else
+    /// removed a crossing at their edge: the flat region counted by winding numbers
+    /// instead of at the centroids of its new triangles (slivers thinner than the rounding
+    /// of a centroid, between corners in line within an ulp), its outline first snapped
+    /// and split where its corners lie a few ulps from each other or from its edges (those
+    /// snaps and splits are counted with the others).
+    pub sheets: usize,
+    /// Triangles those sheets had.
+    pub sheet_triangles: usize,
     /// Long flat triangles (a corner on the opposite edge once rounded) removed by
     /// splitting the neighbour across that edge at the corner.
     pub flipped: usize,
@@ -138,6 +157,7 @@ impl Repair {
             && self.removed_triangles == 0
             && self.split_edges == 0
             && self.pockets == 0
+            && self.sheets == 0
             && self.flipped == 0
             && self.dropped_shells == 0
     }
@@ -149,7 +169,7 @@ impl std::fmt::Display for Repair {
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
-             ({} triangles rebuilt), {} long flat triangles split away, {} flat shells dropped",
+             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
@@ -161,6 +181,8 @@ impl std::fmt::Display for Repair {
             self.moved,
             self.pockets,
             self.pocket_triangles,
+            self.sheets,
+            self.sheet_triangles,
             self.flipped,
             self.dropped_shells
         )
@@ -242,7 +264,7 @@ pub fn finish(
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let mut nudges = 0;
+    let (mut nudges, mut sheets) = (0, 0);
     for round in 0.. {
         let (crossings, flat) = c.defects();
         if round == 0 {
@@ -269,6 +291,12 @@ pub fn finish(
                 .unwrap_or_else(|| c.flat_face(flat[0]));
             if nudges < NUDGES && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.repair) {
                 nudges += 1;
+                continue;
+            }
+            // Past the ulp moves, the sheets at the crossings (each where it leaves fewer
+            // defects around it).
+            if sheets < ROUNDS && c.rebuild_sheets(&crossings) {
+                sheets += 1;
                 continue;
             }
             return Err(err);
@@ -459,7 +487,7 @@ impl Cleanup {
             }
             // The region in the plane of either triangle.
             let Some(f) = [a, b].into_iter().find_map(|seed| {
-                flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness)
+                flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, false)
                     .filter(|f| f.removed.contains(&a) && f.removed.contains(&b))
             }) else {
                 continue;
@@ -475,6 +503,135 @@ impl Cleanup {
             added.extend(f.added);
         }
         self.replace(&gone, added)
+    }
+
+    /// The last resort for crossings that no snap, split, pocket, collapse or ulp move
+    /// removed: the flat region in the plane of either triangle where it holds faces of
+    /// both orientations (a sheet between a face and another's reversed copy a hair off
+    /// its plane: a result used again against the solid that cut it carries that solid's
+    /// faces with rounded corners) or both triangles, rebuilt as a pocket is but with its
+    /// cover counted by winding numbers ([`flatten`]), where that leaves fewer crossings
+    /// and triangles without area around it ([`local_rebuild`]). True when any was.
+    fn rebuild_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
+        let by_edge = edge_faces(&self.soup);
+        let boxes = self.soup.boxes();
+        let mut gone = vec![false; self.soup.triangles.len()];
+        let mut added = Vec::new();
+        for &(a, b) in crossings {
+            if gone[a] || gone[b] {
+                continue;
+            }
+            for seed in [a, b] {
+                let Some(f) = flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, true) else {
+                    continue;
+                };
+                let both = f.removed.contains(&a) && f.removed.contains(&b);
+                if !(both || f.opposed) || f.removed.iter().any(|&t| gone[t]) {
+                    continue;
+                }
+                let (before, after) = local_rebuild(&self.soup, &boxes, &f);
+                if after >= before {
+                    continue;
+                }
+                for &t in &f.removed {
+                    gone[t] = true;
+                }
+                self.repair.sheets += 1;
+                self.repair.sheet_triangles += f.removed.len();
+                added.extend(f.added);
+                break;
+            }
+        }
+        if self.replace(&gone, added) {
+            return true;
+        }
+        // None could be rebuilt as it is: its outline's corners in line within an ulp cross
+        // each other's edges in the plane. The first whose outline, split at those corners
+        // (in every triangle on the edge), can be rebuilt, where that leaves fewer defects.
+        crossings
+            .iter()
+            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed)))
+    }
+
+    /// The sheet in the plane of triangle `seed` with the points within a few ulps of its
+    /// corners snapped together ([`snap_map`]), its outline split at the corners beside
+    /// its edges ([`outline_splits`]) and then rebuilt ([`flatten`] by winding numbers),
+    /// made where that leaves fewer crossings and triangles without area at its corners
+    /// than before. True when it was.
+    fn split_sheet(&mut self, by_edge: &EdgeFaces, boxes: &[(DVec3, DVec3)], seed: usize) -> bool {
+        let Some(region) = flat_region(&self.soup, by_edge, seed, self.thickness) else { return false };
+        let (mut soup, mut origin, mut changed) =
+            (self.soup.clone(), self.origin.clone(), self.changed.clone());
+        let mut scratch = Repair::default();
+        // Corners a few ulps apart first (two that differ only across the plane are one
+        // point in its projection): snapped together, as at a defect.
+        let snaps = snap_map(&soup, region.iter().copied(), self.snap);
+        collapse(&mut soup, &mut origin, &mut changed, &snaps, true, &mut scratch);
+        let find = |soup: &TriangleSoup, tris: Vec<[u32; 3]>| {
+            let index: HashMap<[u32; 3], usize> =
+                soup.triangles.iter().enumerate().map(|(k, &t)| (t, k)).collect();
+            tris.into_iter().find_map(|t| index.get(&t).copied())
+        };
+        let snapped = |t: [u32; 3]| t.map(|v| snaps.get(&v).copied().unwrap_or(v));
+        let Some(start) = find(&soup, region.iter().map(|&t| snapped(self.soup.triangles[t])).collect())
+        else {
+            return false;
+        };
+        let Some(region) = flat_region(&soup, &edge_faces(&soup), start, self.thickness) else {
+            return false;
+        };
+        let splits = outline_splits(&soup, &region, self.snap);
+        if splits.is_empty() && snaps.is_empty() {
+            return false;
+        }
+        let before_splits = soup.clone();
+        for &(edge, at) in &splits {
+            split_edges(&mut soup, &mut origin, &mut changed, &HashMap::from_iter([(edge, at)]));
+            collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), true, &mut scratch);
+        }
+        // The seed, or another triangle of the region, as it is after the splits.
+        let Some(start) = find(&soup, region.iter().map(|&t| before_splits.triangles[t]).collect()) else {
+            return false;
+        };
+        let Some(f) = flatten(&soup, &edge_faces(&soup), &origin, start, self.thickness, true) else {
+            return false;
+        };
+        if !f.opposed {
+            return false;
+        }
+        let mut gone = vec![false; soup.triangles.len()];
+        for &t in &f.removed {
+            gone[t] = true;
+        }
+        let rebuilt = f.removed.len();
+        replace_marked(&mut soup, &mut origin, &mut changed, &gone, f.added);
+        // Defects at the region's corners (and those snapped onto them) before and after.
+        let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
+        at.extend(snaps.keys());
+        at.sort_unstable();
+        at.dedup();
+        let mut used = HashSet::new();
+        used.extend(soup.triangles.iter().flatten().copied());
+        let present: Vec<u32> = at.iter().copied().filter(|v| used.contains(v)).collect();
+        let same = |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
+        let before = local_defects(&self.soup, boxes, &at, same).0;
+        let after = local_defects(&soup, &soup.boxes(), &present, same).0;
+        if after >= before {
+            return false;
+        }
+        self.soup = soup;
+        self.origin = origin;
+        self.changed = changed;
+        for (&gone, &keep) in &snaps {
+            let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
+            self.repair.moved = self.repair.moved.max(d);
+        }
+        self.repair.snapped += snaps.len();
+        self.repair.split_edges += splits.len();
+        self.repair.removed_triangles += scratch.removed_triangles;
+        self.repair.sheets += 1;
+        self.repair.sheet_triangles += rebuilt;
+        true
     }
 
     /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
@@ -767,37 +924,14 @@ fn edge_faces(soup: &TriangleSoup) -> EdgeFaces {
     by_edge
 }
 
-/// A flat region rebuilt without its sliver: the triangles it removes and those it adds.
-struct Flattened {
-    removed: Vec<usize>,
-    /// New triangles, each with the origin of a removed triangle it lies on.
-    added: Vec<([u32; 3], u32)>,
-}
-
-/// Rebuilds the flat region around triangle `seed`, if it holds a sliver: the triangles
-/// connected to it by edges with every corner within `thickness` of its plane are replaced
-/// by a triangulation, in the plane's projection, of where they cover the plane a net once
-/// (bounded by their boundary edges left after opposite edges cancel). Nearly coincident
-/// faces kept from both operands (one's face outside the other, the other's inside the
-/// one, a hair apart) cover the plane once from each side: the sliver between them goes,
-/// and the region's boundary, where it joins the rest of the surface, stays edge for edge
-/// (closed and oriented). `None` when the new triangles would not have that boundary, or
-/// the change of volume is not negligible.
-fn flatten(
-    soup: &TriangleSoup,
-    by_edge: &EdgeFaces,
-    origin: &[u32],
-    seed: usize,
-    thickness: f64,
-) -> Option<Flattened> {
+/// The triangles connected to triangle `seed` by edges with every corner within
+/// `thickness` of its plane, the seed first; `None` beyond [`flat_region`]'s limit.
+fn flat_region(soup: &TriangleSoup, by_edge: &EdgeFaces, seed: usize, thickness: f64) -> Option<Vec<usize>> {
     /// Beyond this many triangles in one plane the search gives up (quadratic coverage).
     const MOST: usize = 4096;
     let [a, b, c] = soup.triangle(seed);
-    let normal = (b - a).cross(c - a);
-    let unit = normal.try_normalize()?;
-    let proj = Projection::along(normal)?;
+    let unit = (b - a).cross(c - a).try_normalize()?;
     let within = |t: usize| soup.triangle(t).iter().all(|&p| (p - a).dot(unit).abs() <= thickness);
-    // The faces in the plane, connected to the seed.
     let mut region = vec![seed];
     let mut seen = HashSet::from_iter([seed]);
     let mut next = 0;
@@ -817,6 +951,90 @@ fn flatten(
             }
         }
     }
+    Some(region)
+}
+
+/// The splits that put each corner of a flat region's outline (its edges left after
+/// opposite ones cancel) that lies within `snap` (per coordinate) of one of the outline's
+/// edges, strictly between its ends, onto that edge: (edge, corner) in the order to make
+/// them, each edge one of the outline's once the splits before it are made.
+fn outline_splits(soup: &TriangleSoup, region: &[usize], snap: f64) -> Vec<((u32, u32), u32)> {
+    let mut balance: HashMap<(u32, u32), i32> = HashMap::new();
+    for &t in region {
+        let tri = soup.triangles[t];
+        for k in 0..3 {
+            let (p, q) = (tri[k], tri[(k + 1) % 3]);
+            *balance.entry((p.min(q), p.max(q))).or_default() += if p < q { 1 } else { -1 };
+        }
+    }
+    let mut outline: Vec<(u32, u32)> = balance.into_iter().filter(|e| e.1 != 0).map(|e| e.0).collect();
+    let mut corners: Vec<u32> = outline.iter().flat_map(|&(p, q)| [p, q]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let within = |a: DVec3, b: DVec3| (a - b).abs().max_element() <= snap;
+    let mut splits = Vec::new();
+    while splits.len() < corners.len() {
+        outline.sort_unstable();
+        let found = outline.iter().enumerate().find_map(|(k, &(p, q))| {
+            let (pp, pq) = (soup.positions[p as usize], soup.positions[q as usize]);
+            let d = pq - pp;
+            corners.iter().find_map(|&v| {
+                let x = soup.positions[v as usize];
+                let s = (x - pp).dot(d) / d.length_squared();
+                let beside = v != p
+                    && v != q
+                    && s > 0.0
+                    && s < 1.0
+                    && !within(x, pp)
+                    && !within(x, pq)
+                    && within(x, pp + s * d);
+                beside.then_some((k, v))
+            })
+        });
+        let Some((k, v)) = found else { break };
+        let (p, q) = outline.swap_remove(k);
+        outline.extend([(p.min(v), p.max(v)), (v.min(q), v.max(q))]);
+        splits.push(((p, q), v));
+    }
+    splits
+}
+
+/// A flat region rebuilt without its sliver: the triangles it removes and those it adds.
+struct Flattened {
+    removed: Vec<usize>,
+    /// New triangles, each with the origin of a removed triangle it lies on.
+    added: Vec<([u32; 3], u32)>,
+    /// Whether the removed triangles face both ways in the plane (a sheet between a face
+    /// and a reversed copy of it).
+    opposed: bool,
+}
+
+/// Rebuilds the flat region around triangle `seed`, if it holds a sliver: the triangles
+/// connected to it by edges with every corner within `thickness` of its plane are replaced
+/// by a triangulation, in the plane's projection, of where they cover the plane a net once
+/// (bounded by their boundary edges left after opposite edges cancel). Nearly coincident
+/// faces kept from both operands (one's face outside the other, the other's inside the
+/// one, a hair apart) cover the plane once from each side: the sliver between them goes,
+/// and the region's boundary, where it joins the rest of the surface, stays edge for edge
+/// (closed and oriented). `None` when the new triangles would not have that boundary, or
+/// the change of volume is not negligible.
+///
+/// The cover of a new triangle is counted at its centroid; `by_winding` counts it instead
+/// as the winding number of the region's boundary around it ([`windings`]): a sliver
+/// between corners in line within an ulp may have a centroid that rounds onto or out of
+/// it, where the winding number is still exact.
+fn flatten(
+    soup: &TriangleSoup,
+    by_edge: &EdgeFaces,
+    origin: &[u32],
+    seed: usize,
+    thickness: f64,
+    by_winding: bool,
+) -> Option<Flattened> {
+    let [a, b, c] = soup.triangle(seed);
+    let normal = (b - a).cross(c - a);
+    let proj = Projection::along(normal)?;
+    let region = flat_region(soup, by_edge, seed, thickness)?;
     let flat: Vec<[DVec2; 3]> = region.iter().map(|&t| soup.triangle(t).map(|p| proj.apply(p))).collect();
     let side: Vec<i32> = flat.iter().map(|f| i32::from(orient2d(f[0], f[1], f[2]))).collect();
     // Net cover at x: +1 per face of the seed's side holding it, −1 per face of the other,
@@ -853,10 +1071,19 @@ fn flatten(
     let points: Vec<DVec2> = ids.iter().map(|&v| proj.apply(soup.positions[v as usize])).collect();
     let constraints: Vec<[u32; 2]> = boundary.keys().map(|&(p, q)| [local(p), local(q)]).collect();
     let cdt = triangulate::cdt(&points, &[], &constraints).ok()?;
+    let along = |p: u32, q: u32| {
+        let b = boundary.get(&(ids[p.min(q) as usize], ids[p.max(q) as usize])).copied().unwrap_or(0);
+        if p < q { b } else { -b }
+    };
+    let winding = if by_winding { Some(windings(&cdt.triangles, along, boundary.len())?) } else { None };
     let mut added = Vec::new();
-    for t in cdt.triangles {
+    for (i, t) in cdt.triangles.into_iter().enumerate() {
         let f = t.map(|v| points[v as usize]);
-        match cover((f[0] + f[1] + f[2]) / 3.0) {
+        let (centroid, first) = cover((f[0] + f[1] + f[2]) / 3.0);
+        // By winding number, a triangle with no region triangle holding its centroid takes
+        // the seed's origin.
+        let held = if by_winding { first.or(Some(0)) } else { first };
+        match (winding.as_ref().map_or(centroid, |w| w[i]), held) {
             (0, _) => {}
             (1, Some(k)) => added.push((t.map(|v| ids[v as usize]), origin[region[k]])),
             (-1, Some(k)) => added.push(([t[0], t[2], t[1]].map(|v| ids[v as usize]), origin[region[k]])),
@@ -877,7 +1104,99 @@ fn flatten(
     };
     let change: f64 = region.iter().map(|&t| volume(soup.triangles[t])).sum::<f64>()
         - added.iter().map(|a| volume(a.0)).sum::<f64>();
-    is_flat(change, lo, hi).then_some(Flattened { removed: region, added })
+    let opposed = side.contains(&1) && side.contains(&-1);
+    is_flat(change, lo, hi).then_some(Flattened { removed: region, added, opposed })
+}
+
+/// The winding number of a boundary around each triangle of a triangulation of its
+/// points (counter-clockwise triangles covering their convex hull): `along(p, q)` is the
+/// boundary's multiplicity on the directed edge p → q (of `edges` boundary edges). Outside
+/// the hull it is 0, and across each edge, from the triangle on its left to the one on its
+/// right, it drops by the multiplicity there. `None` when a boundary edge is not an edge
+/// of the triangulation, or the count disagrees with itself.
+fn windings(triangles: &[[u32; 3]], along: impl Fn(u32, u32) -> i32, edges: usize) -> Option<Vec<i32>> {
+    let mut left: HashMap<(u32, u32), usize> = HashMap::new();
+    for (i, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            left.insert((t[k], t[(k + 1) % 3]), i);
+        }
+    }
+    let on_boundary =
+        left.keys().filter(|&&(p, q)| (p < q || !left.contains_key(&(q, p))) && along(p, q) != 0).count();
+    if on_boundary != edges {
+        return None;
+    }
+    let mut winding: Vec<Option<i32>> = vec![None; triangles.len()];
+    let mut stack = Vec::new();
+    let set = |winding: &mut Vec<Option<i32>>, stack: &mut Vec<usize>, i: usize, w: i32| match winding[i] {
+        Some(x) => x == w,
+        None => {
+            winding[i] = Some(w);
+            stack.push(i);
+            true
+        }
+    };
+    for (i, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (p, q) = (t[k], t[(k + 1) % 3]);
+            if !left.contains_key(&(q, p)) && !set(&mut winding, &mut stack, i, along(p, q)) {
+                return None;
+            }
+        }
+    }
+    while let Some(i) = stack.pop() {
+        let t = triangles[i];
+        let w = winding[i]?;
+        for k in 0..3 {
+            let (p, q) = (t[k], t[(k + 1) % 3]);
+            if let Some(&j) = left.get(&(q, p)) {
+                if !set(&mut winding, &mut stack, j, w - along(p, q)) {
+                    return None;
+                }
+            }
+        }
+    }
+    winding.into_iter().collect()
+}
+
+/// Crossings and triangles without area at the corners of a flat region before and after
+/// it is rebuilt ([`flatten`]): its triangles and their neighbours against those whose
+/// boxes meet theirs.
+fn local_rebuild(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], f: &Flattened) -> (usize, usize) {
+    let mut at: Vec<u32> = f.removed.iter().flat_map(|&t| soup.triangles[t]).collect();
+    at.sort_unstable();
+    at.dedup();
+    local_defects(soup, boxes, &at.clone(), |sub, origin, changed, local| {
+        let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
+        // The region's triangles in the sub-soup, by their corners.
+        let mut removed: HashMap<[u32; 3], usize> = HashMap::new();
+        for &t in &f.removed {
+            if let [Some(a), Some(b), Some(c)] = soup.triangles[t].map(id) {
+                *removed.entry([a, b, c]).or_default() += 1;
+            }
+        }
+        let gone: Vec<bool> = sub
+            .triangles
+            .iter()
+            .map(|t| match removed.get_mut(t) {
+                Some(n) if *n > 0 => {
+                    *n -= 1;
+                    true
+                }
+                _ => false,
+            })
+            .collect();
+        let added: Vec<([u32; 3], u32)> = f
+            .added
+            .iter()
+            .filter_map(|&(t, o)| match t.map(id) {
+                [Some(a), Some(b), Some(c)] => Some(([a, b, c], o)),
+                _ => None,
+            })
+            .collect();
+        replace_marked(sub, origin, changed, &gone, added);
+        local.to_vec()
+    })
 }
 
 /// Crossings and triangles without area at `gone` and `keep` before and after `gone`
@@ -1217,21 +1536,22 @@ fn drop_flat_shells(
         sets.union(t[0], t[1]);
         sets.union(t[0], t[2]);
     }
-    let (lo, hi) =
-        soup.triangles.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(soup.positions[v as usize]), hi.max(soup.positions[v as usize]))
-        });
-    let apex = (lo + hi) * 0.5;
-    // Per shell root: volume, box and area.
+    // Per shell root: volume, box and area; the volume from the centre of the shell's own
+    // box (from one far away, the rounding of each term would outweigh a sheet's volume).
     let mut shells: HashMap<u32, (f64, DVec3, DVec3, f64)> = HashMap::new();
     let roots: Vec<u32> = soup.triangles.iter().map(|t| sets.find(t[0])).collect();
     for (t, &r) in soup.triangles.iter().zip(&roots) {
         let [a, b, c] = t.map(|v| soup.positions[v as usize]);
         let e = shells.entry(r).or_insert((0.0, DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0));
-        e.0 += signed_tetra_volume(apex, a, b, c);
         e.1 = e.1.min(a.min(b).min(c));
         e.2 = e.2.max(a.max(b).max(c));
         e.3 += 0.5 * (b - a).cross(c - a).length();
+    }
+    for (t, &r) in soup.triangles.iter().zip(&roots) {
+        let [a, b, c] = t.map(|v| soup.positions[v as usize]);
+        if let Some(e) = shells.get_mut(&r) {
+            e.0 += signed_tetra_volume((e.1 + e.2) * 0.5, a, b, c);
+        }
     }
     let flat: HashSet<u32> = shells
         .iter()

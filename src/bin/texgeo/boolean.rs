@@ -218,6 +218,8 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "flipped": r.flipped,
         "pockets": r.pockets,
         "pocket_triangles": r.pocket_triangles,
+        "sheets": r.sheets,
+        "sheet_triangles": r.sheet_triangles,
         "dropped_shells": r.dropped_shells,
         "moved": r.moved,
     })
