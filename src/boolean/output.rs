@@ -52,7 +52,12 @@
 //! where its outline's edges cross in the plane, first with its corners a few ulps apart
 //! snapped together and its outline's edges split at the corners a few ulps beside them.
 //! Each such rebuild is made only where it leaves fewer crossings and triangles without
-//! area around it ([`Repair::sheets`]). A shell that encloses no volume by the
+//! area around it ([`Repair::sheets`]). Past those, the sheets are rebuilt once more
+//! keeping their own edges that meet none of their others in the plane (a fresh diagonal
+//! beside a corner in line within an ulp with two others may pass over a thin wedge
+//! hinged at that corner), and any edge of a crossing triangle up to [`COLLAPSE`] × the
+//! diagonal is collapsed, not only the shortest: each again only where it leaves fewer
+//! defects around it. A shell that encloses no volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
 //! volume over its area) than a flat region's thickness, is dropped whole. A result the
@@ -264,7 +269,7 @@ pub fn finish(
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let (mut nudges, mut sheets) = (0, 0);
+    let (mut nudges, mut sheets, mut longer) = (0, 0, 0);
     for round in 0.. {
         let (crossings, flat) = c.defects();
         if round == 0 {
@@ -295,8 +300,14 @@ pub fn finish(
             }
             // Past the ulp moves, the sheets at the crossings (each where it leaves fewer
             // defects around it).
-            if sheets < ROUNDS && c.rebuild_sheets(&crossings) {
+            if sheets < ROUNDS && c.rebuild_sheets(&crossings, false) {
                 sheets += 1;
+                continue;
+            }
+            // Past the sheets, the sheets keeping their own edges that cross none of their
+            // others ([`flatten`]), then the other short edges of the crossing triangles.
+            if longer < ROUNDS && (c.rebuild_sheets(&crossings, true) || c.collapse_longer(&crossings)) {
+                longer += 1;
                 continue;
             }
             return Err(err);
@@ -487,7 +498,7 @@ impl Cleanup {
             }
             // The region in the plane of either triangle.
             let Some(f) = [a, b].into_iter().find_map(|seed| {
-                flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, false)
+                flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, false, false)
                     .filter(|f| f.removed.contains(&a) && f.removed.contains(&b))
             }) else {
                 continue;
@@ -512,7 +523,7 @@ impl Cleanup {
     /// faces with rounded corners) or both triangles, rebuilt as a pocket is but with its
     /// cover counted by winding numbers ([`flatten`]), where that leaves fewer crossings
     /// and triangles without area around it ([`local_rebuild`]). True when any was.
-    fn rebuild_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
+    fn rebuild_sheets(&mut self, crossings: &[(usize, usize)], keep: bool) -> bool {
         let by_edge = edge_faces(&self.soup);
         let boxes = self.soup.boxes();
         let mut gone = vec![false; self.soup.triangles.len()];
@@ -522,7 +533,8 @@ impl Cleanup {
                 continue;
             }
             for seed in [a, b] {
-                let Some(f) = flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, true) else {
+                let Some(f) = flatten(&self.soup, &by_edge, &self.origin, seed, self.thickness, true, keep)
+                else {
                     continue;
                 };
                 let both = f.removed.contains(&a) && f.removed.contains(&b);
@@ -550,7 +562,7 @@ impl Cleanup {
         // (in every triangle on the edge), can be rebuilt, where that leaves fewer defects.
         crossings
             .iter()
-            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed)))
+            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep)))
     }
 
     /// The sheet in the plane of triangle `seed` with the points within a few ulps of its
@@ -558,7 +570,13 @@ impl Cleanup {
     /// its edges ([`outline_splits`]) and then rebuilt ([`flatten`] by winding numbers),
     /// made where that leaves fewer crossings and triangles without area at its corners
     /// than before. True when it was.
-    fn split_sheet(&mut self, by_edge: &EdgeFaces, boxes: &[(DVec3, DVec3)], seed: usize) -> bool {
+    fn split_sheet(
+        &mut self,
+        by_edge: &EdgeFaces,
+        boxes: &[(DVec3, DVec3)],
+        seed: usize,
+        keep: bool,
+    ) -> bool {
         let Some(region) = flat_region(&self.soup, by_edge, seed, self.thickness) else { return false };
         let (mut soup, mut origin, mut changed) =
             (self.soup.clone(), self.origin.clone(), self.changed.clone());
@@ -593,45 +611,90 @@ impl Cleanup {
         let Some(start) = find(&soup, region.iter().map(|&t| before_splits.triangles[t]).collect()) else {
             return false;
         };
-        let Some(f) = flatten(&soup, &edge_faces(&soup), &origin, start, self.thickness, true) else {
-            return false;
-        };
-        if !f.opposed {
-            return false;
+        let by_edge = edge_faces(&soup);
+        {
+            let Some(f) = flatten(&soup, &by_edge, &origin, start, self.thickness, true, keep) else {
+                return false;
+            };
+            if !f.opposed {
+                return false;
+            }
+            let (mut soup, mut origin, mut changed) = (soup.clone(), origin.clone(), changed.clone());
+            let mut gone = vec![false; soup.triangles.len()];
+            for &t in &f.removed {
+                gone[t] = true;
+            }
+            let rebuilt = f.removed.len();
+            replace_marked(&mut soup, &mut origin, &mut changed, &gone, f.added);
+            // Defects at the region's corners (and those snapped onto them) before and after.
+            let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
+            at.extend(snaps.keys());
+            at.sort_unstable();
+            at.dedup();
+            let mut used = HashSet::new();
+            used.extend(soup.triangles.iter().flatten().copied());
+            let present: Vec<u32> = at.iter().copied().filter(|v| used.contains(v)).collect();
+            let same =
+                |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
+            let before = local_defects(&self.soup, boxes, &at, same).0;
+            let after = local_defects(&soup, &soup.boxes(), &present, same).0;
+            if after >= before {
+                return false;
+            }
+            self.soup = soup;
+            self.origin = origin;
+            self.changed = changed;
+            for (&gone, &keep) in &snaps {
+                let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
+                self.repair.moved = self.repair.moved.max(d);
+            }
+            self.repair.snapped += snaps.len();
+            self.repair.split_edges += splits.len();
+            self.repair.removed_triangles += scratch.removed_triangles;
+            self.repair.sheets += 1;
+            self.repair.sheet_triangles += rebuilt;
+            true
         }
-        let mut gone = vec![false; soup.triangles.len()];
-        for &t in &f.removed {
-            gone[t] = true;
+    }
+
+    /// The last resort for crossings past the sheets: any edge of either triangle at most
+    /// `limit` long, not only the shortest ([`Cleanup::plan`]), shortest first, collapsed
+    /// (an intersection point onto an input vertex, else either way) where that leaves fewer
+    /// crossings and triangles without area around it. True when one was.
+    fn collapse_longer(&mut self, crossings: &[(usize, usize)]) -> bool {
+        let boxes = self.soup.boxes();
+        for &(a, b) in crossings {
+            let mut edges: Vec<(f64, u32, u32)> = [a, b]
+                .iter()
+                .flat_map(|&f| {
+                    let t = self.soup.triangles[f];
+                    (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+                })
+                .map(|(p, q)| {
+                    (self.soup.positions[p as usize].distance(self.soup.positions[q as usize]), p, q)
+                })
+                .filter(|e| e.0 <= self.limit)
+                .collect();
+            edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+            edges.dedup();
+            for (length, p, q) in edges {
+                let ways = match (self.is_new(p), self.is_new(q)) {
+                    (true, false) => [(q, p), (q, p)],
+                    (false, true) => [(p, q), (p, q)],
+                    _ => [(p, q), (q, p)],
+                };
+                for (keep, gone) in ways {
+                    let (before, after) = local_crossings(&self.soup, &boxes, keep, gone);
+                    if after < before {
+                        self.repair.collapsed_edges += 1;
+                        self.repair.moved = self.repair.moved.max(length);
+                        self.collapse(&HashMap::from_iter([(gone, keep)]));
+                        return true;
+                    }
+                }
+            }
         }
-        let rebuilt = f.removed.len();
-        replace_marked(&mut soup, &mut origin, &mut changed, &gone, f.added);
-        // Defects at the region's corners (and those snapped onto them) before and after.
-        let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
-        at.extend(snaps.keys());
-        at.sort_unstable();
-        at.dedup();
-        let mut used = HashSet::new();
-        used.extend(soup.triangles.iter().flatten().copied());
-        let present: Vec<u32> = at.iter().copied().filter(|v| used.contains(v)).collect();
-        let same = |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
-        let before = local_defects(&self.soup, boxes, &at, same).0;
-        let after = local_defects(&soup, &soup.boxes(), &present, same).0;
-        if after >= before {
-            return false;
-        }
-        self.soup = soup;
-        self.origin = origin;
-        self.changed = changed;
-        for (&gone, &keep) in &snaps {
-            let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
-            self.repair.moved = self.repair.moved.max(d);
-        }
-        self.repair.snapped += snaps.len();
-        self.repair.split_edges += splits.len();
-        self.repair.removed_triangles += scratch.removed_triangles;
-        self.repair.sheets += 1;
-        self.repair.sheet_triangles += rebuilt;
-        true
+        false
     }
 
     /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
@@ -1022,7 +1085,11 @@ struct Flattened {
 /// The cover of a new triangle is counted at its centroid; `by_winding` counts it instead
 /// as the winding number of the region's boundary around it ([`windings`]): a sliver
 /// between corners in line within an ulp may have a centroid that rounds onto or out of
-/// it, where the winding number is still exact.
+/// it, where the winding number is still exact. `keep_edges` (by winding number) makes the
+/// region's own edges between corners of its boundary that meet no other of its edges or
+/// corners in the plane edges of the triangulation too: the region's triangles away from
+/// its sliver stay as they were (a fresh diagonal beside a corner in line within an ulp
+/// with two others may pass over a thin wedge hinged at that corner).
 fn flatten(
     soup: &TriangleSoup,
     by_edge: &EdgeFaces,
@@ -1030,6 +1097,7 @@ fn flatten(
     seed: usize,
     thickness: f64,
     by_winding: bool,
+    keep_edges: bool,
 ) -> Option<Flattened> {
     let [a, b, c] = soup.triangle(seed);
     let normal = (b - a).cross(c - a);
@@ -1069,7 +1137,10 @@ fn flatten(
     ids.dedup();
     let local = |v: u32| ids.binary_search(&v).map(|i| i as u32).unwrap_or(u32::MAX);
     let points: Vec<DVec2> = ids.iter().map(|&v| proj.apply(soup.positions[v as usize])).collect();
-    let constraints: Vec<[u32; 2]> = boundary.keys().map(|&(p, q)| [local(p), local(q)]).collect();
+    let mut constraints: Vec<[u32; 2]> = boundary.keys().map(|&(p, q)| [local(p), local(q)]).collect();
+    if keep_edges {
+        constraints.extend(kept_edges(soup, &region, &proj, &boundary, &ids));
+    }
     let cdt = triangulate::cdt(&points, &[], &constraints).ok()?;
     let along = |p: u32, q: u32| {
         let b = boundary.get(&(ids[p.min(q) as usize], ids[p.max(q) as usize])).copied().unwrap_or(0);
@@ -1106,6 +1177,72 @@ fn flatten(
         - added.iter().map(|a| volume(a.0)).sum::<f64>();
     let opposed = side.contains(&1) && side.contains(&-1);
     is_flat(change, lo, hi).then_some(Flattened { removed: region, added, opposed })
+}
+
+/// The edges of a flat region's triangles (by ids local to `ids`, the corners of its
+/// boundary) that are not on the boundary, join two of its corners, and meet no other edge
+/// of the region nor any corner in the plane's projection but at their ends; none for a
+/// region of more than [`kept_edges`]' limit.
+fn kept_edges(
+    soup: &TriangleSoup,
+    region: &[usize],
+    proj: &Projection,
+    boundary: &HashMap<(u32, u32), i32>,
+    ids: &[u32],
+) -> Vec<[u32; 2]> {
+    /// Beyond this many triangles the edges are not compared (quadratic).
+    const MOST: usize = 256;
+    if region.len() > MOST {
+        return Vec::new();
+    }
+    let mut edges: Vec<(u32, u32)> = region
+        .iter()
+        .flat_map(|&t| {
+            let tri = soup.triangles[t];
+            (0..3).map(move |k| (tri[k].min(tri[(k + 1) % 3]), tri[k].max(tri[(k + 1) % 3])))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let at = |v: u32| proj.apply(soup.positions[v as usize]);
+    let sign = |a: DVec2, b: DVec2, c: DVec2| i32::from(orient2d(a, b, c));
+    // Whether c lies on the closed segment a b (exactly, in the projection).
+    let on = |a: DVec2, b: DVec2, c: DVec2| {
+        sign(a, b, c) == 0 && c.cmpge(a.min(b)).all() && c.cmple(a.max(b)).all()
+    };
+    let meet = |(p, q): (u32, u32), (r, s): (u32, u32)| {
+        let (a, b, c, d) = (at(p), at(q), at(r), at(s));
+        let shared = [r, s].iter().filter(|v| **v == p || **v == q).count();
+        match shared {
+            2 => false,
+            // One end shared: they meet elsewhere only when in line and overlapping.
+            1 => {
+                let (o, x, y) = if r == p || r == q {
+                    (c, if r == p { b } else { a }, d)
+                } else {
+                    (d, if s == p { b } else { a }, c)
+                };
+                sign(o, x, y) == 0 && (x - o).dot(y - o) > 0.0
+            }
+            _ => {
+                let (o1, o2) = (sign(a, b, c), sign(a, b, d));
+                let (o3, o4) = (sign(c, d, a), sign(c, d, b));
+                (o1 * o2 < 0 && o3 * o4 < 0) || on(a, b, c) || on(a, b, d) || on(c, d, a) || on(c, d, b)
+            }
+        }
+    };
+    let local = |v: u32| ids.binary_search(&v).ok().map(|i| i as u32);
+    edges
+        .iter()
+        .filter(|e| !boundary.contains_key(e))
+        .filter_map(|&(p, q)| {
+            let (lp, lq) = (local(p)?, local(q)?);
+            let (a, b) = (at(p), at(q));
+            let clear = edges.iter().all(|&e| e == (p, q) || !meet((p, q), e))
+                && ids.iter().all(|&v| v == p || v == q || !on(a, b, at(v)));
+            clear.then_some([lp, lq])
+        })
+        .collect()
 }
 
 /// The winding number of a boundary around each triangle of a triangulation of its
