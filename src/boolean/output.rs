@@ -65,7 +65,7 @@
 //! [`InvalidResult::NotOperand`]). Anything still invalid is an error naming the faces and
 //! the place: never a silently invalid result.
 
-use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
+use crate::mesh::hash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -173,7 +173,7 @@ impl std::fmt::Display for Repair {
         write!(
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
-             {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed ({} triangles removed, points moved at most {:e}), {} flat slivers removed \
+             {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
              ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,

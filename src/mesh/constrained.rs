@@ -22,7 +22,7 @@
 
 use std::collections::VecDeque;
 
-use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
+use super::hash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
 use glam::DVec2;
 

@@ -428,7 +428,7 @@ fn split_at_t_junctions(soup: &TriangleSoup) -> Option<TriangleSoup> {
     // Exactly collinear points are in line order when ordered lexicographically.
     let order = |x: &u32, y: &u32| pos(*x).partial_cmp(&pos(*y)).unwrap_or(std::cmp::Ordering::Equal);
     let flat = |t: [u32; 3]| t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
-    let mut on_edge: foldhash::HashMap<(u32, u32), Vec<u32>> = foldhash::HashMap::default();
+    let mut on_edge: super::hash::HashMap<(u32, u32), Vec<u32>> = super::hash::HashMap::default();
     let mut degenerate = vec![false; soup.triangles.len()];
     for (t, &tri) in soup.triangles.iter().enumerate() {
         if !is_degenerate(soup.triangle(t)) {
@@ -690,7 +690,7 @@ fn crossings(
         })
         .collect();
     // Keep the first occurrence of each face pair, in discovery order.
-    let mut seen = foldhash::HashSet::default();
+    let mut seen = super::hash::HashSet::default();
     faces.retain(|p| seen.insert(*p));
     found.extend(faces);
     found.truncate(limit);

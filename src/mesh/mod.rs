@@ -11,6 +11,7 @@ pub mod disjoint_sets;
 pub mod error;
 pub mod formats;
 pub mod frame;
+pub mod hash;
 pub mod intersect;
 pub mod procedural;
 pub mod solidity;
