@@ -506,12 +506,8 @@ impl Cleanup {
             if f.removed.iter().any(|&t| gone[t]) {
                 continue;
             }
-            for &t in &f.removed {
-                gone[t] = true;
-            }
             self.repair.pockets += 1;
-            self.repair.pocket_triangles += f.removed.len();
-            added.extend(f.added);
+            self.repair.pocket_triangles += f.take_into(&mut gone, &mut added);
         }
         self.replace(&gone, added)
     }
@@ -545,12 +541,8 @@ impl Cleanup {
                 if after >= before {
                     continue;
                 }
-                for &t in &f.removed {
-                    gone[t] = true;
-                }
                 self.repair.sheets += 1;
-                self.repair.sheet_triangles += f.removed.len();
-                added.extend(f.added);
+                self.repair.sheet_triangles += f.take_into(&mut gone, &mut added);
                 break;
             }
         }
@@ -620,12 +612,9 @@ impl Cleanup {
                 return false;
             }
             let (mut soup, mut origin, mut changed) = (soup.clone(), origin.clone(), changed.clone());
-            let mut gone = vec![false; soup.triangles.len()];
-            for &t in &f.removed {
-                gone[t] = true;
-            }
-            let rebuilt = f.removed.len();
-            replace_marked(&mut soup, &mut origin, &mut changed, &gone, f.added);
+            let (mut gone, mut added) = (vec![false; soup.triangles.len()], Vec::new());
+            let rebuilt = f.take_into(&mut gone, &mut added);
+            replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
             // Defects at the region's corners (and those snapped onto them) before and after.
             let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
             at.extend(snaps.keys());
@@ -678,12 +667,13 @@ impl Cleanup {
             edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
             edges.dedup();
             for (length, p, q) in edges {
-                let ways = match (self.is_new(p), self.is_new(q)) {
-                    (true, false) => [(q, p), (q, p)],
-                    (false, true) => [(p, q), (p, q)],
-                    _ => [(p, q), (q, p)],
+                // An intersection point goes onto an input vertex; otherwise either way.
+                let ways: &[(u32, u32)] = match (self.is_new(p), self.is_new(q)) {
+                    (true, false) => &[(q, p)],
+                    (false, true) => &[(p, q)],
+                    _ => &[(p, q), (q, p)],
                 };
-                for (keep, gone) in ways {
+                for &(keep, gone) in ways {
                     let (before, after) = local_crossings(&self.soup, &boxes, keep, gone);
                     if after < before {
                         self.repair.collapsed_edges += 1;
@@ -1070,6 +1060,18 @@ struct Flattened {
     /// Whether the removed triangles face both ways in the plane (a sheet between a face
     /// and a reversed copy of it).
     opposed: bool,
+}
+
+impl Flattened {
+    /// Marks the removed triangles in `gone` and moves the new ones to `added`; the
+    /// number removed.
+    fn take_into(self, gone: &mut [bool], added: &mut Vec<([u32; 3], u32)>) -> usize {
+        for &t in &self.removed {
+            gone[t] = true;
+        }
+        added.extend(self.added);
+        self.removed.len()
+    }
 }
 
 /// Rebuilds the flat region around triangle `seed`, if it holds a sliver: the triangles
