@@ -156,6 +156,105 @@ impl Ring for Exact {
     }
 }
 
+/// A point's homogeneous coordinates for the plain f64 filter ([`orient2d_fast`]): per
+/// coordinate an f64 `mid` within `rad` of the exact value, `mag` ≥ |mid| + rad (so
+/// |exact| ≤ mag), and one `rho` with rad ≤ rho·mag for all four; `ok` when every `mag` is at
+/// most 2^256 (the filter's underflow allowance assumes it). Derived once from the
+/// intervals, each step rounded so that the inequalities hold (see [`Fast::of`]).
+#[derive(Clone, Copy, Debug)]
+struct Fast {
+    mid: [f64; 4],
+    mag: [f64; 4],
+    rho: f64,
+    ok: bool,
+}
+
+/// 1 + 2⁻⁵⁰: a product by it, rounded to nearest, is at least the exact value times
+/// 1 + 2⁻⁵¹ ≥ 1/(1 − u) (u = 2⁻⁵³) for a normal result, and never below the value
+/// itself: it turns an f64 computed with one rounding to nearest into an upper bound.
+const UP: f64 = 1.0 + 1.0 / 1125899906842624.0;
+
+impl Fast {
+    /// From intervals [lo, hi] that hold the exact values. mid is any f64 near the middle;
+    /// rad = max(hi − mid, mid − lo) bounds |exact − mid| (even if rounding put mid
+    /// outside [lo, hi]); each difference is exact below 2⁻¹⁰²² (subtraction does not
+    /// underflow) and within one rounding above, which `UP` covers. mag = (|mid| + rad)·UP
+    /// the same way (a sum of non-negative numbers). rho = max rad/mag, rounded up by `UP`
+    /// and at least 2⁻¹⁰²² where rad > 0: a quotient that underflows loses its relative
+    /// accuracy, but is then below 2⁻¹⁰²².
+    fn of(approx: &[Interval; 4]) -> Fast {
+        let mut f = Fast { mid: [0.0; 4], mag: [0.0; 4], rho: 0.0, ok: true };
+        for (i, x) in approx.iter().enumerate() {
+            let mid = 0.5 * x.lo + 0.5 * x.hi;
+            let rad = (x.hi - mid).max(mid - x.lo).max(0.0) * UP;
+            let mag = (mid.abs() + rad) * UP;
+            if rad > 0.0 {
+                f.rho = f.rho.max(((rad / mag) * UP).max(f64::MIN_POSITIVE));
+            }
+            // NaN fails the test too.
+            f.ok &= mag <= TWO_256;
+            f.mid[i] = mid;
+            f.mag[i] = mag;
+        }
+        f
+    }
+}
+
+/// 2²⁵⁶: the largest `Fast::mag` the f64 filter takes.
+const TWO_256: f64 = 1.157920892373162e77;
+
+/// γ₅ = 5u/(1 − 5u) (u = 2⁻⁵³) rounded up generously: 6u = 3·2⁻⁵².
+const GAMMA5: f64 = 3.0 / 4503599627370496.0;
+
+/// 1 + 2⁻⁴⁰, the margin that turns the f64-computed bound into an upper bound.
+const MARGIN: f64 = 1.0 + 1.0 / 1099511627776.0;
+
+/// 2⁻⁸⁰⁰, more than all underflow can cost the f64 filter with entries below 2²⁵⁶.
+const UNDERFLOW: f64 = 1.499696813895631e-241;
+
+/// The sign of det [[a.u a.v a.w] [b.u b.v b.w] [c.u c.v c.w]] (homogeneous coordinates
+/// u, v and W of three points) in plain f64, or `None` when the bound below does not vouch
+/// for it (never decides a zero).
+///
+/// Error bound. Write each exact entry as mid + e with |e| ≤ rho·mag and |mid|, |exact| ≤
+/// mag (per point, [`Fast`]). The determinant is a signed sum of six products of one entry
+/// per row (point), and |xyz − x̃ỹz̃| ≤ (ρx + ρy + ρz)·mx·my·mz, so the exact determinant
+/// differs from det(mid) by at most (ρa + ρb + ρc)·perm(mag) (perm: the same sum with all
+/// signs +). Evaluating det(mid) as a0·(b1c2 − b2c1) − a1·(b0c2 − b2c0) + a2·(b0c1 − b1c0)
+/// puts at most five roundings on each product's path, so its f64 value is within
+/// γ₅·perm(|mid|) ≤ γ₅·perm(mag) of det(mid) (Higham, Lemma 3.1; no contraction into FMA
+/// in Rust). Together: |det − fl(det(mid))| ≤ (ρa + ρb + ρc + γ₅)·perm(mag) + the
+/// underflow allowance. The bound is computed in f64 on non-negative numbers: perm(mag)
+/// with five roundings per path, the sum of the ρ's and γ₅ with three, their product, the
+/// product by `MARGIN` and the last sum with one each. Each rounding loses at most a
+/// factor (1 − u), eleven in all, and `MARGIN`·(1 − u)¹¹ > 1, so the computed bound is at
+/// least the exact one plus the allowance. Underflow: a product that falls below 2⁻¹⁰²² is off
+/// by at most 2⁻¹⁰⁷⁵ (sums are exact there) and the later products scale that by at most
+/// 2²⁵⁶ (`Fast::ok`) a few times, in det(mid) and in perm(mag): far below 2⁻⁸⁰⁰, which
+/// is added twice over (the last sum may round down by a factor 1 − u).
+fn orient2d_fast(axes: [usize; 2], a: &Fast, b: &Fast, c: &Fast) -> Option<Sign> {
+    if !(a.ok && b.ok && c.ok) {
+        return None;
+    }
+    let [u, v] = axes;
+    let (a0, a1, a2) = (a.mid[u], a.mid[v], a.mid[3]);
+    let (b0, b1, b2) = (b.mid[u], b.mid[v], b.mid[3]);
+    let (c0, c1, c2) = (c.mid[u], c.mid[v], c.mid[3]);
+    let det = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
+    let (a0, a1, a2) = (a.mag[u], a.mag[v], a.mag[3]);
+    let (b0, b1, b2) = (b.mag[u], b.mag[v], b.mag[3]);
+    let (c0, c1, c2) = (c.mag[u], c.mag[v], c.mag[3]);
+    let perm = a0 * (b1 * c2 + b2 * c1) + a1 * (b0 * c2 + b2 * c0) + a2 * (b0 * c1 + b1 * c0);
+    let bound = ((a.rho + b.rho + c.rho + GAMMA5) * perm) * MARGIN + 2.0 * UNDERFLOW;
+    if det > bound {
+        Some(1)
+    } else if det < -bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
 /// What defines a point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Definition {
@@ -171,12 +270,13 @@ pub enum Definition {
 pub struct Point {
     definition: Definition,
     approx: [Interval; 4],
+    fast: Fast,
     exact: OnceLock<[Exact; 4]>,
 }
 
 impl Clone for Point {
     fn clone(&self) -> Point {
-        Point { definition: self.definition, approx: self.approx, exact: self.exact.clone() }
+        Point { definition: self.definition, approx: self.approx, fast: self.fast, exact: self.exact.clone() }
     }
 }
 
@@ -222,7 +322,8 @@ impl Point {
     }
 
     fn new(definition: Definition) -> Point {
-        Point { definition, approx: homogeneous::<Interval>(&definition), exact: OnceLock::new() }
+        let approx = homogeneous::<Interval>(&definition);
+        Point { definition, approx, fast: Fast::of(&approx), exact: OnceLock::new() }
     }
 
     pub fn definition(&self) -> &Definition {
@@ -405,6 +506,9 @@ pub fn orient3d_implicit(a: &Point, b: &Point, c: &Point, d: &Point) -> Sign {
 pub fn orient2d_implicit(axes: [usize; 2], a: &Point, b: &Point, c: &Point) -> Sign {
     let [u, v] = axes;
     let w = a.w_sign() * b.w_sign() * c.w_sign();
+    if let Some(s) = orient2d_fast(axes, &a.fast, &b.fast, &c.fast) {
+        return w * s;
+    }
     let rows = |p: &[Interval; 4]| [p[u], p[v], p[3]];
     let (ra, rb, rc) = (rows(&a.approx), rows(&b.approx), rows(&c.approx));
     w * decide(
@@ -437,6 +541,18 @@ pub fn same_point(a: &Point, b: &Point) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The filter's constants are the powers of two their comments name.
+    #[test]
+    fn fast_filter_constants() {
+        let u = 2f64.powi(-53);
+        assert_eq!(UP, 1.0 + 2f64.powi(-50));
+        assert_eq!(MARGIN, 1.0 + 2f64.powi(-40));
+        assert_eq!(GAMMA5, 6.0 * u);
+        assert!(GAMMA5 >= 5.0 * u / (1.0 - 5.0 * u));
+        assert_eq!(TWO_256, 2f64.powi(256));
+        assert_eq!(UNDERFLOW, 2f64.powi(-800));
+    }
     use crate::exact::orient2d;
     use crate::random::Rng;
 
@@ -464,6 +580,52 @@ mod tests {
             orient2d_implicit([0, 1], &ea, &eb, &mid),
             orient2d([a.x, a.y], [b.x, b.y], [mid.position().x, mid.position().y])
         );
+    }
+
+    /// The plain f64 filter decides only signs the expansions confirm, on points near a
+    /// line through two others (implicit points on a segment, nudged by an ulp or more)
+    /// and off it, and it leaves the exact zeros alone.
+    #[test]
+    fn the_f64_filter_decides_only_true_signs() {
+        let exact = |axes: [usize; 2], a: &Point, b: &Point, c: &Point| {
+            let [u, v] = axes;
+            let w = a.w_sign() * b.w_sign() * c.w_sign();
+            let (ea, eb, ec) = (a.exact(), b.exact(), c.exact());
+            w * det3([&ea[u], &ea[v], &ea[3]], [&eb[u], &eb[v], &eb[3]], [&ec[u], &ec[v], &ec[3]]).sign()
+        };
+        let mut rng = Rng::new(23);
+        let (mut decided, mut zeros) = (0, 0);
+        for _ in 0..400 {
+            let plane = [rand_point(&mut rng), rand_point(&mut rng), rand_point(&mut rng)];
+            let (p, q) = (rand_point(&mut rng), rand_point(&mut rng));
+            let Ok(x) = Point::edge_plane(p, q, plane) else { continue };
+            let at = x.position();
+            let mut points = vec![x, Point::explicit(at)];
+            for k in 0..3 {
+                let mut near = at;
+                near[k] = f64::from_bits(near[k].to_bits() + 1 + rng.below(4));
+                points.push(Point::explicit(near));
+            }
+            // And points off the line, which the filter should decide.
+            points.push(Point::explicit(rand_point(&mut rng)));
+            let other = [rand_point(&mut rng), rand_point(&mut rng), rand_point(&mut rng)];
+            points.extend(Point::edge_plane(p, rand_point(&mut rng), other));
+            let (ep, eq) = (Point::explicit(p), Point::explicit(q));
+            for axes in [[0, 1], [1, 2], [2, 0], [1, 0]] {
+                for c in &points {
+                    let want = exact(axes, &ep, &eq, c);
+                    let w = ep.w_sign() * eq.w_sign() * c.w_sign();
+                    if let Some(s) = orient2d_fast(axes, &ep.fast, &eq.fast, &c.fast) {
+                        assert_eq!(w * s, want);
+                        decided += 1;
+                    }
+                    zeros += (want == 0) as usize;
+                    assert_eq!(orient2d_implicit(axes, &ep, &eq, c), want);
+                    assert_eq!(orient2d_implicit(axes, c, &ep, &eq), want);
+                }
+            }
+        }
+        assert!(decided > 800 && zeros > 300, "{decided} {zeros}");
     }
 
     /// The crossing of pq with a plane lies exactly on line pq and exactly on the plane,

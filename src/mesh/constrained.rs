@@ -100,16 +100,20 @@ impl<O: Fn(u32, u32, u32) -> Sign> Mesh2<'_, O> {
     }
 
     /// The triangle holding point p and how: (t, None) inside, (t, Some(i)) on edge i.
+    /// Each triangle's three signs are taken once: the walk's tests are the ones that
+    /// place the point.
     fn locate(&self, p: u32, start: u32) -> Result<(u32, Option<usize>), ConstrainedError> {
         let mut t = start;
         let limit = 3 * self.tris.len() + 8;
         for step in 0..limit {
             let v = self.tris[t as usize];
+            let mut signs = [0; 3];
             let mut moved = false;
             // Start the test at a rotating edge so that a walk cannot circle.
             for k in 0..3 {
                 let i = (k + step) % 3;
-                if self.o(v[i], v[(i + 1) % 3], p) < 0 {
+                signs[i] = self.o(v[i], v[(i + 1) % 3], p);
+                if signs[i] < 0 {
                     let n = self.adj[t as usize][i];
                     if n == NONE {
                         return Err(ConstrainedError::Outside(self.ids[p as usize]));
@@ -120,28 +124,39 @@ impl<O: Fn(u32, u32, u32) -> Sign> Mesh2<'_, O> {
                 }
             }
             if !moved {
-                return self.classify_in(t, p);
+                return self.classify_in(t, p, signs);
             }
         }
         // A walk that did not arrive: look at every triangle.
         for t in 0..self.tris.len() as u32 {
             let v = self.tris[t as usize];
-            if (0..3).all(|i| self.o(v[i], v[(i + 1) % 3], p) >= 0) {
-                return self.classify_in(t, p);
+            let mut signs = [0; 3];
+            if (0..3).all(|i| {
+                signs[i] = self.o(v[i], v[(i + 1) % 3], p);
+                signs[i] >= 0
+            }) {
+                return self.classify_in(t, p, signs);
             }
         }
         Err(ConstrainedError::Outside(self.ids[p as usize]))
     }
 
-    fn classify_in(&self, t: u32, p: u32) -> Result<(u32, Option<usize>), ConstrainedError> {
+    /// Where p lies in triangle t, from the signs of p against its three edges (none
+    /// negative): inside, on one edge, or at a corner (an error).
+    fn classify_in(
+        &self,
+        t: u32,
+        p: u32,
+        signs: [Sign; 3],
+    ) -> Result<(u32, Option<usize>), ConstrainedError> {
         let v = self.tris[t as usize];
-        let zeros: Vec<usize> = (0..3).filter(|&i| self.o(v[i], v[(i + 1) % 3], p) == 0).collect();
-        match zeros.as_slice() {
-            [] => Ok((t, None)),
-            [i] => Ok((t, Some(*i))),
+        let mut zeros = (0..3).filter(|&i| signs[i] == 0);
+        match (zeros.next(), zeros.next(), zeros.next()) {
+            (None, _, _) => Ok((t, None)),
+            (Some(i), None, _) => Ok((t, Some(i))),
             // On two edges: at their common corner.
-            [i, j] => {
-                let corner = if (i + 1) % 3 == *j { v[*j] } else { v[*i] };
+            (Some(i), Some(j), None) => {
+                let corner = if (i + 1) % 3 == j { v[j] } else { v[i] };
                 Err(ConstrainedError::Duplicate(self.ids[corner as usize], self.ids[p as usize]))
             }
             _ => Err(ConstrainedError::Corners),
