@@ -87,8 +87,13 @@ pub fn check_known(
     // In the frame: the volume in the input's units may underflow. The solid check's
     // volume serves where it is a normal number clearly above the bound (the same sum up
     // to rounding); near the bound it is measured again here.
-    let bound = flatness_bound(piece_boxes(&soup));
     let known = solid.volume.filter(|v| v.is_normal()).map(|v| frame.volume_in(v));
+    if known.is_some_and(|v| v.is_normal() && v.abs() > 2.0 * coarse_flatness_bound(&soup)) {
+        // Clearly above the bound below (which it bounds from above): not flat, and the
+        // same verdict without finding the pieces.
+        return Ok((soup, Some(solid)));
+    }
+    let bound = flatness_bound(piece_boxes(&soup));
     let volume = match known {
         Some(v) if v.is_normal() && v.abs() > 2.0 * bound => v,
         _ => Covering::new(mesh).volume(),
@@ -110,6 +115,21 @@ pub fn is_flat(volume: f64, lo: DVec3, hi: DVec3) -> bool {
 /// solids far apart flat).
 pub fn flatness_bound(piece_boxes: impl IntoIterator<Item = (DVec3, DVec3)>) -> f64 {
     piece_boxes.into_iter().map(|(lo, hi)| 1e-12 * (hi - lo).max_element().powi(3)).sum()
+}
+
+/// An upper bound of `flatness_bound(piece_boxes(soup))` as computed, from one pass over
+/// the positions: each piece's box lies in the box of all positions (so its term is at most
+/// T, the term of that box, the same f64 operations being monotone), there are at most as
+/// many pieces as triangles (N), and a sum of N terms at most T, rounded N times, is at
+/// most N·T·(1 + u)^N ≤ N·T·(1 + 2⁻²⁰) for N < 2³¹; the factor 1 + 2⁻¹⁹ covers that and the
+/// two roundings here.
+fn coarse_flatness_bound(soup: &TriangleSoup) -> f64 {
+    let Some(&first) = soup.positions.first() else {
+        return 0.0;
+    };
+    let (lo, hi) = soup.positions.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let term = flatness_bound([(lo, hi)]);
+    soup.triangles.len() as f64 * term * (1.0 + 1.0 / 524288.0)
 }
 
 /// The boxes of the connected pieces of a triangle soup.
@@ -187,5 +207,24 @@ mod tests {
         );
         assert!(e.to_string().contains("--allow-self-intersections"), "{e}");
         assert!(check_unit(&two, true).is_ok());
+    }
+
+    /// The one-pass bound is never below the bound over the pieces, for one piece, pieces
+    /// far apart (where it is much larger) and every built-in model.
+    #[test]
+    fn the_coarse_flatness_bound_is_above_the_pieces_bound() {
+        let s = procedural::sphere(6, 8);
+        let mut apart = s.positions().to_vec();
+        let n = apart.len() as u32;
+        apart.extend(s.positions().iter().map(|&x| x * 1e-3 + DVec3::new(1e3, 0.0, 0.0)));
+        let mut faces: Vec<Vec<u32>> = s.faces().map(<[u32]>::to_vec).collect();
+        faces.extend(s.faces().map(|x| x.iter().map(|&i| i + n).collect::<Vec<_>>()));
+        let mut meshes = vec![Mesh::new(apart, faces).unwrap()];
+        meshes.extend(procedural::BUILTIN_NAMES.iter().map(|name| procedural::by_name(name).unwrap()));
+        for m in &meshes {
+            let soup = TriangleSoup::new(m);
+            let (coarse, fine) = (coarse_flatness_bound(&soup), flatness_bound(piece_boxes(&soup)));
+            assert!(coarse >= fine && fine > 0.0, "{coarse} {fine}");
+        }
     }
 }

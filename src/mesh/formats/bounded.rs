@@ -65,8 +65,19 @@ impl Text {
             // ends): `(w − 0x20…) & !w & 0x80…` is zero exactly then.
             if let Some(word) = bytes.get(i..i + 8).and_then(|w| <[u8; 8]>::try_from(w).ok()) {
                 let w = u64::from_le_bytes(word);
-                if w.wrapping_sub(0x20 * ONES) & !w & (0x80 * ONES) == 0 {
+                let below = w.wrapping_sub(0x20 * ONES) & !w & (0x80 * ONES);
+                if below == 0 {
                     i += 8;
+                    continue;
+                }
+                // The lowest flagged byte is the first one below 0x20 (the borrow that can
+                // flag a byte by mistake only runs upward from a true one): the bytes
+                // before it are plain, and a line end (the usual case) is handled here.
+                let k = (below.trailing_zeros() / 8) as usize;
+                if bytes[i + k] == b'\n' {
+                    self.line_ends(i + k, base)?;
+                    self.line_start = i + k + 1;
+                    i += k + 1;
                     continue;
                 }
             }
@@ -219,6 +230,43 @@ mod tests {
         let e = t.check(&text, 9).unwrap_err();
         assert_eq!(e.at, 8);
         assert!(e.why.contains("longer than 16 MiB"), "{}", e.why);
+    }
+
+    /// The word-at-a-time scan stops where a byte-at-a-time one does, with the same line
+    /// start, on random texts of plain, high, control and line-end bytes.
+    #[test]
+    fn the_word_scan_agrees_with_a_byte_scan() {
+        let byte_scan = |bytes: &[u8]| -> (Option<u64>, usize) {
+            let mut line_start = 0;
+            for (at, &b) in bytes.iter().enumerate() {
+                if b == b'\n' {
+                    line_start = at + 1;
+                } else if b < 0x20 && !matches!(b, b'\t' | 0x0b | 0x0c | b'\r') {
+                    return (Some(at as u64), line_start);
+                }
+            }
+            (None, line_start)
+        };
+        let mut rng = crate::random::Rng::new(3);
+        let alphabet = b"ab 1.\n\n\r\t\x0b\x00\x1f\x7f\x80\xa0\xe0\xff";
+        for len in 0..80 {
+            for _ in 0..200 {
+                let text: Vec<u8> = (0..len)
+                    .map(|_| {
+                        let k = rng.below(3 * alphabet.len() as u64) as usize;
+                        // Mostly plain bytes, as in real files.
+                        alphabet.get(k).copied().unwrap_or(b'7')
+                    })
+                    .collect();
+                let mut t = Text::new("OFF");
+                let got = t.check(&text, 0).err().map(|e| e.at);
+                let (want, line_start) = byte_scan(&text);
+                assert_eq!(got, want, "{text:?}");
+                if want.is_none() {
+                    assert_eq!(t.line_start, line_start, "{text:?}");
+                }
+            }
+        }
     }
 
     #[test]
