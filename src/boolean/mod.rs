@@ -20,7 +20,10 @@
 //!    covering of its polygon faces) with any inclusion method: the thesis' GPU test with
 //!    its exact fallback, or a CPU one
 //!    (the default, `octants`, is the fastest exact one for the few points grouped
-//!    classification tests; on lavapipe the GPU test's set-up alone costs more).
+//!    classification tests; on lavapipe the GPU test's set-up alone costs more). With the
+//!    default, an operand that gets at most [`classify::FEW_POINTS`] points is not even
+//!    built: its points are answered by exact ray crossings over its triangles
+//!    ([`classify::ray_crossings`]), which costs less than building any structure.
 //! 3. **Selection** (§6.2.2, §6.5.2) — [`select`]: every operation, regularized or
 //!    not, picked from the same refinement and classification, then compacted.
 //! 4. **Output** — [`output`]: a regularized result is checked as an operand would be,
@@ -136,7 +139,8 @@ pub struct Timings {
     pub check: Duration,
     /// Phase 1: index, pair tests, intersection points, re-triangulation.
     pub refine: Duration,
-    /// Building both inclusion classifiers.
+    /// Building the inclusion classifiers (none when few points are tested: see
+    /// [`classify::FEW_POINTS`]).
     pub classifiers: Duration,
     /// On-tests, groups and point tests.
     pub classify: Duration,
@@ -235,17 +239,28 @@ pub fn evaluate(
 
     // The operands' closure is checked above.
     let inclusion = inclusion::Options { known_closed: true, ..options.inclusion };
-    let build = |mesh: &Mesh, name: &str| {
-        Solver::new(options.method, mesh, &inclusion, ctx, None)
-            .map_err(|source| BooleanError::Inclusion { name: name.to_string(), source })
+    let build = |mesh: &Mesh| Solver::new(options.method, mesh, &inclusion, ctx, None);
+    let named = |name: &str| {
+        let name = name.to_string();
+        move |source| BooleanError::Inclusion { name, source }
     };
+    // With the default method, grouped classification tests a few points against each
+    // operand: those are answered by exact ray crossings over its triangles, and the
+    // method is built (after the refinement) only for an operand that gets more
+    // ([`classify::FEW_POINTS`]). Otherwise both are built up front.
+    let lazy = options.grouping == Grouping::Grouped && options.method.fixed() == Some(Method::Octants);
     let build_both = || {
         let start = Instant::now();
-        let solvers = if options.method.is_cpu() {
-            let (x, y) = rayon::join(|| build(a, names.a), || build(b, names.b));
-            x.and_then(|x| Ok((x, y?)))
+        let solvers = if lazy {
+            Ok((None, None))
+        } else if options.method.is_cpu() {
+            let (x, y) =
+                rayon::join(|| build(a).map_err(named(names.a)), || build(b).map_err(named(names.b)));
+            x.and_then(|x| Ok((Some(x), Some(y?))))
         } else {
-            build(a, names.a).and_then(|x| Ok((x, build(b, names.b)?)))
+            build(a)
+                .map_err(named(names.a))
+                .and_then(|x| Ok((Some(x), Some(build(b).map_err(named(names.b))?))))
         };
         (solvers, start.elapsed())
     };
@@ -254,33 +269,48 @@ pub fn evaluate(
         (refine::refine(&sa, &sb), start.elapsed())
     };
     // GPU solvers hold the device: build them on this thread.
-    let ((refinement, t_refine), (solvers, t_build)) = if options.overlap && options.method.is_cpu() {
-        let (r, s) = rayon::join(refine_timed, || {
-            let (s, t) = build_both();
-            (s.map(|(x, y)| (Some(x), Some(y))), t)
-        });
-        (r, s)
+    let ((refinement, t_refine), (solvers, t_build)) = if options.overlap && options.method.is_cpu() && !lazy
+    {
+        rayon::join(refine_timed, build_both)
     } else {
         let r = refine_timed();
-        let (s, t) = build_both();
-        (r, (s.map(|(x, y)| (Some(x), Some(y))), t))
+        (r, build_both())
     };
     timings.refine = t_refine;
     timings.classifiers = t_build;
     let refinement = refinement?;
-    let (Some(mut solver_a), Some(mut solver_b)) = solvers? else { unreachable!("both solvers were built") };
-    let method = solver_a.name().to_string();
+    let mut solvers = {
+        let (x, y) = solvers?;
+        [x, y]
+    };
+    let method = match &solvers[0] {
+        Some(s) => s.name().to_string(),
+        None => Method::Octants.name().to_string(),
+    };
 
     let start = Instant::now();
+    let (mut built, mut ray_tests) = (std::time::Duration::ZERO, 0);
     let mut test = |side: Side, points: &[DVec3]| -> inclusion::Result<Vec<inclusion::Class>> {
-        let solver = match side {
-            Side::A => &mut solver_a,
-            Side::B => &mut solver_b,
+        let (k, mesh, soup) = match side {
+            Side::A => (0, a, &sa),
+            Side::B => (1, b, &sb),
         };
+        if solvers[k].is_none() {
+            if points.len() <= classify::FEW_POINTS {
+                ray_tests += points.len();
+                return Ok(classify::ray_crossings(points, soup));
+            }
+            let start = Instant::now();
+            solvers[k] = Some(build(mesh)?);
+            built += start.elapsed();
+        }
+        let Some(solver) = &mut solvers[k] else { unreachable!("built above") };
         solver.classify_fine(points, 4)
     };
-    let classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
-    timings.classify = start.elapsed();
+    let mut classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
+    classification.stats.ray_tests = ray_tests;
+    timings.classifiers += built;
+    timings.classify = start.elapsed().saturating_sub(built);
     Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame })
 }
 

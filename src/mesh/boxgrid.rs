@@ -69,6 +69,43 @@ pub fn box_pairs(a: &[Box3], b: Option<&[Box3]>) -> Vec<(u32, u32)> {
     box_pairs_within(a, b, u64::MAX).unwrap_or_default()
 }
 
+/// [`box_pairs`]`(near, Some(all))` for a set `near` that lies along a part of `all`
+/// (the changed triangles of a result among all of them): the boxes of `all` that share
+/// no cell of a grid laid over `near` with a box of `near` overlap none of them and are
+/// left out first, so the grid that pairs the rest is not laid over all of `all`.
+pub fn box_pairs_near(near: &[Box3], all: &[Box3]) -> Vec<(u32, u32)> {
+    let Some((region, entries)) = entries_in_region(near, None) else {
+        return Vec::new();
+    };
+    let grid = fit_grid(&region, &entries);
+    let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
+    let mut occupied = vec![false; cells];
+    for (_, x) in &entries {
+        grid.each_cell(grid.cells_of(&x.clamp_to(&region)), |c| occupied[c] = true);
+    }
+    // A box of `all` overlapping one of `near` shares a point with it inside `region`,
+    // whose cell both boxes' (clamped) cell ranges hold: the cell of a point is monotone
+    // in each coordinate.
+    let kept: Vec<u32> = (0..all.len() as u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter(|&j| {
+            let x = &all[j as usize];
+            let mut hit = false;
+            if overlaps(x, &region) {
+                grid.each_cell(grid.cells_of(&x.clamp_to(&region)), |c| hit |= occupied[c]);
+            }
+            hit
+        })
+        .collect();
+    let boxes: Vec<Box3> = kept.iter().map(|&j| all[j as usize]).collect();
+    let mut pairs = box_pairs(near, Some(&boxes));
+    for p in &mut pairs {
+        p.1 = kept[p.1 as usize];
+    }
+    pairs
+}
+
 /// [`box_pairs`], unless the grid would compare more than `max_tests` pairs of boxes
 /// sharing a cell (counted from the cells' occupancy before any pair is compared): then
 /// `None`. Boxes that pile up in a few cells whatever their size — a fan of slivers
@@ -79,8 +116,8 @@ pub fn box_pairs_within(a: &[Box3], b: Option<&[Box3]>, max_tests: u64) -> Optio
         return Some(Vec::new());
     };
     let grid = fit_grid(&region, &all);
-    let (start, entries) = sort_by_cell(&grid, &region, &all, max_tests)?;
-    let pairs = pairs_in_cells(&grid, &region, &start, &entries, &all, b.is_some());
+    let (start, entries, lows) = sort_by_cell(&grid, &region, &all, max_tests)?;
+    let pairs = pairs_in_cells(&grid, &start, &entries, &lows, &all, b.is_some());
     Some(pairs.into_iter().map(|p| ((p >> 32) as u32, p as u32)).collect())
 }
 
@@ -136,13 +173,14 @@ fn fit_grid(region: &Box3, all: &[(u32, &Box3)]) -> Grid {
 /// Counting sort of the entries by cell: `entries[start[c]..start[c + 1]]` are the places
 /// in `all` of cell c's boxes, in increasing order (4 bytes an entry, where a copy of the
 /// box would take 56: a box is in 8 cells or so, and the copies were most of the grid's
-/// memory traffic). `None` when the cells would take more than `max_tests` pair tests.
+/// memory traffic), and the cell of every box's (clamped) lower corner. `None` when the
+/// cells would take more than `max_tests` pair tests.
 fn sort_by_cell(
     grid: &Grid,
     region: &Box3,
     all: &[(u32, &Box3)],
     max_tests: u64,
-) -> Option<(Vec<u32>, Vec<u32>)> {
+) -> Option<(Vec<u32>, Vec<u32>, Vec<UVec3>)> {
     let cells = grid.dims.x as usize * grid.dims.y as usize * grid.dims.z as usize;
     let ranges: Vec<(UVec3, UVec3)> =
         all.par_iter().with_min_len(4096).map(|(_, x)| grid.cells_of(&x.clamp_to(region))).collect();
@@ -169,16 +207,20 @@ fn sort_by_cell(
         });
     }
     start.truncate(cells + 1);
-    Some((start, entries))
+    Some((start, entries, ranges.into_iter().map(|r| r.0).collect()))
 }
 
 /// The overlapping pairs of each cell's boxes (ids packed high/low), each reported by the
 /// cell of its overlap's lower corner only; with `two_sets`, pairs of one box of each set.
+/// `lows[e]` is the cell of entry e's lower corner (clamped to the region): the cell of a
+/// point is monotone in each coordinate, so the cell of the overlap's lower corner (the
+/// larger of the two lower corners) is the larger of their cells, axis by axis, and a pair
+/// that is not reported in this cell is passed over before its boxes are compared.
 fn pairs_in_cells(
     grid: &Grid,
-    region: &Box3,
     start: &[u32],
     entries: &[u32],
+    lows: &[UVec3],
     all: &[(u32, &Box3)],
     two_sets: bool,
 ) -> Vec<u64> {
@@ -195,20 +237,23 @@ fn pairs_in_cells(
             // Two sets: a cell's boxes of `a` come before those of `b` (filled in the order
             // of `all`), and each box of `a` is compared with those of `b` only.
             let split = if two_sets { run.partition_point(|&e| e < in_a) } else { run.len() };
+            let (dx, dy) = (grid.dims.x as usize, grid.dims.y as usize);
+            let here = UVec3::new((cell % dx) as u32, (cell / dx % dy) as u32, (cell / (dx * dy)) as u32);
             for (k, &ex) in run.iter().enumerate() {
                 let (tx, bx) = all[ex as usize];
+                let low = lows[ex as usize];
                 let others = match two_sets {
                     false => &run[k + 1..],
                     true if k < split => &run[split..],
                     true => break,
                 };
                 for &ey in others {
-                    let (ty, by) = all[ey as usize];
-                    if !overlaps(bx, by) {
+                    // Report from the cell of the overlap's lower corner only.
+                    if low.max(lows[ey as usize]) != here {
                         continue;
                     }
-                    // Report from the cell of the overlap's lower corner only.
-                    if grid.key(grid.cell(bx.0.max(by.0).max(region.0))) as usize != cell {
+                    let (ty, by) = all[ey as usize];
+                    if !overlaps(bx, by) {
                         continue;
                     }
                     let (i, j) = if !two_sets {
@@ -305,6 +350,28 @@ mod tests {
         assert_eq!(box_pairs(&c, None), vec![(0, 1)]);
         let far = vec![(DVec3::splat(50.0), DVec3::splat(51.0))];
         assert_eq!(box_pairs(&c, Some(&far)), vec![]);
+    }
+
+    #[test]
+    fn pairs_near_a_few_boxes_are_those_of_all_pairs() {
+        let sorted = |mut v: Vec<(u32, u32)>| {
+            v.sort_unstable();
+            v
+        };
+        let all = random_boxes(3000, 4, 0.0);
+        // A few boxes in one corner, touching some of `all` exactly at their faces.
+        let mut near = random_boxes(60, 5, 0.0);
+        near.iter_mut().for_each(|b| *b = (b.0 * 0.2, b.1 * 0.2));
+        near.push((all[7].1, all[7].1 + DVec3::ONE));
+        near.push((all[9].0 - DVec3::ONE, all[9].0));
+        let want = brute(&near, Some(&all));
+        assert!(want.contains(&(60, 7)) && want.contains(&(61, 9)) && want.len() > 20, "{want:?}");
+        assert_eq!(sorted(box_pairs_near(&near, &all)), want);
+        // Spread over all of them, and none.
+        let spread = random_boxes(200, 6, 0.0);
+        assert_eq!(sorted(box_pairs_near(&spread, &all)), brute(&spread, Some(&all)));
+        assert_eq!(box_pairs_near(&[], &all), vec![]);
+        assert_eq!(box_pairs_near(&near, &[]), vec![]);
     }
 
     #[test]

@@ -155,13 +155,14 @@ fn evaluation_lines(a: &str, b: &str, ev: &Evaluation) -> [String; 3] {
             ev.refinement.b.triangles.len()
         ),
         format!(
-            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved), {} decided by an exact local side, {} at a rounded centroid, {} exact fallbacks, {} signs by exact arithmetic",
+            "classification ({}): {} triangles, {} on the other surface, {} groups, {} point tests ({:.1} % saved; {} by exact ray crossings, no structure built), {} decided by an exact local side, {} at a rounded centroid, {} exact fallbacks, {} signs by exact arithmetic",
             ev.method,
             c.triangles,
             c.on,
             c.groups,
             c.point_tests,
             100.0 * c.saved_share(),
+            c.ray_tests,
             c.local_sides,
             c.rounded_probes,
             c.exact_fallbacks,
@@ -197,6 +198,7 @@ fn evaluation_json(a: &str, b: &str, ev: &Evaluation) -> serde_json::Value {
             "point_tests": c.point_tests,
             "saved_share": c.saved_share(),
             "exact_fallbacks": c.exact_fallbacks,
+            "ray_tests": c.ray_tests,
             "local_sides": c.local_sides,
             "rounded_probes": c.rounded_probes,
             "exact_signs": c.exact_signs,
