@@ -348,18 +348,11 @@ impl TriangleSoup {
 
 /// For every vertex, the first vertex with exactly the same position (−0 equals +0).
 pub fn weld_by_position(positions: &[DVec3]) -> Vec<u32> {
+    use super::hash::{HashMap, HashMapExt};
     let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
-    // (position's bits, id), sorted: each position's ids in a run, the lowest first.
-    let mut order: Vec<([u64; 3], u32)> =
-        positions.par_iter().with_min_len(4096).enumerate().map(|(i, &p)| (key(p), i as u32)).collect();
-    order.par_sort_unstable();
-    let mut weld: Vec<u32> = (0..positions.len() as u32).collect();
-    for run in order.chunk_by(|x, y| x.0 == y.0) {
-        for &(_, i) in &run[1..] {
-            weld[i as usize] = run[0].1;
-        }
-    }
-    weld
+    // Each position's bits to the first id seen with them, ids in increasing order.
+    let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(positions.len());
+    positions.iter().enumerate().map(|(i, &p)| *first.entry(key(p)).or_insert(i as u32)).collect()
 }
 
 /// Every directed edge a→b of `triangles` is matched by a use b→a (edges from a vertex to

@@ -107,17 +107,38 @@ impl<'a> HalfEdges<'a> {
             items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
             *slot += 1;
         });
-        for lo in 0..nv {
-            items[start[lo]..start[lo + 1]].sort_unstable();
-        }
+        sort_buckets(&start, &mut items);
         HalfEdges { indices, start, items }
     }
 
     /// The half-edges of `triangles` over `nv` vertices (corner `3t + k` is corner k of
-    /// triangle t).
+    /// triangle t): [`Self::of_faces`] of their faces, without the faces' offsets.
     pub(crate) fn of_triangles(triangles: &'a [[u32; 3]], nv: usize) -> HalfEdges<'a> {
-        let offsets: Vec<usize> = (0..=triangles.len()).map(|t| 3 * t).collect();
-        HalfEdges::of_faces(&offsets, triangles.as_flattened(), nv)
+        let each = |f: &mut dyn FnMut(u32, u32, usize)| {
+            for (t, tri) in triangles.iter().enumerate() {
+                for (k, (a, b)) in
+                    [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])].into_iter().enumerate()
+                {
+                    if a != b {
+                        f(a, b, 3 * t + k);
+                    }
+                }
+            }
+        };
+        let mut start = vec![0usize; nv + 1];
+        each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u64; start[nv]];
+        each(&mut |a, b, corner| {
+            let slot = &mut fill[a.min(b) as usize];
+            items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
+            *slot += 1;
+        });
+        sort_buckets(&start, &mut items);
+        HalfEdges { indices: triangles.as_flattened(), start, items }
     }
 
     /// Bucket `lo`: its items in order.
@@ -137,6 +158,27 @@ impl<'a> HalfEdges<'a> {
     /// How many of the uses `run` of an edge with lower vertex `lo` go lo → higher.
     pub(crate) fn forward(&self, lo: usize, run: &[u64]) -> usize {
         run.iter().filter(|&&item| self.indices[corner(item)] as usize == lo).count()
+    }
+}
+
+/// Sorts each bucket `items[start[lo]..start[lo + 1]]`: a few items each (the edges at a
+/// vertex), by insertion in place, longer ones by the library's sort.
+fn sort_buckets(start: &[usize], items: &mut [u64]) {
+    for w in start.windows(2) {
+        let bucket = &mut items[w[0]..w[1]];
+        if bucket.len() > 16 {
+            bucket.sort_unstable();
+            continue;
+        }
+        for i in 1..bucket.len() {
+            let x = bucket[i];
+            let mut j = i;
+            while j > 0 && bucket[j - 1] > x {
+                bucket[j] = bucket[j - 1];
+                j -= 1;
+            }
+            bucket[j] = x;
+        }
     }
 }
 
