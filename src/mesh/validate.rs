@@ -95,20 +95,7 @@ impl<'a> HalfEdges<'a> {
                 }
             }
         };
-        let mut start = vec![0usize; nv + 1];
-        each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
-        for v in 0..nv {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u64; start[nv]];
-        each(&mut |a, b, corner| {
-            let slot = &mut fill[a.min(b) as usize];
-            items[*slot] = u64::from(a.max(b)) << 32 | corner as u64;
-            *slot += 1;
-        });
-        sort_buckets(&start, &mut items);
-        HalfEdges { indices, start, items }
+        HalfEdges::bucketed(indices, nv, each)
     }
 
     /// The half-edges of `triangles` over `nv` vertices (corner `3t + k` is corner k of
@@ -125,6 +112,16 @@ impl<'a> HalfEdges<'a> {
                 }
             }
         };
+        HalfEdges::bucketed(triangles.as_flattened(), nv, each)
+    }
+
+    /// The counting sort of the half-edges `each` calls its argument with (a, b, corner),
+    /// over `nv` vertices: it is walked twice, to count and to fill.
+    fn bucketed(
+        indices: &'a [u32],
+        nv: usize,
+        each: impl Fn(&mut dyn FnMut(u32, u32, usize)),
+    ) -> HalfEdges<'a> {
         let mut start = vec![0usize; nv + 1];
         each(&mut |a, b, _| start[a.min(b) as usize + 1] += 1);
         for v in 0..nv {
@@ -138,7 +135,7 @@ impl<'a> HalfEdges<'a> {
             *slot += 1;
         });
         sort_buckets(&start, &mut items);
-        HalfEdges { indices: triangles.as_flattened(), start, items }
+        HalfEdges { indices, start, items }
     }
 
     /// Bucket `lo`: its items in order.
