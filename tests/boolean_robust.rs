@@ -372,6 +372,27 @@ fn a_turned_difference_reused_against_its_cutter() {
     }
 }
 
+/// The sphere minus its copy turned 1e-6° about a skew axis (as `--transform-b` turns it),
+/// intersected with the copy: exactly, what is left is sheets between S's faces and the
+/// copy's a hair apart. Where a sheet's outline must be split at corners in line within an
+/// ulp, the splits cut the triangles of the sheet beside it (across a crease of the
+/// outline), which then cross: the two are rebuilt together (`Repair::joined_sheets`).
+/// The result carries no volume and re-reads as an operand.
+#[test]
+fn a_micro_turned_difference_intersected_with_its_cutter() {
+    let a = procedural::sphere(16, 32);
+    let b = Transform::parse("rotate 1 2 3 0.000001").unwrap().apply(&a).unwrap();
+    let options = Options::default();
+    let evaluate = |x: &Mesh, y: &Mesh| boolean::evaluate(x, y, Names::default(), &options, None).unwrap();
+    let s = evaluate(&a, &b).result(Operation::Difference, true).unwrap();
+    assert!(volume(&s) > 0.0, "{}", volume(&s));
+    let inter =
+        evaluate(&s, &b).output(Operation::Intersection, true).unwrap_or_else(|e| panic!("S ∩ B: {e}"));
+    assert!(inter.repair.joined_sheets > 0, "{}", inter.repair);
+    assert!(volume(&inter.mesh).abs() <= 1e-12, "S ∩ B: {}", volume(&inter.mesh));
+    assert_operand("S ∩ B", &inter.mesh);
+}
+
 /// A difference used again against the solid that cut it, B shifted by half the width:
 /// corners of A − B that were intersection points on B's edges lie an ulp beside them.
 #[test]

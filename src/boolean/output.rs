@@ -57,7 +57,11 @@
 //! beside a corner in line within an ulp with two others may pass over a thin wedge
 //! hinged at that corner), and any edge of a crossing triangle up to [`COLLAPSE`] × the
 //! diagonal is collapsed, not only the shortest: each again only where it leaves fewer
-//! defects around it. A shell that encloses no volume by the
+//! defects around it. Past all of these, the sheets once more, each where the splits of
+//! its outline cut the triangles of the sheet beside it (across a crease of the outline)
+//! and leave them crossing rebuilt together with that sheet (and so on for up to three),
+//! all of them made only where together they leave fewer defects
+//! ([`Repair::joined_sheets`]). A shell that encloses no volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
 //! volume over its area) than a flat region's thickness, is dropped whole. A result the
@@ -144,6 +148,10 @@ pub struct Repair {
     pub sheets: usize,
     /// Triangles those sheets had.
     pub sheet_triangles: usize,
+    /// Of those sheets, the ones rebuilt together with the sheet before them, where its
+    /// outline's splits left crossings in this one beside it (across a crease of the
+    /// outline).
+    pub joined_sheets: usize,
     /// Long flat triangles (a corner on the opposite edge once rounded) removed by
     /// splitting the neighbour across that edge at the corner.
     pub flipped: usize,
@@ -174,7 +182,7 @@ impl std::fmt::Display for Repair {
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
-             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles), {} long flat triangles split away, {} flat shells dropped",
+             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
@@ -188,6 +196,7 @@ impl std::fmt::Display for Repair {
             self.pocket_triangles,
             self.sheets,
             self.sheet_triangles,
+            self.joined_sheets,
             self.flipped,
             self.dropped_shells
         )
@@ -269,7 +278,7 @@ pub fn finish(
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let (mut nudges, mut sheets, mut longer) = (0, 0, 0);
+    let (mut nudges, mut sheets, mut longer, mut joined) = (0, 0, 0, 0);
     for round in 0.. {
         let (crossings, flat) = c.defects();
         if round == 0 {
@@ -310,6 +319,12 @@ pub fn finish(
                 longer += 1;
                 continue;
             }
+            // Past those, the sheets again, each rebuilt together with the sheets beside it
+            // where its outline's splits leave those crossing ([`Cleanup::split_sheet`]).
+            if joined < ROUNDS && c.join_sheets(&crossings) {
+                joined += 1;
+                continue;
+            }
             return Err(err);
         }
         c.collapse(&map);
@@ -342,6 +357,36 @@ struct Plan {
     wide: Vec<(usize, usize)>,
     long_flat: Vec<usize>,
     stuck: Option<InvalidResult>,
+}
+
+/// Sheets rebuilt on a copy of the soup ([`Cleanup::sheet_edit`]): the copy, the points
+/// to count defects at (the regions' corners and the points snapped onto them), and what
+/// was done.
+struct SheetEdit {
+    soup: TriangleSoup,
+    origin: Vec<u32>,
+    changed: Vec<bool>,
+    at: Vec<u32>,
+    snaps: HashMap<u32, u32>,
+    splits: usize,
+    removed: usize,
+    rebuilt: usize,
+}
+
+impl SheetEdit {
+    /// `next`, made on this edit's copy, joined to it.
+    fn join(&mut self, next: SheetEdit) {
+        self.soup = next.soup;
+        self.origin = next.origin;
+        self.changed = next.changed;
+        self.at.extend(next.at);
+        self.at.sort_unstable();
+        self.at.dedup();
+        self.snaps.extend(next.snaps);
+        self.splits += next.splits;
+        self.removed += next.removed;
+        self.rebuilt += next.rebuilt;
+    }
 }
 
 impl Cleanup {
@@ -554,24 +599,115 @@ impl Cleanup {
         // (in every triangle on the edge), can be rebuilt, where that leaves fewer defects.
         crossings
             .iter()
-            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep)))
+            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, 0)))
+    }
+
+    /// The last resort past every other: the sheets at the crossings with their outlines
+    /// split ([`Cleanup::split_sheet`]), each together with up to three sheets beside it that
+    /// the splits leave crossing, without and then with their own edges kept. True when one
+    /// was rebuilt.
+    fn join_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
+        /// Sheets rebuilt after the first where the one before left crossings beside it.
+        const JOINED: usize = 3;
+        let by_edge = edge_faces(&self.soup);
+        let boxes = self.soup.boxes();
+        [false, true].into_iter().any(|keep| {
+            crossings.iter().any(|&(a, b)| {
+                [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, JOINED))
+            })
+        })
     }
 
     /// The sheet in the plane of triangle `seed` with the points within a few ulps of its
     /// corners snapped together ([`snap_map`]), its outline split at the corners beside
     /// its edges ([`outline_splits`]) and then rebuilt ([`flatten`] by winding numbers),
     /// made where that leaves fewer crossings and triangles without area at its corners
-    /// than before. True when it was.
+    /// than before. Where the splits leave crossings in the sheet beside it (across a crease
+    /// of its outline, a sheet of its own whose triangles the splits cut), that sheet is
+    /// rebuilt too, and so on for up to `most` more: all of them are made where together
+    /// they leave fewer defects at their corners ([`Repair::joined_sheets`]). True when it
+    /// was.
     fn split_sheet(
         &mut self,
         by_edge: &EdgeFaces,
         boxes: &[(DVec3, DVec3)],
         seed: usize,
         keep: bool,
+        most: usize,
     ) -> bool {
-        let Some(region) = flat_region(&self.soup, by_edge, seed, self.thickness) else { return false };
-        let (mut soup, mut origin, mut changed) =
-            (self.soup.clone(), self.origin.clone(), self.changed.clone());
+        let start = (self.soup.clone(), self.origin.clone(), self.changed.clone());
+        let Some(mut edit) = self.sheet_edit(start, Some(by_edge), seed, keep, false) else {
+            return false;
+        };
+        let same = |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
+        for joined in 0..=most {
+            // Defects at the regions' corners (and those snapped onto them) before and after.
+            let mut used = HashSet::new();
+            used.extend(edit.soup.triangles.iter().flatten().copied());
+            let present: Vec<u32> = edit.at.iter().copied().filter(|v| used.contains(v)).collect();
+            let before = local_defects(&self.soup, boxes, &edit.at, same).0;
+            let after = local_defects(&edit.soup, &edit.soup.boxes(), &present, same).0;
+            if after < before {
+                for (&gone, &keep) in &edit.snaps {
+                    let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
+                    self.repair.moved = self.repair.moved.max(d);
+                }
+                self.repair.snapped += edit.snaps.len();
+                self.repair.split_edges += edit.splits;
+                self.repair.removed_triangles += edit.removed;
+                self.repair.sheets += 1 + joined;
+                self.repair.joined_sheets += joined;
+                self.repair.sheet_triangles += edit.rebuilt;
+                self.soup = edit.soup;
+                self.origin = edit.origin;
+                self.changed = edit.changed;
+                return true;
+            }
+            if joined == most {
+                break;
+            }
+            // The next sheet: at a triangle the edits left crossing another at their corners.
+            let near: Vec<bool> = edit
+                .soup
+                .triangles
+                .iter()
+                .map(|t| t.iter().any(|v| present.binary_search(v).is_ok()))
+                .collect();
+            let mut crossing: Vec<usize> = soup_self_intersections_near(&edit.soup, &near, usize::MAX)
+                .into_iter()
+                .flat_map(|(a, b)| [a, b])
+                .collect();
+            crossing.sort_unstable();
+            crossing.dedup();
+            let Some(next) = crossing.into_iter().find_map(|t| {
+                let state = (edit.soup.clone(), edit.origin.clone(), edit.changed.clone());
+                self.sheet_edit(state, None, t, keep, true)
+            }) else {
+                break;
+            };
+            edit.join(next);
+        }
+        false
+    }
+
+    /// [`Cleanup::split_sheet`]'s edit of one sheet, made on `state` (a copy of the soup,
+    /// the origins and the changed flags, whose edge map is `by_edge` where given): its
+    /// corners snapped, its outline split and the sheet rebuilt. `None` where the sheet
+    /// cannot be rebuilt, or (unless `plain`) needs neither a snap nor a split.
+    fn sheet_edit(
+        &self,
+        state: (TriangleSoup, Vec<u32>, Vec<bool>),
+        by_edge: Option<&EdgeFaces>,
+        seed: usize,
+        keep: bool,
+        plain: bool,
+    ) -> Option<SheetEdit> {
+        let (mut soup, mut origin, mut changed) = state;
+        let region = match by_edge {
+            Some(by_edge) => flat_region(&soup, by_edge, seed, self.thickness)?,
+            None => flat_region(&soup, &edge_faces(&soup), seed, self.thickness)?,
+        };
+        let region_tris: Vec<[u32; 3]> = region.iter().map(|&t| soup.triangles[t]).collect();
         let mut scratch = Repair::default();
         // Corners a few ulps apart first (two that differ only across the plane are one
         // point in its projection): snapped together, as at a defect.
@@ -583,16 +719,11 @@ impl Cleanup {
             tris.into_iter().find_map(|t| index.get(&t).copied())
         };
         let snapped = |t: [u32; 3]| t.map(|v| snaps.get(&v).copied().unwrap_or(v));
-        let Some(start) = find(&soup, region.iter().map(|&t| snapped(self.soup.triangles[t])).collect())
-        else {
-            return false;
-        };
-        let Some(region) = flat_region(&soup, &edge_faces(&soup), start, self.thickness) else {
-            return false;
-        };
+        let start = find(&soup, region_tris.iter().map(|&t| snapped(t)).collect())?;
+        let region = flat_region(&soup, &edge_faces(&soup), start, self.thickness)?;
         let splits = outline_splits(&soup, &region, self.snap);
-        if splits.is_empty() && snaps.is_empty() {
-            return false;
+        if splits.is_empty() && snaps.is_empty() && !plain {
+            return None;
         }
         let before_splits = soup.clone();
         for &(edge, at) in &splits {
@@ -600,50 +731,28 @@ impl Cleanup {
             collapse(&mut soup, &mut origin, &mut changed, &HashMap::new(), true, &mut scratch);
         }
         // The seed, or another triangle of the region, as it is after the splits.
-        let Some(start) = find(&soup, region.iter().map(|&t| before_splits.triangles[t]).collect()) else {
-            return false;
-        };
-        let by_edge = edge_faces(&soup);
-        {
-            let Some(f) = flatten(&soup, &by_edge, &origin, start, self.thickness, true, keep) else {
-                return false;
-            };
-            if !f.opposed {
-                return false;
-            }
-            let (mut soup, mut origin, mut changed) = (soup.clone(), origin.clone(), changed.clone());
-            let (mut gone, mut added) = (vec![false; soup.triangles.len()], Vec::new());
-            let rebuilt = f.take_into(&mut gone, &mut added);
-            replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
-            // Defects at the region's corners (and those snapped onto them) before and after.
-            let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
-            at.extend(snaps.keys());
-            at.sort_unstable();
-            at.dedup();
-            let mut used = HashSet::new();
-            used.extend(soup.triangles.iter().flatten().copied());
-            let present: Vec<u32> = at.iter().copied().filter(|v| used.contains(v)).collect();
-            let same =
-                |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
-            let before = local_defects(&self.soup, boxes, &at, same).0;
-            let after = local_defects(&soup, &soup.boxes(), &present, same).0;
-            if after >= before {
-                return false;
-            }
-            self.soup = soup;
-            self.origin = origin;
-            self.changed = changed;
-            for (&gone, &keep) in &snaps {
-                let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
-                self.repair.moved = self.repair.moved.max(d);
-            }
-            self.repair.snapped += snaps.len();
-            self.repair.split_edges += splits.len();
-            self.repair.removed_triangles += scratch.removed_triangles;
-            self.repair.sheets += 1;
-            self.repair.sheet_triangles += rebuilt;
-            true
+        let start = find(&soup, region.iter().map(|&t| before_splits.triangles[t]).collect())?;
+        let f = flatten(&soup, &edge_faces(&soup), &origin, start, self.thickness, true, keep)?;
+        if !f.opposed {
+            return None;
         }
+        let (mut gone, mut added) = (vec![false; soup.triangles.len()], Vec::new());
+        let rebuilt = f.take_into(&mut gone, &mut added);
+        replace_marked(&mut soup, &mut origin, &mut changed, &gone, added);
+        let mut at: Vec<u32> = region.iter().flat_map(|&t| before_splits.triangles[t]).collect();
+        at.extend(snaps.keys());
+        at.sort_unstable();
+        at.dedup();
+        Some(SheetEdit {
+            soup,
+            origin,
+            changed,
+            at,
+            snaps,
+            splits: splits.len(),
+            removed: scratch.removed_triangles,
+            rebuilt,
+        })
     }
 
     /// The last resort for crossings past the sheets: any edge of either triangle at most

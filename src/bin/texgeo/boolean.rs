@@ -222,6 +222,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "pocket_triangles": r.pocket_triangles,
         "sheets": r.sheets,
         "sheet_triangles": r.sheet_triangles,
+        "joined_sheets": r.joined_sheets,
         "dropped_shells": r.dropped_shells,
         "moved": r.moved,
     })
