@@ -757,8 +757,9 @@ impl Cleanup {
 
     /// The last resort for crossings past the sheets: any edge of either triangle at most
     /// `limit` long, not only the shortest ([`Cleanup::plan`]), shortest first, collapsed
-    /// (an intersection point onto an input vertex, else either way) where that leaves fewer
-    /// crossings and triangles without area around it. True when one was.
+    /// the way that leaves the fewest crossings and triangles without area around it
+    /// ([`Cleanup::collapse_way`], as a round's collapses), where that is fewer than before.
+    /// True when one was.
     fn collapse_longer(&mut self, crossings: &[(usize, usize)]) -> bool {
         let boxes = self.soup.boxes();
         for &(a, b) in crossings {
@@ -776,20 +777,11 @@ impl Cleanup {
             edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
             edges.dedup();
             for (length, p, q) in edges {
-                // An intersection point goes onto an input vertex; otherwise either way.
-                let ways: &[(u32, u32)] = match (self.is_new(p), self.is_new(q)) {
-                    (true, false) => &[(q, p)],
-                    (false, true) => &[(p, q)],
-                    _ => &[(p, q), (q, p)],
-                };
-                for &(keep, gone) in ways {
-                    let (before, after) = local_crossings(&self.soup, &boxes, keep, gone);
-                    if after < before {
-                        self.repair.collapsed_edges += 1;
-                        self.repair.moved = self.repair.moved.max(length);
-                        self.collapse(&HashMap::from_iter([(gone, keep)]));
-                        return true;
-                    }
+                if let Some((_, keep, gone)) = self.collapse_way(&boxes, p, q) {
+                    self.repair.collapsed_edges += 1;
+                    self.repair.moved = self.repair.moved.max(length);
+                    self.collapse(&HashMap::from_iter([(gone, keep)]));
+                    return true;
                 }
             }
         }
@@ -806,8 +798,8 @@ impl Cleanup {
     }
 
     /// The collapses of one round, shortest edge first: each point takes part in one,
-    /// and goes the way (onto either end when both are intersection points) after which
-    /// the triangles around it cross the fewest others — if that is fewer than before.
+    /// and goes the way after which the triangles around it cross the fewest others — if
+    /// that is fewer than before ([`Cleanup::collapse_way`]).
     fn choose_collapses(&mut self, mut edges: Vec<(f64, u32, u32)>) -> HashMap<u32, u32> {
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         let mut map: HashMap<u32, u32> = HashMap::new();
@@ -817,20 +809,7 @@ impl Cleanup {
             if busy.contains(&keep) || busy.contains(&gone) {
                 continue;
             }
-            // Onto either end when both are intersection points or both input vertices.
-            let ways: &[(u32, u32)] = if self.is_new(keep) == self.is_new(gone) {
-                &[(keep, gone), (gone, keep)]
-            } else {
-                &[(keep, gone)]
-            };
-            let Some((_, keep, gone)) = ways
-                .iter()
-                .filter_map(|&(keep, gone)| {
-                    let (before, after) = local_crossings(&self.soup, &boxes, keep, gone);
-                    (after < before).then_some((after, keep, gone))
-                })
-                .min_by_key(|w| w.0)
-            else {
+            let Some((_, keep, gone)) = self.collapse_way(&boxes, keep, gone) else {
                 continue;
             };
             busy.insert(keep);
@@ -840,6 +819,24 @@ impl Cleanup {
             self.repair.moved = self.repair.moved.max(length);
         }
         map
+    }
+
+    /// The way to collapse the edge `p` `q` that leaves the fewest crossings and triangles
+    /// without area around it, if fewer than before: (those left, the end kept, the end
+    /// that goes). An intersection point goes onto an input vertex; between two of a kind,
+    /// either way, `q` onto `p` first (the first of two that leave as few).
+    fn collapse_way(&self, boxes: &[(DVec3, DVec3)], p: u32, q: u32) -> Option<(usize, u32, u32)> {
+        let ways: &[(u32, u32)] = match (self.is_new(p), self.is_new(q)) {
+            (true, false) => &[(q, p)],
+            (false, true) => &[(p, q)],
+            _ => &[(p, q), (q, p)],
+        };
+        ways.iter()
+            .filter_map(|&(keep, gone)| {
+                let (before, after) = local_crossings(&self.soup, boxes, keep, gone);
+                (after < before).then_some((after, keep, gone))
+            })
+            .min_by_key(|w| w.0)
     }
 
     fn collapse(&mut self, map: &HashMap<u32, u32>) {
