@@ -576,6 +576,11 @@ pub fn ray_crossings(points: &[DVec3], soup: &TriangleSoup) -> Vec<inclusion::Cl
             |mut acc, t| {
                 let [a, b, c] = soup.triangle(t);
                 let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                let yz = |v: DVec3| glam::DVec2::new(v.y, v.z);
+                let (pa, pb, pc) = (yz(a), yz(b), yz(c));
+                // The triangle's normal along x (the orientation of its projection), taken
+                // once, for the first point in its projection.
+                let mut normal_x = None;
                 let first = sorted.partition_point(|p| p.y < lo.y);
                 for (k, p) in sorted.iter().enumerate().skip(first) {
                     if p.y > hi.y {
@@ -584,14 +589,12 @@ pub fn ray_crossings(points: &[DVec3], soup: &TriangleSoup) -> Vec<inclusion::Cl
                     if p.z < lo.z || p.z > hi.z || p.x > hi.x || acc[k].1 {
                         continue;
                     }
-                    let yz = |v: DVec3| glam::DVec2::new(v.y, v.z);
-                    let (pa, pb, pc, pp) = (yz(a), yz(b), yz(c), yz(*p));
+                    let pp = yz(*p);
                     let e = [orient2d(pa, pb, pp), orient2d(pb, pc, pp), orient2d(pc, pa, pp)];
                     if e.contains(&1) && e.contains(&-1) {
                         continue;
                     }
-                    // The triangle's normal along x: the orientation of its projection.
-                    let s = orient2d(pa, pb, pc);
+                    let s = *normal_x.get_or_insert_with(|| orient2d(pa, pb, pc));
                     if s == 0 || e.contains(&0) {
                         acc[k].1 = true;
                         continue;
