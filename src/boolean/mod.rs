@@ -290,6 +290,8 @@ pub fn evaluate(
 
     let start = Instant::now();
     let (mut built, mut ray_tests) = (std::time::Duration::ZERO, 0);
+    // The operand whose lazily built method failed, to name it in the error.
+    let mut failed = None;
     let mut test = |side: Side, points: &[DVec3]| -> inclusion::Result<Vec<inclusion::Class>> {
         let (k, mesh, soup) = match side {
             Side::A => (0, a, &sa),
@@ -301,13 +303,20 @@ pub fn evaluate(
                 return Ok(classify::ray_crossings(points, soup));
             }
             let start = Instant::now();
-            solvers[k] = Some(build(mesh)?);
+            solvers[k] = Some(build(mesh).inspect_err(|_| failed = Some(side))?);
             built += start.elapsed();
         }
         let Some(solver) = &mut solvers[k] else { unreachable!("built above") };
         solver.classify_fine(points, 4)
     };
-    let mut classification = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test)?;
+    let classified = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test);
+    let mut classification = match (classified, failed) {
+        (Err(classify::ClassifyError::Inclusion(source)), Some(side)) => {
+            let name = if side == Side::A { names.a } else { names.b };
+            return Err(named(name)(source));
+        }
+        (classified, _) => classified?,
+    };
     classification.stats.ray_tests = ray_tests;
     timings.classifiers += built;
     timings.classify = start.elapsed().saturating_sub(built);
