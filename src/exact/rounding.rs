@@ -102,6 +102,12 @@ impl Ball {
         e.components().iter().fold(Ball::of(0.0), |s, &c| s.add(&Ball::of(c)))
     }
 
+    /// The same ball with its radius grown by r ≥ 0 (rounded up).
+    #[inline]
+    pub fn widened(&self, r: f64) -> Ball {
+        Ball { hi: self.hi, lo: self.lo, rad: (self.rad + r) * RADIUS_UP }
+    }
+
     /// The f64 nearest the midpoint `hi + lo`.
     #[inline]
     pub fn value(&self) -> f64 {
