@@ -393,6 +393,49 @@ fn a_micro_turned_difference_intersected_with_its_cutter() {
     assert_operand("S ∩ B", &inter.mesh);
 }
 
+/// The knot minus its copy turned 1e-6° about a skew axis, united with the copy: along an
+/// edge of the knot, needles of S (A's edge and the cut a few 1e-9 beside it) lie along
+/// needles of the copy's faces, and a vertex of A and its turned copy 2e-8 apart share no
+/// edge. No snap, collapse, ulp move or sheet removes the crossing there; merging the two
+/// vertices does (`Repair::merged`). The result re-reads as an operand and holds the
+/// volume of A ∪ B.
+#[test]
+fn a_micro_turned_knot_difference_united_with_its_cutter() {
+    let a = procedural::torus_knot();
+    let b = Transform::parse("rotate 1 2 3 0.000001").unwrap().apply(&a).unwrap();
+    let options = Options::default();
+    let evaluate = |x: &Mesh, y: &Mesh| boolean::evaluate(x, y, Names::default(), &options, None).unwrap();
+    let ab = evaluate(&a, &b);
+    let s = ab.result(Operation::Difference, true).unwrap();
+    let v_union = volume(&ab.result(Operation::Union, true).unwrap());
+    let r = evaluate(&s, &b).output(Operation::Union, true).unwrap_or_else(|e| panic!("S ∪ B: {e}"));
+    assert!(r.repair.merged > 0, "S ∪ B: {}", r.repair);
+    assert!((volume(&r.mesh) - v_union).abs() <= REL * v_union, "S ∪ B: {} vs {v_union}", volume(&r.mesh));
+    assert_operand("S ∪ B", &r.mesh);
+}
+
+/// The knot's symmetric difference with its copy turned 1e-6° about a skew axis, united
+/// with the knot: X carries faces of the knot reversed with corners rounded a hair off
+/// their planes, and where a face of the knot and its reversed copy share an edge, the
+/// corners across it lie 1e-9 apart and the sheet between them cannot be rebuilt (a corner
+/// of one lies off the plane by more than a flat region's thickness). Merging those two
+/// corners (`Repair::merged`) makes the two faces cancel. The result re-reads as an
+/// operand and holds the volume of A ∪ B.
+#[test]
+fn a_micro_turned_knot_symmetric_difference_united_with_the_knot() {
+    let a = procedural::torus_knot();
+    let b = Transform::parse("rotate 1 2 3 0.000001").unwrap().apply(&a).unwrap();
+    let options = Options::default();
+    let evaluate = |x: &Mesh, y: &Mesh| boolean::evaluate(x, y, Names::default(), &options, None).unwrap();
+    let ab = evaluate(&a, &b);
+    let x = ab.result(Operation::SymmetricDifference, true).unwrap();
+    let v_union = volume(&ab.result(Operation::Union, true).unwrap());
+    let r = evaluate(&x, &a).output(Operation::Union, true).unwrap_or_else(|e| panic!("X ∪ A: {e}"));
+    assert!(r.repair.merged > 0, "X ∪ A: {}", r.repair);
+    assert!((volume(&r.mesh) - v_union).abs() <= REL * v_union, "X ∪ A: {} vs {v_union}", volume(&r.mesh));
+    assert_operand("X ∪ A", &r.mesh);
+}
+
 /// A difference used again against the solid that cut it, B shifted by half the width:
 /// corners of A − B that were intersection points on B's edges lie an ulp beside them.
 #[test]

@@ -61,7 +61,12 @@
 //! its outline cut the triangles of the sheet beside it (across a crease of the outline)
 //! and leave them crossing rebuilt together with that sheet (and so on for up to three),
 //! all of them made only where together they leave fewer defects
-//! ([`Repair::joined_sheets`]). A shell that encloses no volume by the
+//! ([`Repair::joined_sheets`]). Past those, a corner of a crossing triangle is merged with
+//! any point at most [`COLLAPSE`] × the diagonal from it, joined to it by an edge of other
+//! triangles or by none (a vertex of one operand and its turned copy in the other a hair
+//! apart, where needles of both lie along each other; a corner of a face and of its
+//! reversed copy a hair off its plane), nearest first, the way a collapse goes and only
+//! where it leaves fewer defects around it ([`Repair::merged`]). A shell that encloses no volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
 //! volume over its area) than a flat region's thickness, is dropped whole. A result the
@@ -152,6 +157,11 @@ pub struct Repair {
     /// outline's splits left crossings in this one beside it (across a crease of the
     /// outline).
     pub joined_sheets: usize,
+    /// Points merged with a point a hair away, past every other repair (a corner of a
+    /// crossing triangle and a point it shares no edge with, or an edge of triangles
+    /// beside it: the two operands' vertices and the cut a hair apart, along needles of
+    /// both, or a corner of a face and of its reversed copy a hair off its plane).
+    pub merged: usize,
     /// Long flat triangles (a corner on the opposite edge once rounded) removed by
     /// splitting the neighbour across that edge at the corner.
     pub flipped: usize,
@@ -172,6 +182,7 @@ impl Repair {
             && self.pockets == 0
             && self.sheets == 0
             && self.flipped == 0
+            && self.merged == 0
             && self.dropped_shells == 0
     }
 }
@@ -182,7 +193,7 @@ impl std::fmt::Display for Repair {
             f,
             "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
-             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} flat shells dropped",
+             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
@@ -198,6 +209,7 @@ impl std::fmt::Display for Repair {
             self.sheet_triangles,
             self.joined_sheets,
             self.flipped,
+            self.merged,
             self.dropped_shells
         )
     }
@@ -278,7 +290,7 @@ pub fn finish(
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let (mut nudges, mut sheets, mut longer, mut joined) = (0, 0, 0, 0);
+    let (mut nudges, mut sheets, mut longer, mut joined, mut merged) = (0, 0, 0, 0, 0);
     for round in 0.. {
         let (crossings, flat) = c.defects();
         if round == 0 {
@@ -323,6 +335,12 @@ pub fn finish(
             // where its outline's splits leave those crossing ([`Cleanup::split_sheet`]).
             if joined < ROUNDS && c.join_sheets(&crossings) {
                 joined += 1;
+                continue;
+            }
+            // Past every other: a corner of a crossing triangle merged with any point a hair
+            // away.
+            if merged < ROUNDS && c.merge_near(&crossings) {
+                merged += 1;
                 continue;
             }
             return Err(err);
@@ -779,6 +797,52 @@ impl Cleanup {
             for (length, p, q) in edges {
                 if let Some((_, keep, gone)) = self.collapse_way(&boxes, p, q) {
                     self.repair.collapsed_edges += 1;
+                    self.repair.moved = self.repair.moved.max(length);
+                    self.collapse(&HashMap::from_iter([(gone, keep)]));
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// The last resort past the joined sheets: a corner of a crossing triangle and any point
+    /// at most `limit` from it, not only along the crossing triangles' own edges
+    /// ([`Cleanup::collapse_longer`]): one it shares no edge with (the two operands'
+    /// vertices and the cut a hair apart, where a needle of one lies along a needle of the
+    /// other) or an edge of triangles beside them (a corner of a face and of its reversed
+    /// copy a hair off its plane, where the sheet between them cannot be rebuilt), nearest
+    /// first, merged the way that leaves the fewest crossings and triangles without
+    /// area around it ([`Cleanup::collapse_way`]), where that is fewer than before. True
+    /// when one was.
+    fn merge_near(&mut self, crossings: &[(usize, usize)]) -> bool {
+        let boxes = self.soup.boxes();
+        let mut used = vec![false; self.soup.positions.len()];
+        for t in &self.soup.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        for &(a, b) in crossings {
+            let mut corners: Vec<u32> = [a, b].iter().flat_map(|&f| self.soup.triangles[f]).collect();
+            corners.sort_unstable();
+            corners.dedup();
+            let positions = &self.soup.positions;
+            let mut pairs = Vec::new();
+            for &v in &corners {
+                let p = positions[v as usize];
+                for (w, &q) in positions.iter().enumerate() {
+                    let (w, d) = (w as u32, p.distance(q));
+                    if used[w as usize] && w != v && d <= self.limit {
+                        pairs.push((d, v.min(w), v.max(w)));
+                    }
+                }
+            }
+            pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+            pairs.dedup();
+            for (length, p, q) in pairs {
+                if let Some((_, keep, gone)) = self.collapse_way(&boxes, p, q) {
+                    self.repair.merged += 1;
                     self.repair.moved = self.repair.moved.max(length);
                     self.collapse(&HashMap::from_iter([(gone, keep)]));
                     return true;

@@ -218,6 +218,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "collapsed_edges": r.collapsed_edges,
         "removed_triangles": r.removed_triangles,
         "flipped": r.flipped,
+        "merged": r.merged,
         "pockets": r.pockets,
         "pocket_triangles": r.pocket_triangles,
         "sheets": r.sheets,
