@@ -43,7 +43,8 @@
 //! (rounding put it there by an ulp) goes by moving one of the intersection points among
 //! its triangles' corners to a neighbouring f64 position, each coordinate by an ulp or two,
 //! where the exact tests around that point find nothing crossing ([`nudge`]); then
-//! everything is checked again. Where a crossing is still left, the flat region at it
+//! everything is checked again (a point none of whose positions helped is not tried again
+//! while the triangles around it stay as they were: the tests would answer the same). Where a crossing is still left, the flat region at it
 //! that holds faces of both orientations (a sheet between a face and a reversed copy of it
 //! a hair off its plane: a result used again against the solid that cut it carries that
 //! solid's faces with rounded corners) is rebuilt as a pocket is, its new triangles' cover
@@ -315,7 +316,9 @@ pub fn finish(
                 .stuck
                 .or_else(|| crossings.first().map(|x| c.crossing(x)))
                 .unwrap_or_else(|| c.flat_face(flat[0]));
-            if nudges < NUDGES && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.repair) {
+            if nudges < NUDGES
+                && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.unmoved, &mut c.repair)
+            {
                 nudges += 1;
                 continue;
             }
@@ -365,7 +368,14 @@ struct Cleanup {
     thickness: f64,
     /// Points within this distance (per coordinate) of a defect's corner snap together.
     snap: f64,
+    /// The points for which [`nudge`] found no position, with the triangles around them
+    /// then: with the same triangles it finds none again.
+    unmoved: Unmoved,
 }
+
+/// Per point, the triangles around it (as [`sub_soup`] gives them) where [`nudge`] found no
+/// position for it.
+type Unmoved = HashMap<u32, (Vec<[u32; 3]>, Vec<DVec3>)>;
 
 /// What one round found to do about the defects: short edges to collapse (length,
 /// keep, gone), crossings and flat triangles without one, and the error to give if
@@ -429,6 +439,7 @@ impl Cleanup {
             limit: COLLAPSE * diagonal,
             thickness: flat_thickness(max_abs, diagonal),
             snap: snap_distance(max_abs),
+            unmoved: Unmoved::new(),
         }
     }
 
@@ -1541,8 +1552,9 @@ fn local_defects(
     at: &[u32],
     edit: impl FnOnce(&mut TriangleSoup, &mut Vec<u32>, &mut Vec<bool>, &[u32]) -> Vec<u32>,
 ) -> (usize, usize) {
+    let around: HashSet<u32> = at.iter().copied().collect();
     let (lo, hi) = (0..soup.triangles.len())
-        .filter(|&t| soup.triangles[t].iter().any(|v| at.contains(v)))
+        .filter(|&t| soup.triangles[t].iter().any(|v| around.contains(v)))
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
     let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
     let count = |sub: &TriangleSoup, at: &[u32]| {
@@ -1631,11 +1643,14 @@ fn neighbour_positions(p: DVec3) -> Vec<DVec3> {
 /// fewer do and none that did not before. Never onto another point's position (the file
 /// read back would make them one). The topology does not change, so the result stays
 /// closed and oriented. True when a point moved (the caller checks everything again).
+/// A point for which no position was found, with the same triangles around it as then
+/// (`unmoved`), is not tried again: the tests would give the same answer.
 fn nudge(
     soup: &mut TriangleSoup,
     crossings: &[(usize, usize)],
     flat: &[usize],
     first_new: u32,
+    unmoved: &mut Unmoved,
     repair: &mut Repair,
 ) -> bool {
     let key = |p: DVec3| (p + DVec3::ZERO).to_array().map(f64::to_bits);
@@ -1667,6 +1682,9 @@ fn nudge(
                 .iter()
                 .fold((reach(-2), reach(2)), |(lo, hi), &t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
             let (mut sub, ids) = sub_soup(soup, &boxes, lo, hi);
+            if unmoved.get(&v).is_some_and(|(t, p)| *t == sub.triangles && *p == sub.positions) {
+                continue;
+            }
             let at = ids[&v];
             let near: Vec<bool> = sub.triangles.iter().map(|t| t.contains(&at)).collect();
             let defects = |sub: &TriangleSoup| {
@@ -1702,7 +1720,11 @@ fn nudge(
                     fewer = Some(q);
                 }
             }
-            let Some(q) = clean.or(fewer) else { continue };
+            let Some(q) = clean.or(fewer) else {
+                sub.positions[at as usize] = p;
+                unmoved.insert(v, (sub.triangles, sub.positions));
+                continue;
+            };
             taken.remove(&key(p));
             taken.insert(key(q));
             soup.positions[v as usize] = q;
