@@ -44,7 +44,8 @@
 //! its triangles' corners to a neighbouring f64 position, each coordinate by an ulp or two,
 //! where the exact tests around that point find nothing crossing ([`nudge`]); then
 //! everything is checked again (a point none of whose positions helped is not tried again
-//! while the triangles around it stay as they were: the tests would answer the same). Where a crossing is still left, the flat region at it
+//! while the triangles around it stay as they were: the tests would answer the same).
+//! Where a crossing is still left, the flat region at it
 //! that holds faces of both orientations (a sheet between a face and a reversed copy of it
 //! a hair off its plane: a result used again against the solid that cut it carries that
 //! solid's faces with rounded corners) is rebuilt as a pocket is, its new triangles' cover
@@ -67,7 +68,8 @@
 //! triangles or by none (a vertex of one operand and its turned copy in the other a hair
 //! apart, where needles of both lie along each other; a corner of a face and of its
 //! reversed copy a hair off its plane), nearest first, the way a collapse goes and only
-//! where it leaves fewer defects around it ([`Repair::merged`]). A shell that encloses no volume by the
+//! where it leaves fewer defects around it ([`Repair::merged`]). A shell that encloses no
+//! volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
 //! volume over its area) than a flat region's thickness, is dropped whole. A result the
@@ -792,7 +794,7 @@ impl Cleanup {
     fn collapse_longer(&mut self, crossings: &[(usize, usize)]) -> bool {
         let boxes = self.soup.boxes();
         for &(a, b) in crossings {
-            let mut edges: Vec<(f64, u32, u32)> = [a, b]
+            let edges: Vec<(f64, u32, u32)> = [a, b]
                 .iter()
                 .flat_map(|&f| {
                     let t = self.soup.triangles[f];
@@ -803,15 +805,24 @@ impl Cleanup {
                 })
                 .filter(|e| e.0 <= self.limit)
                 .collect();
-            edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-            edges.dedup();
-            for (length, p, q) in edges {
-                if let Some((_, keep, gone)) = self.collapse_way(&boxes, p, q) {
-                    self.repair.collapsed_edges += 1;
-                    self.repair.moved = self.repair.moved.max(length);
-                    self.collapse(&HashMap::from_iter([(gone, keep)]));
-                    return true;
-                }
+            if self.collapse_first(&boxes, edges) {
+                self.repair.collapsed_edges += 1;
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Collapses the first of `pairs` (length, p, q), shortest first, that
+    /// [`Cleanup::collapse_way`] takes; true when one was.
+    fn collapse_first(&mut self, boxes: &[(DVec3, DVec3)], mut pairs: Vec<(f64, u32, u32)>) -> bool {
+        pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        pairs.dedup();
+        for (length, p, q) in pairs {
+            if let Some((_, keep, gone)) = self.collapse_way(boxes, p, q) {
+                self.repair.moved = self.repair.moved.max(length);
+                self.collapse(&HashMap::from_iter([(gone, keep)]));
+                return true;
             }
         }
         false
@@ -828,12 +839,7 @@ impl Cleanup {
     /// when one was.
     fn merge_near(&mut self, crossings: &[(usize, usize)]) -> bool {
         let boxes = self.soup.boxes();
-        let mut used = vec![false; self.soup.positions.len()];
-        for t in &self.soup.triangles {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
+        let grid = UsedGrid::new(&self.soup, self.limit);
         for &(a, b) in crossings {
             let mut corners: Vec<u32> = [a, b].iter().flat_map(|&f| self.soup.triangles[f]).collect();
             corners.sort_unstable();
@@ -842,22 +848,16 @@ impl Cleanup {
             let mut pairs = Vec::new();
             for &v in &corners {
                 let p = positions[v as usize];
-                for (w, &q) in positions.iter().enumerate() {
-                    let (w, d) = (w as u32, p.distance(q));
-                    if used[w as usize] && w != v && d <= self.limit {
+                for w in grid.near(p) {
+                    let d = p.distance(positions[w as usize]);
+                    if w != v && d <= self.limit {
                         pairs.push((d, v.min(w), v.max(w)));
                     }
                 }
             }
-            pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-            pairs.dedup();
-            for (length, p, q) in pairs {
-                if let Some((_, keep, gone)) = self.collapse_way(&boxes, p, q) {
-                    self.repair.merged += 1;
-                    self.repair.moved = self.repair.moved.max(length);
-                    self.collapse(&HashMap::from_iter([(gone, keep)]));
-                    return true;
-                }
+            if self.collapse_first(&boxes, pairs) {
+                self.repair.merged += 1;
+                return true;
             }
         }
         false
@@ -968,35 +968,55 @@ impl Cleanup {
     }
 }
 
+/// The points the soup's triangles use, in a hash of cells `width` wide: every point
+/// within `width` (per coordinate) of p lies in p's cell or one beside it.
+struct UsedGrid {
+    width: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl UsedGrid {
+    fn new(soup: &TriangleSoup, width: f64) -> UsedGrid {
+        let mut grid = UsedGrid { width, cells: HashMap::new() };
+        let mut used = vec![false; soup.positions.len()];
+        for t in &soup.triangles {
+            for &v in t {
+                if !std::mem::replace(&mut used[v as usize], true) {
+                    grid.cells.entry(grid.cell(soup.positions[v as usize])).or_default().push(v);
+                }
+            }
+        }
+        grid
+    }
+
+    fn cell(&self, p: DVec3) -> [i64; 3] {
+        (p / self.width).floor().as_i64vec3().to_array()
+    }
+
+    /// The points in p's cell and the 26 beside it.
+    fn near(&self, p: DVec3) -> impl Iterator<Item = u32> + '_ {
+        let [x, y, z] = self.cell(p);
+        (-1..=1)
+            .flat_map(move |i| (-1..=1).flat_map(move |j| (-1..=1).map(move |k| [x + i, y + j, z + k])))
+            .flat_map(|key| self.cells.get(&key).into_iter().flatten().copied())
+    }
+}
+
 /// The snaps for the corners of `faces`: every point of the soup within `snap` (per
 /// coordinate) of such a corner joins its cluster, and each cluster goes onto its lowest
 /// id. Points already at one position are one point (welded), so every snap moves one.
 fn snap_map(soup: &TriangleSoup, faces: impl Iterator<Item = usize>, snap: f64) -> HashMap<u32, u32> {
-    let cell = |p: DVec3| (p / snap).floor().as_i64vec3().to_array();
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    let mut used = vec![false; soup.positions.len()];
-    for t in &soup.triangles {
-        for &v in t {
-            if !std::mem::replace(&mut used[v as usize], true) {
-                grid.entry(cell(soup.positions[v as usize])).or_default().push(v);
-            }
-        }
-    }
+    let grid = UsedGrid::new(soup, snap);
     let mut sets = UnionFind::new(soup.positions.len());
     let mut members = std::collections::BTreeSet::new();
     for f in faces {
         for v in soup.triangles[f] {
             let p = soup.positions[v as usize];
-            let [x, y, z] = cell(p);
-            for key in (-1..=1)
-                .flat_map(|i| (-1..=1).flat_map(move |j| (-1..=1).map(move |k| [x + i, y + j, z + k])))
-            {
-                for &w in grid.get(&key).into_iter().flatten() {
-                    if w != v && (soup.positions[w as usize] - p).abs().max_element() <= snap {
-                        sets.union(v, w);
-                        members.insert(v);
-                        members.insert(w);
-                    }
+            for w in grid.near(p) {
+                if w != v && (soup.positions[w as usize] - p).abs().max_element() <= snap {
+                    sets.union(v, w);
+                    members.insert(v);
+                    members.insert(w);
                 }
             }
         }
