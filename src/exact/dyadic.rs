@@ -9,6 +9,7 @@
 
 use num_bigint::{BigInt, BigUint, Sign as BigSign};
 
+use super::expansion::Exact;
 use super::predicates::Sign;
 use super::rounding::Ball;
 
@@ -59,6 +60,11 @@ impl Dyadic {
         let (mant, e) = if exp == 0 { (frac, -1074) } else { (frac | (1u64 << 52), exp - 1075) };
         let m = BigInt::from(mant);
         Dyadic::normalized(if x < 0.0 { -m } else { m }, e)
+    }
+
+    /// The exact value of an expansion.
+    pub fn of_exact(e: &Exact) -> Dyadic {
+        e.components().iter().fold(Dyadic::default(), |s, &c| s.add(&Dyadic::from_f64(c)))
     }
 
     pub fn add(&self, o: &Dyadic) -> Dyadic {
@@ -163,13 +169,8 @@ pub fn quotient(x: &Dyadic, w: &Dyadic) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exact::expansion::Exact;
-    use crate::exact::rounding::quotient_exact;
+    use crate::exact::rounding::quotient_by_midpoints;
     use crate::random::Rng;
-
-    fn of_exact(e: &Exact) -> Dyadic {
-        e.components().iter().fold(Dyadic::default(), |s, &c| s.add(&Dyadic::from_f64(c)))
-    }
 
     fn rand_f64(rng: &mut Rng) -> f64 {
         rng.range_f64(-1.0, 1.0) * 2f64.powi(rng.below(81) as i32 - 40)
@@ -186,7 +187,7 @@ mod tests {
                 v.iter().map(|&x| (Dyadic::from_f64(x), Exact::from_f64(x))).unzip();
             let dd = d[0].mul(&d[1]).sub(&d[2].mul(&d[3])).add(&d[4].mul(&d[5]).mul(&d[0]));
             let ee = &(&(&e[0] * &e[1]) - &(&e[2] * &e[3])) + &(&(&e[4] * &e[5]) * &e[0]);
-            assert_eq!(dd, of_exact(&ee));
+            assert_eq!(dd, Dyadic::of_exact(&ee));
             assert_eq!(dd.sign(), ee.sign());
             assert_eq!(d[0].sub(&d[0]), Dyadic::default());
             assert_eq!(d[1].add(&d[2]), d[2].add(&d[1]));
@@ -213,8 +214,8 @@ mod tests {
                 &(&Exact::from_f64(x) * &Exact::from_f64(z)) + &(&Exact::from_f64(y) * &Exact::from_f64(w)),
                 &Exact::from_f64(w) * &Exact::from_f64(z),
             );
-            let (dx, dw) = (of_exact(&ex), of_exact(&ew));
-            let want = quotient_exact(&ex, &ew);
+            let (dx, dw) = (Dyadic::of_exact(&ex), Dyadic::of_exact(&ew));
+            let want = quotient_by_midpoints(&ex, &ew);
             assert_eq!(quotient(&dx, &dw).to_bits(), want.to_bits(), "{x} {w} {y} {z}");
             // Scaling both by 2^±3000 changes nothing.
             let k = Dyadic::normalized(BigInt::from(1), if round % 2 == 0 { 3000 } else { -3000 });

@@ -8,11 +8,12 @@
 //! lies strictly between the two rounding midpoints around r — the signs of X − m·W for
 //! m = (r + r⁻) / 2 and (r + r⁺) / 2, decided when the ball excludes zero. When a ball is
 //! too wide (the value sits within about 2⁻¹⁰⁰ of a midpoint, or X or W cancel badly) the
-//! exact path ([`quotient_exact`]) decides the same midpoints with expansions.
+//! exact path ([`quotient_exact`]) divides their exact values.
 //!
 //! Like the rest of [`crate::exact`], it assumes coordinates in a normalized frame: no
 //! product overflows or falls below f64's normal range.
 
+use super::dyadic::Dyadic;
 use super::expansion::{Exact, two_prod, two_sum};
 
 /// u = 2⁻⁵³, the unit roundoff of f64.
@@ -203,8 +204,17 @@ pub fn quotient_fast(x: &Ball, w: &Ball) -> Option<f64> {
     (below_upper && above_lower).then_some(r)
 }
 
-/// X / W rounded to nearest, ties to even, W ≠ 0; exact 0 gives +0.
+/// X / W rounded to nearest, ties to even, W ≠ 0; exact 0 gives +0: the expansions'
+/// exact values divided as big dyadics ([`super::dyadic::quotient`]).
 pub fn quotient_exact(x: &Exact, w: &Exact) -> f64 {
+    super::dyadic::quotient(&Dyadic::of_exact(x), &Dyadic::of_exact(w))
+}
+
+/// [`quotient_exact`] found another way, the reference of the tests: from the f64 quotient
+/// of the leading parts, stepping by one ulp while X / W lies beyond a rounding midpoint
+/// (decided exactly with expansions).
+#[cfg(test)]
+pub(crate) fn quotient_by_midpoints(x: &Exact, w: &Exact) -> f64 {
     let sw = w.sign();
     if x.sign() == 0 || sw == 0 {
         return 0.0;
@@ -245,20 +255,24 @@ mod tests {
 
     #[test]
     fn ties_round_to_even_and_exact_quotients_stay() {
-        // (1 + 2⁻⁵²)/2 + 1/2 is the midpoint 1 + 2⁻⁵³, a tie: it rounds to even, 1.
-        let x = &Exact::from_f64(1.0) + &Exact::from_f64(1.0 + f64::EPSILON);
-        let w = Exact::from_f64(2.0);
-        assert_eq!(quotient_exact(&x, &w), 1.0);
+        // Both exact ways: the big-dyadic division and the midpoint steps.
+        let ways: [fn(&Exact, &Exact) -> f64; 2] = [quotient_exact, quotient_by_midpoints];
+        for quotient in ways {
+            // (1 + 2⁻⁵²)/2 + 1/2 is the midpoint 1 + 2⁻⁵³, a tie: it rounds to even, 1.
+            let x = &Exact::from_f64(1.0) + &Exact::from_f64(1.0 + f64::EPSILON);
+            let w = Exact::from_f64(2.0);
+            assert_eq!(quotient(&x, &w), 1.0);
+            // Three halves of an ulp above 1 rounds to 1 + 2ulp (even).
+            let x = &Exact::from_f64(2.0) + &Exact::from_f64(3.0 * f64::EPSILON);
+            assert_eq!(quotient(&x, &w), 1.0 + 2.0 * f64::EPSILON);
+            // Exact quotients, of either sign.
+            assert_eq!(quotient(&Exact::from_f64(-3.0), &Exact::from_f64(4.0)), -0.75);
+            assert_eq!(quotient(&Exact::from_f64(1.0), &Exact::from_f64(-3.0)), -1.0 / 3.0);
+            assert_eq!(quotient(&Exact::default(), &Exact::from_f64(-3.0)).to_bits(), 0);
+        }
         let bx = Ball::of(1.0).add(&Ball::of(1.0 + f64::EPSILON));
         assert_eq!(quotient_fast(&bx, &Ball::of(2.0)), None);
-        // Three halves of an ulp above 1 rounds to 1 + 2ulp (even).
-        let x = &Exact::from_f64(2.0) + &Exact::from_f64(3.0 * f64::EPSILON);
-        assert_eq!(quotient_exact(&x, &w), 1.0 + 2.0 * f64::EPSILON);
-        // Exact quotients, of either sign.
-        assert_eq!(quotient_exact(&Exact::from_f64(-3.0), &Exact::from_f64(4.0)), -0.75);
         assert_eq!(quotient_fast(&Ball::of(-3.0), &Ball::of(4.0)), Some(-0.75));
-        assert_eq!(quotient_exact(&Exact::from_f64(1.0), &Exact::from_f64(-3.0)), -1.0 / 3.0);
         assert_eq!(quotient_fast(&Ball::of(1.0), &Ball::of(-3.0)), Some(-1.0 / 3.0));
-        assert_eq!(quotient_exact(&Exact::default(), &Exact::from_f64(-3.0)).to_bits(), 0);
     }
 }
