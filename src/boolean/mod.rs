@@ -58,6 +58,7 @@ pub mod expr;
 pub mod index;
 pub mod input;
 pub mod intersect;
+pub mod operand;
 pub mod output;
 pub mod refine;
 pub mod select;

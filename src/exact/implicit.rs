@@ -630,6 +630,17 @@ impl Point {
             }
         })
     }
+
+    /// A box that certainly holds the exact point: the point itself when explicit, else
+    /// one ulp either side of its correctly rounded [`Point::position`] (the exact value
+    /// lies within half an ulp of it), for spatial indexes of implicit points.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let p = self.position();
+        if let Definition::Explicit(_) = self.definition {
+            return (p, p);
+        }
+        (p.to_array().map(Ulp::down).into(), p.to_array().map(Ulp::up).into())
+    }
 }
 
 impl Point {
