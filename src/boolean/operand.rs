@@ -6,6 +6,8 @@
 //! always explicit, so a later step's edge of an input mesh crosses it at an edge–plane
 //! point of input data; only its own edges are segments between implicit points.
 
+use std::borrow::Cow;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -57,6 +59,64 @@ impl ExactSolid {
     }
 }
 
+/// What the refinement and the classification ask of an operand: a file's mesh
+/// ([`TriangleSoup`], every point explicit: the f64 predicates decide, as fast as
+/// before) or an exact intermediate result ([`ExactSolid`]). Generic code branches on
+/// [`Solid::EXPLICIT`], a constant, so the explicit path compiles to today's code.
+pub trait Solid: Sync {
+    /// True when every point is explicit ([`Solid::point`] is [`Point::explicit`] of
+    /// [`Solid::rounded`]).
+    const EXPLICIT: bool;
+    /// Triangles over vertex ids (welded: one id per exact point), oriented outward.
+    fn triangles(&self) -> &[[u32; 3]];
+    /// Each vertex's position: exact for explicit points, else rounded (for shapes only).
+    fn rounded(&self) -> &[DVec3];
+    /// Vertex `v` as an exact point.
+    fn point(&self, v: u32) -> Cow<'_, Point>;
+    /// The plane triangle `t` lies in, as three explicit points oriented like it.
+    fn support(&self, t: u32) -> [DVec3; 3];
+    /// Per triangle, a box that certainly holds it.
+    fn boxes(&self) -> Vec<(DVec3, DVec3)>;
+}
+
+impl Solid for TriangleSoup {
+    const EXPLICIT: bool = true;
+    fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+    fn rounded(&self) -> &[DVec3] {
+        &self.positions
+    }
+    fn point(&self, v: u32) -> Cow<'_, Point> {
+        Cow::Owned(Point::explicit(self.positions[v as usize]))
+    }
+    fn support(&self, t: u32) -> [DVec3; 3] {
+        self.triangle(t as usize)
+    }
+    fn boxes(&self) -> Vec<(DVec3, DVec3)> {
+        TriangleSoup::boxes(self)
+    }
+}
+
+impl Solid for ExactSolid {
+    const EXPLICIT: bool = false;
+    fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+    fn rounded(&self) -> &[DVec3] {
+        &self.rounded
+    }
+    fn point(&self, v: u32) -> Cow<'_, Point> {
+        Cow::Borrowed(&self.points[v as usize])
+    }
+    fn support(&self, t: u32) -> [DVec3; 3] {
+        self.support[t as usize]
+    }
+    fn boxes(&self) -> Vec<(DVec3, DVec3)> {
+        ExactSolid::boxes(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,7 +128,7 @@ mod tests {
         let triangles = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
         let soup = TriangleSoup { positions, triangles, face_of: vec![0, 1, 2, 3], failed: Vec::new() };
         let s = ExactSolid::from_soup(&soup);
-        assert_eq!(s.boxes(), soup.boxes());
+        assert_eq!(Solid::boxes(&s), Solid::boxes(&soup));
         for t in 0..4 {
             let [a, b, c] = s.support[t as usize].map(Point::explicit);
             assert!(s.corners(t).iter().all(|p| orient3d_implicit(&a, &b, &c, p) == 0));
