@@ -33,7 +33,7 @@ pub mod rounding;
 pub mod volume;
 
 pub use distance::{closest_point_on_segment, closest_point_on_triangle, segment_within, triangle_within};
-pub use expansion::{Exact, Exact3, two_prod, two_sum};
+pub use expansion::{Exact, Exact3, lowest_bit, two_prod, two_sum};
 pub use predicates::{
     Sign, line_crossing, normal_signs, orient_yz_perturbed, orient2d, orient2d_approx, orient3d,
     orient3d_perturbed, plane_crossing, sign_of,

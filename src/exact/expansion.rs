@@ -24,6 +24,19 @@ pub fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, err)
 }
 
+/// The exponent of the lowest set bit of finite non-zero x: x is an integer multiple of
+/// 2^lowest_bit(x). A product of numbers that are multiples of 2^l₁, 2^l₂ … is a multiple
+/// of 2^(l₁ + l₂ + …), which decides whether expansions hold it exactly (their components
+/// must be multiples of 2⁻¹⁰⁷⁴, f64's smallest step).
+pub fn lowest_bit(x: f64) -> i32 {
+    let bits = x.abs().to_bits();
+    let biased = (bits >> 52) as i32;
+    let mantissa = bits & ((1 << 52) - 1);
+    let (mantissa, base) =
+        if biased == 0 { (mantissa, -1074) } else { (mantissa | (1 << 52), biased - 1075) };
+    base + mantissa.trailing_zeros() as i32
+}
+
 /// a · b = p + e exactly, p the rounded product (fused multiply-add).
 #[inline(always)]
 pub fn two_prod(a: f64, b: f64) -> (f64, f64) {

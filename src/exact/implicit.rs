@@ -48,13 +48,17 @@
 //! [`super::predicates`]: the predicates here agree with [`orient2d`](super::orient2d)
 //! and [`orient3d`](super::orient3d) on explicit points.
 //!
-//! Inputs are assumed to lie in a normalized frame (coordinates within 2^±60 or so, as
-//! [`crate::mesh::frame`] makes them): the expansions' products for the first two kinds
-//! must neither overflow nor fall below f64's normal range. Points made from points do
-//! not need it for exactness: their degree in the input coordinates grows with depth
-//! (W has degree 0 for an explicit point, 3 for an edge crossing a plane, deg W_P +
-//! deg W_Q + 3 for a crossing of segment PQ with a plane of explicit points), past what
-//! expansions hold, and big dyadics round nothing at any degree. Their intervals and
+//! Expansions are exact while no product overflows (inputs are assumed below 2^60 in
+//! magnitude: [`crate::mesh::frame`] brings the largest coordinate into [1, 2)) and every
+//! product is an integer multiple of f64's smallest step 2⁻¹⁰⁷⁴. The second is checked:
+//! a product of input coordinates is a multiple of 2 to the sum of their lowest set bits,
+//! so a sign or a rounding whose products could fall below it (tiny coordinates beside
+//! large ones, where some terms would underflow and others not) is computed with big
+//! dyadics instead. Points made from points always take big dyadics: their degree in the
+//! input coordinates grows with depth (W has degree 0 for an explicit point, 3 for an
+//! edge crossing a plane, deg W_P + deg W_Q + 3 for a crossing of segment PQ with a plane
+//! of explicit points), past what expansions hold, and big dyadics round nothing at any
+//! degree. Their intervals and
 //! double-double coordinates are scaled by a power of two per point (the homogeneous
 //! coordinates of a point are defined up to a factor) so that depth does not carry
 //! them out of f64's range; the double-double ones carry an allowance for underflow.
@@ -68,7 +72,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::dyadic::{self, Dyadic};
-use super::expansion::Exact;
+use super::expansion::{Exact, lowest_bit};
 use super::predicates::{Sign, orient3d};
 use super::rounding::{Ball, quotient_exact, quotient_fast};
 
@@ -581,12 +585,37 @@ impl Point {
         if let Some(e) = self.exact.get() {
             return Some(e);
         }
+        if self.granularity()? < EXPANSION_FLOOR {
+            return None;
+        }
         let row = match self.definition {
             Definition::Explicit(p) => explicit_row(p),
             Definition::EdgePlane { p, q, plane } => edge_plane_row(p, q, plane),
             Definition::SegmentPlane(_) => return None,
         };
         Some(self.exact.get_or_init(|| row))
+    }
+
+    /// The power of two every homogeneous coordinate of the point in expansions (and every
+    /// product computing them) is an integer multiple of: an edge crossing a plane has
+    /// entries of degree at most 4 in its input coordinates, each a multiple of 2^m, m the
+    /// lowest bit among them (at most 0: the explicit W is 1). `None` for a point made
+    /// from points, which has no expansions.
+    fn granularity(&self) -> Option<i32> {
+        let low = |c: &[DVec3]| {
+            c.iter()
+                .flat_map(|p| p.to_array())
+                .filter(|&x| x != 0.0)
+                .map(lowest_bit)
+                .min()
+                .unwrap_or(0)
+                .min(0)
+        };
+        match &self.definition {
+            Definition::Explicit(p) => Some(low(&[*p])),
+            Definition::EdgePlane { p, q, plane } => Some(4 * low(&[*p, *q, plane[0], plane[1], plane[2]])),
+            Definition::SegmentPlane(_) => None,
+        }
     }
 
     /// The homogeneous coordinates exactly as big dyadics, for a point of any kind; a
@@ -795,6 +824,11 @@ fn det4<R: Ring>(r: [&[R; 4]; 4]) -> R {
     term(1).minus(&term(0)).plus(&term(3).minus(&term(2)))
 }
 
+/// f64's smallest step is 2^EXPANSION_FLOOR: expansions are exact while every product
+/// they form is an integer multiple of it (fused multiply-add keeps a product's error
+/// exactly then; sums never round).
+const EXPANSION_FLOOR: i32 = -1074;
+
 /// How many points' positions needed expansions, process-wide (for `--stats`).
 static EXACT_ROUNDINGS: AtomicUsize = AtomicUsize::new(0);
 
@@ -822,7 +856,13 @@ fn exact_sign<const N: usize>(
     big: impl FnOnce(&[&[Dyadic; 4]]) -> Dyadic,
 ) -> Sign {
     EXACT_SIGNS.fetch_add(1, AtomicOrdering::Relaxed);
-    let rows: Option<Vec<&[Exact; 4]>> = points.iter().map(|p| p.exact()).collect();
+    // Each term multiplies one coordinate of every point: a multiple of 2 to the sum of
+    // their granularities, which expansions hold only from f64's smallest step up.
+    let fine = points.iter().try_fold(0i32, |sum, p| Some(sum + p.granularity()?));
+    let rows: Option<Vec<&[Exact; 4]>> = match fine {
+        Some(g) if g >= EXPANSION_FLOOR => points.iter().map(|p| p.exact()).collect(),
+        _ => None,
+    };
     match rows {
         Some(rows) => flat(&rows).sign(),
         None => {
@@ -916,6 +956,39 @@ mod tests {
 
     fn rand_point(rng: &mut Rng) -> DVec3 {
         rng.point_in_box(DVec3::splat(-1.0), DVec3::splat(1.0))
+    }
+
+    /// Points on one plane with coordinates of very different sizes (x near 1, y and z
+    /// near 10⁻⁶⁰): products of their coordinates fall below f64's smallest step in some
+    /// terms and not in others, so expansions would round; the signs and roundings are
+    /// still exact (big dyadics take over).
+    #[test]
+    fn tiny_coordinates_beside_large_ones_stay_exact() {
+        let mut rng = Rng::new(11);
+        let t = 1e-60;
+        let mut undecided = 0;
+        for _ in 0..200 {
+            let mut r = || {
+                DVec3::new(rng.range_f64(0.1, 0.9), rng.range_f64(0.1, 0.9) * t, rng.range_f64(0.1, 0.9) * t)
+            };
+            let plane = [r(), r(), r()];
+            let mut crossing = || loop {
+                let (p, q) = (r() + DVec3::new(0.0, 0.0, t), r() - DVec3::new(0.0, 0.0, t));
+                if let Ok(x) = Point::edge_plane(p, q, plane) {
+                    break x;
+                }
+            };
+            let x = [crossing(), crossing(), crossing(), crossing()];
+            let before = exact_signs();
+            assert_eq!(orient3d_implicit(&x[0], &x[1], &x[2], &x[3]), 0);
+            undecided += exact_signs() - before;
+            // The plane's own points with the crossings: on it too.
+            let [a, b, c] = plane.map(Point::explicit);
+            assert_eq!(orient3d_implicit(&a, &b, &x[0], &x[1]), 0);
+            assert_eq!(orient3d_implicit(&a, &b, &c, &x[2]), 0);
+            assert_eq!(x[3].position().to_array(), rounded_exact(&x[3]));
+        }
+        assert!(undecided > 0);
     }
 
     #[test]

@@ -25,6 +25,7 @@ use std::borrow::Cow;
 use glam::DVec3;
 
 use super::Mesh;
+use crate::exact::lowest_bit;
 
 /// Query coordinates beyond this magnitude in the frame are taken at it.
 const FAR: f64 = 4294967296.0;
@@ -133,16 +134,6 @@ fn binary_exponent(x: f64) -> i32 {
     } else {
         biased - 1023
     }
-}
-
-/// The exponent of the lowest set bit of finite non-zero x.
-fn lowest_bit(x: f64) -> i32 {
-    let bits = x.abs().to_bits();
-    let biased = (bits >> 52) as i32;
-    let mantissa = bits & ((1 << 52) - 1);
-    let (mantissa, base) =
-        if biased == 0 { (mantissa, -1074) } else { (mantissa | (1 << 52), biased - 1075) };
-    base + mantissa.trailing_zeros() as i32
 }
 
 /// x · 2^e, in steps whose factors are normal f64 numbers; rounds only where the result
