@@ -1,5 +1,13 @@
 //! Triangle–triangle intersection of one candidate pair (§6.4): which part of t ∈ A
-//! meets u ∈ B, decided with exact predicates on the f64 inputs.
+//! meets u ∈ B, decided with exact predicates.
+//!
+//! The operands are [`Solid`]s: a file's mesh (every point an f64 input vertex: the
+//! predicates are the f64 ones, [`crate::exact`], as fast as they are) or the exact result
+//! of an earlier step ([`super::operand::ExactSolid`]), whose vertices may be implicit
+//! points. Then every decision is a predicate on implicit points
+//! ([`crate::exact::implicit`]): a triangle's plane is its *support* (the input triangle
+//! it is a piece of: explicit), its corners are the operand's points, and points along a
+//! segment are ordered by exact comparisons of one coordinate.
 //!
 //! A point where the two surfaces meet is named by the pair of smallest simplices that
 //! hold it, one of A (vertex, edge or triangle) and one of B: a [`Key`]. Keys are exact
@@ -15,9 +23,14 @@
 //! t is made of u's edges clipped to t (constraints for t) and within u of t's edges
 //! clipped to u (constraints for u).
 
+use std::borrow::Cow;
+use std::cmp::Ordering;
+
 use glam::{DVec2, DVec3};
 
-use crate::exact::implicit::Point;
+use super::operand::Solid;
+use super::refine::plane_axes;
+use crate::exact::implicit::{Definition, Point, compare_implicit, orient2d_implicit, orient3d_implicit};
 use crate::exact::{Sign, line_crossing, orient2d, orient3d};
 use crate::mesh::intersect::triangle_projection;
 
@@ -52,15 +65,32 @@ pub struct Key {
     pub b: Simplex,
 }
 
-/// The two input meshes as triangles over welded vertex ids.
-pub struct Operands<'a> {
-    pub a_positions: &'a [DVec3],
-    pub a_triangles: &'a [[u32; 3]],
-    pub b_positions: &'a [DVec3],
-    pub b_triangles: &'a [[u32; 3]],
+/// The two operands, triangles over welded vertex ids ([`Solid`]).
+pub struct Operands<'a, A: Solid, B: Solid> {
+    pub a: &'a A,
+    pub b: &'a B,
+    // Their triangles and positions (rounded where implicit), at hand for the f64 path.
+    a_positions: &'a [DVec3],
+    a_triangles: &'a [[u32; 3]],
+    b_positions: &'a [DVec3],
+    b_triangles: &'a [[u32; 3]],
 }
 
-impl Operands<'_> {
+impl<'a, A: Solid, B: Solid> Operands<'a, A, B> {
+    /// Both operands explicit: every decision is an f64 predicate on the positions.
+    const EXPLICIT: bool = A::EXPLICIT && B::EXPLICIT;
+
+    pub fn new(a: &'a A, b: &'a B) -> Operands<'a, A, B> {
+        Operands {
+            a,
+            b,
+            a_positions: a.rounded(),
+            a_triangles: a.triangles(),
+            b_positions: b.rounded(),
+            b_triangles: b.triangles(),
+        }
+    }
+
     fn a_tri(&self, t: u32) -> [DVec3; 3] {
         self.a_triangles[t as usize].map(|i| self.a_positions[i as usize])
     }
@@ -70,35 +100,91 @@ impl Operands<'_> {
     }
 }
 
+/// The input vertex a point is, if it is one.
+fn explicit(p: &Point) -> Option<DVec3> {
+    match *p.definition() {
+        Definition::Explicit(x) => Some(x),
+        _ => None,
+    }
+}
+
+/// Where the edge (p, q) of `own` crosses the support plane of triangle u of `other`: an
+/// input edge crossing an input plane when p and q are explicit, else the segment between
+/// the two points crossing it.
+fn edge_face<S: Solid, T: Solid>(own: &S, (p, q): (u32, u32), other: &T, u: u32) -> Option<Point> {
+    let plane = other.support(u);
+    if S::EXPLICIT {
+        let pos = own.rounded();
+        return Point::edge_plane(pos[p as usize], pos[q as usize], plane).ok();
+    }
+    let (p, q) = (own.point(p), own.point(q));
+    match (explicit(&p), explicit(&q)) {
+        (Some(x), Some(y)) => Point::edge_plane(x, y, plane).ok(),
+        _ => {
+            let [a, b, c] = plane.map(Point::explicit);
+            Point::segment_plane(&p, &q, [&a, &b, &c]).ok()
+        }
+    }
+}
+
+/// Where the coplanar input edges pq and rs cross. Any point off the two edges' plane
+/// names the crossing; one a unit step from p along an axis, the normal's largest
+/// component first.
+fn explicit_edge_edge(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Point> {
+    let n = (q - p).cross(s - r).abs();
+    let mut axes = [0, 1, 2];
+    axes.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
+    axes.into_iter().find_map(|k| {
+        let mut off = p;
+        off[k] += if p[k] > 0.0 { -1.0 } else { 1.0 };
+        Point::edge_edge(p, q, r, s, off).ok()
+    })
+}
+
+/// Where the coplanar segments pq and rs (points of any kind; `near`: p rounded) cross:
+/// pq against the plane through r, s and a point off their plane. Of `near` and its unit
+/// steps along the three axes (four points not in one plane) one is off it.
+fn segment_segment(p: &Point, q: &Point, r: &Point, s: &Point, near: DVec3) -> Option<Point> {
+    let steps = [0, 1, 2].map(|k| {
+        let mut off = near;
+        off[k] += if near[k] > 0.0 { -1.0 } else { 1.0 };
+        off
+    });
+    steps
+        .into_iter()
+        .chain([near])
+        .find_map(|off| Point::segment_segment(p, q, r, s, &Point::explicit(off)).ok())
+}
+
 impl Key {
     /// The point itself, from the key alone, as an implicit point
-    /// ([`crate::exact::implicit`]): an input vertex as it is, an edge crossing a
-    /// triangle's plane, or two coplanar edges crossing each other. Every predicate on it
-    /// is exact; `None` only for keys no pair produces (two faces), or inputs that are not
-    /// what the exact tests said.
-    pub fn point(&self, ops: &Operands) -> Option<Point> {
-        let (pa, pb) = (ops.a_positions, ops.b_positions);
+    /// ([`crate::exact::implicit`]): an operand's vertex as it is, an edge crossing a
+    /// triangle's support plane, or two coplanar edges crossing each other (input edges
+    /// and planes where the edge's ends are input vertices, else segments between the
+    /// operand's points). Every predicate on it is exact; `None` only for keys no pair
+    /// produces (two faces), or inputs that are not what the exact tests said.
+    pub fn point<A: Solid, B: Solid>(&self, ops: &Operands<A, B>) -> Option<Point> {
         match (self.a, self.b) {
-            (Simplex::Vertex(v), _) => Some(Point::explicit(pa[v as usize])),
-            (_, Simplex::Vertex(v)) => Some(Point::explicit(pb[v as usize])),
-            (Simplex::Edge(p, q), Simplex::Face(u)) => {
-                Point::edge_plane(pa[p as usize], pa[q as usize], ops.b_tri(u)).ok()
-            }
-            (Simplex::Face(t), Simplex::Edge(p, q)) => {
-                Point::edge_plane(pb[p as usize], pb[q as usize], ops.a_tri(t)).ok()
-            }
+            (Simplex::Vertex(v), _) => Some(ops.a.point(v).into_owned()),
+            (_, Simplex::Vertex(v)) => Some(ops.b.point(v).into_owned()),
+            (Simplex::Edge(p, q), Simplex::Face(u)) => edge_face(ops.a, (p, q), ops.b, u),
+            (Simplex::Face(t), Simplex::Edge(p, q)) => edge_face(ops.b, (p, q), ops.a, t),
             (Simplex::Edge(p, q), Simplex::Edge(r, s)) => {
-                let (p, q, r, s) = (pa[p as usize], pa[q as usize], pb[r as usize], pb[s as usize]);
-                // Any point off the two edges' plane names the crossing; one a unit step
-                // from p along an axis, the normal's largest component first.
-                let n = (q - p).cross(s - r).abs();
-                let mut axes = [0, 1, 2];
-                axes.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
-                axes.into_iter().find_map(|k| {
-                    let mut off = p;
-                    off[k] += if p[k] > 0.0 { -1.0 } else { 1.0 };
-                    Point::edge_edge(p, q, r, s, off).ok()
-                })
+                if Operands::<A, B>::EXPLICIT {
+                    let (pa, pb) = (ops.a_positions, ops.b_positions);
+                    return explicit_edge_edge(
+                        pa[p as usize],
+                        pa[q as usize],
+                        pb[r as usize],
+                        pb[s as usize],
+                    );
+                }
+                let near = ops.a.rounded()[p as usize];
+                let (p, q, r, s) = (ops.a.point(p), ops.a.point(q), ops.b.point(r), ops.b.point(s));
+                match [&p, &q, &r, &s].map(|x| explicit(x)) {
+                    [Some(p), Some(q), Some(r), Some(s)] => explicit_edge_edge(p, q, r, s),
+                    _ => segment_segment(&p, &q, &r, &s, near),
+                }
             }
             // Two triangles' interiors never hold an end of their intersection.
             (Simplex::Face(_), Simplex::Face(_)) => None,
@@ -107,7 +193,7 @@ impl Key {
 
     /// The point's coordinates rounded to f64 ([`Point::position`]), for output and
     /// pictures only; a key no pair produces gives the first corner of A's simplex.
-    pub fn position(&self, ops: &Operands) -> DVec3 {
+    pub fn position<A: Solid, B: Solid>(&self, ops: &Operands<A, B>) -> DVec3 {
         match self.point(ops) {
             Some(x) => x.position(),
             None => match self.a {
@@ -231,8 +317,14 @@ impl Ends {
     }
 }
 
-/// Decides how triangle t of A and triangle u of B meet (both non-degenerate).
-pub fn meet(ops: &Operands, t: u32, u: u32) -> Meeting {
+/// Decides how triangle t of A and triangle u of B meet (both non-degenerate): with f64
+/// predicates when both operands are explicit, else with predicates on their points.
+pub fn meet<A: Solid, B: Solid>(ops: &Operands<A, B>, t: u32, u: u32) -> Meeting {
+    if Operands::<A, B>::EXPLICIT { meet_explicit(ops, t, u) } else { meet_exact(ops, t, u) }
+}
+
+/// [`meet`] of explicit operands.
+fn meet_explicit<A: Solid, B: Solid>(ops: &Operands<A, B>, t: u32, u: u32) -> Meeting {
     let (ta, tb) = (ops.a_tri(t), ops.b_tri(u));
     let (ia, ib) = (ops.a_triangles[t as usize], ops.b_triangles[u as usize]);
     let sa = ta.map(|p| orient3d(tb[0], tb[1], tb[2], p));
@@ -255,7 +347,7 @@ pub fn meet(ops: &Operands, t: u32, u: u32) -> Meeting {
 
 /// The coplanar case: each triangle's edges clipped to the other, in t's projection
 /// (exact: all six points lie in one plane).
-fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
+fn coplanar<A: Solid, B: Solid>(ops: &Operands<A, B>, t: u32, u: u32) -> Meeting {
     let (ta, tb) = (ops.a_tri(t), ops.b_tri(u));
     let (ia, ib) = (ops.a_triangles[t as usize], ops.b_triangles[u as usize]);
     let Some(proj) = triangle_projection(ta[0], ta[1], ta[2]) else { return Meeting::Apart };
@@ -269,13 +361,13 @@ fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
     for k in 0..3 {
         let (j, l) = (k, (k + 1) % 3);
         let pts = clip((b2[j], b2[l]), (ib[j], ib[l]), (a2, ia, t), |own, other| Key { a: other, b: own });
-        emit(&pts, &mut in_a, &mut points);
+        emit(&pts, |x| x.1, &mut in_a, &mut points);
     }
     // t's edges clipped to u.
     for k in 0..3 {
         let (j, l) = (k, (k + 1) % 3);
         let pts = clip((a2[j], a2[l]), (ia[j], ia[l]), (b2, ib, u), |own, other| Key { a: own, b: other });
-        emit(&pts, &mut in_b, &mut points);
+        emit(&pts, |x| x.1, &mut in_b, &mut points);
     }
     if in_a.is_empty() && in_b.is_empty() && points.is_empty() {
         return Meeting::Apart;
@@ -283,12 +375,13 @@ fn coplanar(ops: &Operands, t: u32, u: u32) -> Meeting {
     Meeting::Coplanar { in_a, in_b, points, same }
 }
 
-/// Consecutive keys along a clipped edge become segments; a lone key is a point.
-fn emit(pts: &[(f64, Key)], segments: &mut Vec<[Key; 2]>, points: &mut Vec<Key>) {
+/// Consecutive keys along a clipped edge (`key` of each entry) become segments; a lone
+/// key is a point.
+fn emit<T>(pts: &[T], key: impl Fn(&T) -> Key, segments: &mut Vec<[Key; 2]>, points: &mut Vec<Key>) {
     match pts.len() {
         0 => {}
-        1 => points.push(pts[0].1),
-        _ => segments.extend(pts.windows(2).map(|w| [w[0].1, w[1].1])),
+        1 => points.push(key(&pts[0])),
+        _ => segments.extend(pts.windows(2).map(|w| [key(&w[0]), key(&w[1])])),
     }
 }
 
@@ -345,12 +438,284 @@ fn clip(
     pts
 }
 
+/// An axis along which point b differs from point a, and whether b is the greater there,
+/// decided exactly. `d`: b's rounded position minus a's ([`Point::position`], correctly
+/// rounded, or the input positions themselves). Rounding is monotone, so where the rounded
+/// coordinates differ the exact ones differ the same way: the largest difference serves;
+/// only ends that round to one position are compared exactly (`exact()` gives them).
+pub(super) fn separating_axis<'p>(
+    d: DVec3,
+    exact: impl FnOnce() -> (Cow<'p, Point>, Cow<'p, Point>),
+) -> Option<(usize, bool)> {
+    let axis = d.abs().max_position();
+    if d[axis] != 0.0 {
+        return Some((axis, d[axis] > 0.0));
+    }
+    let (a, b) = exact();
+    (0..3).find_map(|axis| match compare_implicit(axis, &a, &b) {
+        Ordering::Equal => None,
+        o => Some((axis, o == Ordering::Less)),
+    })
+}
+
+/// A triangle of an operand with implicit points: its corners, ids, index and support
+/// plane (explicit).
+struct ExactTriangle<'p> {
+    corners: [Cow<'p, Point>; 3],
+    /// The corners' rounded positions (for shapes and for choosing axes).
+    rounded: [DVec3; 3],
+    ids: [u32; 3],
+    face: u32,
+    support: [DVec3; 3],
+    plane: [Point; 3],
+}
+
+impl<'p> ExactTriangle<'p> {
+    fn of<S: Solid>(solid: &'p S, t: u32) -> ExactTriangle<'p> {
+        let ids = solid.triangles()[t as usize];
+        let support = solid.support(t);
+        ExactTriangle {
+            corners: ids.map(|i| solid.point(i)),
+            rounded: ids.map(|i| solid.rounded()[i as usize]),
+            ids,
+            face: t,
+            support,
+            plane: support.map(Point::explicit),
+        }
+    }
+
+    fn corner(&self, k: usize) -> &Point {
+        &self.corners[k]
+    }
+
+    fn corners(&self) -> [&Point; 3] {
+        [self.corner(0), self.corner(1), self.corner(2)]
+    }
+
+    /// The side of the support plane `x` lies on.
+    fn side(&self, x: &Point) -> Sign {
+        let [a, b, c] = &self.plane;
+        orient3d_implicit(a, b, c, x)
+    }
+}
+
+/// [`meet`] with predicates on the operands' points (one of them is not explicit).
+fn meet_exact<A: Solid, B: Solid>(ops: &Operands<A, B>, t: u32, u: u32) -> Meeting {
+    let (ta, tb) = (ExactTriangle::of(ops.a, t), ExactTriangle::of(ops.b, u));
+    let sa = [0, 1, 2].map(|k| tb.side(ta.corner(k)));
+    if sa == [1, 1, 1] || sa == [-1, -1, -1] {
+        return Meeting::Apart;
+    }
+    let sb = [0, 1, 2].map(|k| ta.side(tb.corner(k)));
+    if sb == [1, 1, 1] || sb == [-1, -1, -1] {
+        return Meeting::Apart;
+    }
+    if sa == [0, 0, 0] {
+        return coplanar_exact(&ta, &tb);
+    }
+    let mut ends = Ends::default();
+    ends.of_crossing_exact((&ta, sa), &tb, true);
+    ends.of_crossing_exact((&tb, sb), &ta, false);
+    ends.meeting()
+}
+
+/// [`locate_2d`] of implicit points, in the projection on `axes`.
+fn locate_2d_exact(
+    axes: [usize; 2],
+    tri: [&Point; 3],
+    ids: [u32; 3],
+    face: u32,
+    x: &Point,
+) -> Option<Simplex> {
+    let s = orient2d_implicit(axes, tri[0], tri[1], tri[2]);
+    let o = [0, 1, 2].map(|k| s * orient2d_implicit(axes, tri[k], tri[(k + 1) % 3], x));
+    if o.contains(&-1) {
+        return None;
+    }
+    Some(simplex_of_signs(o, ids, face))
+}
+
+/// [`locate_crossing`] of implicit points.
+fn locate_crossing_exact(p: &Point, q: &Point, tri: &ExactTriangle) -> Option<Simplex> {
+    let o = [0, 1, 2].map(|k| orient3d_implicit(p, q, tri.corner(k), tri.corner((k + 1) % 3)));
+    if o.contains(&1) && o.contains(&-1) {
+        return None;
+    }
+    Some(simplex_of_signs(o, tri.ids, tri.face))
+}
+
+impl Ends {
+    /// [`Ends::of_crossing`] with predicates on implicit points: the corners of `p` on the
+    /// support plane of `q` located in `q` (in the projection of that plane), `p`'s edges
+    /// crossing it located against `q`'s corners.
+    fn of_crossing_exact(
+        &mut self,
+        (p, signs): (&ExactTriangle, [Sign; 3]),
+        q: &ExactTriangle,
+        p_is_a: bool,
+    ) {
+        let key = |mine: Simplex, other: Simplex| {
+            if p_is_a { Key { a: mine, b: other } } else { Key { a: other, b: mine } }
+        };
+        for i in 0..3 {
+            let j = (i + 1) % 3;
+            if signs[i] == 0 {
+                if let Some(axes) = plane_axes(q.support) {
+                    if let Some(s) = locate_2d_exact(axes, q.corners(), q.ids, q.face, p.corner(i)) {
+                        self.push(key(Simplex::Vertex(p.ids[i]), s));
+                    }
+                }
+            } else if signs[i] * signs[j] < 0 {
+                if let Some(s) = locate_crossing_exact(p.corner(i), p.corner(j), q) {
+                    self.push(key(Simplex::edge(p.ids[i], p.ids[j]), s));
+                }
+            }
+        }
+    }
+}
+
+/// A point off the plane through `plane` (explicit, not on one line): a unit step from
+/// its first point along an axis (one of three steps leaves the plane).
+fn off_plane(plane: [DVec3; 3]) -> Option<Point> {
+    let [a, b, c] = plane;
+    (0..3).find_map(|k| {
+        let mut off = a;
+        off[k] += if a[k] > 0.0 { -1.0 } else { 1.0 };
+        (orient3d(a, b, c, off) != 0).then(|| Point::explicit(off))
+    })
+}
+
+/// [`coplanar`] with predicates on implicit points, in the projection of t's support
+/// plane (u's is the same plane: t's corners lie on it).
+fn coplanar_exact(ta: &ExactTriangle, tb: &ExactTriangle) -> Meeting {
+    let (Some(axes), Some(off)) = (plane_axes(ta.support), off_plane(ta.support)) else {
+        return Meeting::Apart;
+    };
+    let (a, b) = (ta.corners(), tb.corners());
+    let same = orient2d_implicit(axes, a[0], a[1], a[2]) == orient2d_implicit(axes, b[0], b[1], b[2]);
+    let mut in_a = Vec::new();
+    let mut in_b = Vec::new();
+    let mut points = Vec::new();
+    // u's edges clipped to t.
+    for k in 0..3 {
+        let (j, l) = (k, (k + 1) % 3);
+        let pts = clip_exact(
+            ([b[j], b[l]], [tb.ids[j], tb.ids[l]], tb.rounded[l] - tb.rounded[j]),
+            (a, ta.ids, ta.face),
+            (axes, &off),
+            |own, other| Key { a: other, b: own },
+        );
+        emit(&pts, |x| x.1, &mut in_a, &mut points);
+    }
+    // t's edges clipped to u.
+    for k in 0..3 {
+        let (j, l) = (k, (k + 1) % 3);
+        let pts = clip_exact(
+            ([a[j], a[l]], [ta.ids[j], ta.ids[l]], ta.rounded[l] - ta.rounded[j]),
+            (b, tb.ids, tb.face),
+            (axes, &off),
+            |own, other| Key { a: own, b: other },
+        );
+        emit(&pts, |x| x.1, &mut in_b, &mut points);
+    }
+    if in_a.is_empty() && in_b.is_empty() && points.is_empty() {
+        return Meeting::Apart;
+    }
+    Meeting::Coplanar { in_a, in_b, points, same }
+}
+
+/// [`clip`] of implicit points: the keys of the points of segment pr (ids, and `d` = r − p
+/// rounded) that lie in the coplanar triangle `tri`, sorted along pr, in the projection on
+/// `axes`. They are ordered by exact comparisons of their coordinate along an axis where
+/// p and r differ (all lie on pr); a crossing of pr with an edge of `tri` is made for
+/// that as the segments' crossing (`off`: a point off their plane).
+#[allow(clippy::type_complexity)]
+fn clip_exact<'p>(
+    ([p, r], [ip, ir], d): ([&'p Point; 2], [u32; 2], DVec3),
+    (tri, tid, face): ([&'p Point; 3], [u32; 3], u32),
+    (axes, off): ([usize; 2], &Point),
+    key: impl Fn(Simplex, Simplex) -> Key,
+) -> Vec<(Cow<'p, Point>, Key)> {
+    let mut pts: Vec<(Cow<'p, Point>, Key)> = Vec::with_capacity(3);
+    let Some((axis, forward)) = separating_axis(d, || (Cow::Borrowed(p), Cow::Borrowed(r))) else {
+        return pts;
+    };
+    let order = |x: &Point, y: &Point| {
+        let o = compare_implicit(axis, x, y);
+        if forward { o } else { o.reverse() }
+    };
+    let mut push = |x: Cow<'p, Point>, k: Key| {
+        if !pts.iter().any(|(_, y)| *y == k) {
+            pts.push((x, k));
+        }
+    };
+    if let Some(s) = locate_2d_exact(axes, tri, tid, face, p) {
+        push(Cow::Borrowed(p), key(Simplex::Vertex(ip), s));
+    }
+    if let Some(s) = locate_2d_exact(axes, tri, tid, face, r) {
+        push(Cow::Borrowed(r), key(Simplex::Vertex(ir), s));
+    }
+    let own_edge = Simplex::edge(ip, ir);
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        let oa = orient2d_implicit(axes, p, r, a);
+        let ob = orient2d_implicit(axes, p, r, b);
+        let op = orient2d_implicit(axes, a, b, p);
+        let or = orient2d_implicit(axes, a, b, r);
+        if oa * ob < 0 && op * or < 0 {
+            // Proper crossing of the two edges' interiors: coplanar, strictly crossing, and
+            // `off` is off their plane, so the crossing exists.
+            let x = Point::segment_segment(p, r, a, b, off)
+                .unwrap_or_else(|e| unreachable!("properly crossing coplanar segments: {e}"));
+            push(Cow::Owned(x), key(own_edge, Simplex::edge(tid[k], tid[(k + 1) % 3])));
+        }
+        // A corner of the triangle on the segment's interior.
+        for (o, v, id) in [(oa, a, tid[k]), (ob, b, tid[(k + 1) % 3])] {
+            if o == 0 && order(p, v) == Ordering::Less && order(v, r) == Ordering::Less {
+                push(Cow::Borrowed(v), key(own_edge, Simplex::Vertex(id)));
+            }
+        }
+    }
+    pts.sort_by(|x, y| order(&x.0, &y.0));
+    pts
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boolean::operand::ExactSolid;
+    use crate::mesh::intersect::TriangleSoup;
 
-    fn ops<'a>(pa: &'a [DVec3], ta: &'a [[u32; 3]], pb: &'a [DVec3], tb: &'a [[u32; 3]]) -> Operands<'a> {
-        Operands { a_positions: pa, a_triangles: ta, b_positions: pb, b_triangles: tb }
+    fn soup(positions: &[DVec3], triangles: &[[u32; 3]]) -> TriangleSoup {
+        let face_of = (0..triangles.len() as u32).collect();
+        TriangleSoup {
+            positions: positions.to_vec(),
+            triangles: triangles.to_vec(),
+            face_of,
+            failed: Vec::new(),
+        }
+    }
+
+    /// The pair's meeting is the same when the operands are taken as exact ones (all
+    /// their points explicit), mixed or both; so are its points.
+    fn same_with_exact_points(sa: &TriangleSoup, sb: &TriangleSoup) {
+        let (ea, eb) = (ExactSolid::from_soup(sa), ExactSolid::from_soup(sb));
+        let m = meet(&Operands::new(sa, sb), 0, 0);
+        assert_eq!(meet(&Operands::new(&ea, sb), 0, 0), m);
+        assert_eq!(meet(&Operands::new(sa, &eb), 0, 0), m);
+        assert_eq!(meet(&Operands::new(&ea, &eb), 0, 0), m);
+        let keys: Vec<Key> = match m {
+            Meeting::Apart => Vec::new(),
+            Meeting::Point(k) => vec![k],
+            Meeting::Segment(s) => s.to_vec(),
+            Meeting::Coplanar { in_a, in_b, points, .. } => {
+                in_a.iter().chain(&in_b).flatten().chain(&points).copied().collect()
+            }
+        };
+        for k in keys {
+            let x = k.point(&Operands::new(sa, sb)).unwrap();
+            assert_eq!(k.point(&Operands::new(&ea, &eb)).unwrap().definition(), x.definition());
+        }
     }
 
     #[test]
@@ -358,7 +723,9 @@ mod tests {
         let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(4.0, 0.0, 0.0), DVec3::new(0.0, 4.0, 0.0)];
         let pb = [DVec3::new(1.0, 1.0, -1.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(1.0, 9.0, 0.0)];
         let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
-        let o = ops(&pa, &ta, &pb, &tb);
+        let (sa, sb) = (soup(&pa, &ta), soup(&pb, &tb));
+        let o = Operands::new(&sa, &sb);
+        same_with_exact_points(&sa, &sb);
         let m = meet(&o, 0, 0);
         let Meeting::Segment(keys) = m else { panic!("{m:?}") };
         // One end: B's edge 0–1 pierces t's interior; the other: t's edge 2–0 (x = 0)? No:
@@ -379,7 +746,9 @@ mod tests {
         let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0)];
         let pb = [DVec3::new(1.0, -1.0, 0.0), DVec3::new(1.0, 3.0, 0.0), DVec3::new(-1.0, 1.0, 0.0)];
         let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
-        let o = ops(&pa, &ta, &pb, &tb);
+        let (sa, sb) = (soup(&pa, &ta), soup(&pb, &tb));
+        let o = Operands::new(&sa, &sb);
+        same_with_exact_points(&sa, &sb);
         let Meeting::Coplanar { in_a, in_b, same, .. } = meet(&o, 0, 0) else { panic!() };
         assert!(same);
         // B's edge 0–1 (x = 1) crosses t from (1, 0) to (1, 1).
@@ -397,7 +766,9 @@ mod tests {
         let pa = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0)];
         let pb = [DVec3::new(0.5, 0.5, 0.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(0.0, 1.0, 1.0)];
         let (ta, tb) = ([[0, 1, 2]], [[0, 1, 2]]);
-        let o = ops(&pa, &ta, &pb, &tb);
+        let (sa, sb) = (soup(&pa, &ta), soup(&pb, &tb));
+        let o = Operands::new(&sa, &sb);
+        same_with_exact_points(&sa, &sb);
         assert_eq!(meet(&o, 0, 0), Meeting::Point(Key { a: Simplex::Face(0), b: Simplex::Vertex(0) }));
     }
 }

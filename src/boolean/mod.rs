@@ -51,6 +51,7 @@ use crate::mesh::Mesh;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
 use crate::mesh::solidity::{Memory, Solidity};
+use operand::ExactSolid;
 
 pub mod cgal;
 pub mod classify;
@@ -382,6 +383,16 @@ impl Evaluation {
             }
         });
         v.scaled(|x| self.frame.volume_out(x))
+    }
+
+    /// The exact result of `op`, in the operands' frame, as an operand for a further step:
+    /// the selected triangles over the exact points, nothing rounded
+    /// ([`select::assemble_exact`]).
+    pub fn exact_result(&self, op: Operation, regularized: bool) -> ExactSolid {
+        let (r, c) = (&self.refinement, &self.classification);
+        let (tris, _) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
+        let support = select::selected_supports(op, regularized, r, (&self.a, &c.a), (&self.b, &c.b));
+        select::assemble_exact(r, &tris, support)
     }
 
     /// [`Evaluation::output`] in the operands' frame (a power-of-two scale: the rounding,

@@ -77,6 +77,11 @@ pub trait Solid: Sync {
     fn support(&self, t: u32) -> [DVec3; 3];
     /// Per triangle, a box that certainly holds it.
     fn boxes(&self) -> Vec<(DVec3, DVec3)>;
+    /// The number messages give triangle `t`: the file's face it comes from, or the
+    /// triangle itself for an exact result.
+    fn face(&self, t: u32) -> u32 {
+        t
+    }
 }
 
 impl Solid for TriangleSoup {
@@ -95,6 +100,9 @@ impl Solid for TriangleSoup {
     }
     fn boxes(&self) -> Vec<(DVec3, DVec3)> {
         TriangleSoup::boxes(self)
+    }
+    fn face(&self, t: u32) -> u32 {
+        self.face_of[t as usize]
     }
 }
 

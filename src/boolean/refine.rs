@@ -1,17 +1,26 @@
 //! Mesh refinement (§6.4): after it, every triangle of A lies wholly inside, outside or
 //! on B, and vice versa.
 //!
-//! 1. Candidate pairs from the shared index ([`super::index`]); each pair decided
-//!    exactly ([`super::intersect::meet`]).
+//! The operands are [`Solid`]s: a file's mesh (every vertex an f64 input point) or the
+//! exact result of an earlier step ([`super::operand::ExactSolid`]: vertices that may be
+//! implicit points, every triangle in the plane of an input triangle, its support). The
+//! refinement of two file meshes decides with f64 predicates where it can, as before; with
+//! an exact operand every decision is a predicate on implicit points, and a step's result
+//! is again an exact operand ([`super::select::assemble_exact`]).
+//!
+//! 1. Candidate pairs from the shared index ([`super::index`], boxes that certainly hold
+//!    the triangles); each pair decided exactly ([`super::intersect::meet`]).
 //! 2. Every intersection point, named by its [`Key`], gets one id, shared by A and B,
-//!    and is kept *implicit* ([`crate::exact::implicit`]): an input edge crossing an
-//!    input triangle's plane, or two coplanar input edges crossing, never rounded while
-//!    the refinement and the classification decide anything on it (its rounded position
-//!    is for the output only). Ids: A's vertices first, then B's, then the new points; a
-//!    vertex of B exactly at a vertex of A takes A's id.
+//!    and is kept *implicit* ([`crate::exact::implicit`]): an edge crossing a triangle's
+//!    support plane, or two coplanar edges crossing (input edges where their ends are
+//!    input vertices, else segments between implicit points), never rounded while the
+//!    refinement and the classification decide anything on it (its rounded position is
+//!    for the output only). Ids: A's vertices first, then B's, then the new points; a
+//!    vertex of B exactly at a vertex of A takes A's id (keys are exact, so that is where
+//!    a key names both vertices).
 //! 3. Each cut triangle — one that has points on its edges or inside, or intersection
-//!    segments — is re-triangulated in its own plane ([`crate::mesh::constrained`]), every
-//!    decision an exact orientation of implicit points in the triangle's axis-aligned
+//!    segments — is re-triangulated in its support plane ([`crate::mesh::constrained`]),
+//!    every decision an exact orientation of implicit points in the plane's axis-aligned
 //!    projection: its corners and the points on its edges (in their exact order along
 //!    the edge, shared with the neighbour across it) form the outline, points inside are
 //!    inserted, intersection segments are constraints, so the cut curve appears as edges
@@ -26,11 +35,11 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::index::candidate_pairs;
-use super::intersect::{Key, Meeting, Operands, Simplex, meet};
+use super::intersect::{Key, Meeting, Operands, Simplex, meet, separating_axis};
+use super::operand::Solid;
 use crate::exact::implicit::{self, Point, compare_implicit, orient2d_implicit};
 use crate::exact::orient2d;
 use crate::mesh::constrained::{self, Constrained, ConstrainedError};
-use crate::mesh::intersect::TriangleSoup;
 
 /// Which operand.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -66,9 +75,10 @@ pub enum RefineError {
 pub struct Refined {
     /// Triangles over the refinement's point ids, oriented like their parents.
     pub triangles: Vec<[u32; 3]>,
-    /// The input triangle (of the operand's [`TriangleSoup`]) each one comes from.
+    /// The operand's triangle each one comes from (its parent: a piece of it, in its
+    /// support plane).
     pub parent: Vec<u32>,
-    /// Per input triangle: true when it was cut and re-triangulated.
+    /// Per operand triangle: true when it was cut and re-triangulated.
     pub cut: Vec<bool>,
 }
 
@@ -98,8 +108,12 @@ pub struct RefineStats {
 #[derive(Clone, Debug, Default)]
 pub struct Refinement {
     /// All points: A's positions, then B's, then the new intersection points rounded to
-    /// f64 (for the output: decisions use [`Refinement::point`]).
+    /// f64 (an operand's implicit vertices rounded too: for the output and shapes,
+    /// decisions use [`Refinement::point`]).
     pub points: Vec<DVec3>,
+    /// A's and B's vertices exactly, for an operand that is not explicit ([`Solid`]);
+    /// empty for a file operand (its vertices are its positions in `points`).
+    pub vertices: [Vec<Point>; 2],
     /// The new intersection points, exactly: point id `first_new + k` is `implicit[k]`,
     /// named by `new_keys[k]`.
     pub implicit: Vec<Point>,
@@ -135,9 +149,10 @@ impl Refinement {
         self.cut_edges.binary_search(&edge_key(a, b)).is_ok()
     }
 
-    /// Point `id` exactly: an input vertex or an implicit intersection point.
+    /// Point `id` exactly: an operand's vertex or an implicit intersection point.
     pub fn point(&self, id: u32) -> Cow<'_, Point> {
-        point_of(&self.points, self.first_new, &self.implicit, id)
+        let vertices = [&self.vertices[0][..], &self.vertices[1][..]];
+        point_of(&self.points, (self.b_offset, self.first_new), vertices, &self.implicit, id)
     }
 
     /// The key of point `id` when it lies on both surfaces (a new point, or an input
@@ -157,12 +172,23 @@ impl Refinement {
     }
 }
 
-/// Point `id` of `points` (ids from `first` on: `implicit`) as an exact point.
-fn point_of<'a>(points: &[DVec3], first: u32, implicit: &'a [Point], id: u32) -> Cow<'a, Point> {
-    if id < first {
-        Cow::Owned(Point::explicit(points[id as usize]))
-    } else {
-        Cow::Borrowed(&implicit[(id - first) as usize])
+/// Point `id` of `points` as an exact point: ids below `b_offset` are A's vertices, then
+/// B's up to `first`, then the `implicit` ones; an operand's vertices are its `vertices`
+/// where given (not explicit), else explicit at their positions.
+fn point_of<'a>(
+    points: &[DVec3],
+    (b_offset, first): (u32, u32),
+    vertices: [&'a [Point]; 2],
+    implicit: &'a [Point],
+    id: u32,
+) -> Cow<'a, Point> {
+    if id >= first {
+        return Cow::Borrowed(&implicit[(id - first) as usize]);
+    }
+    let (list, k) = if id < b_offset { (vertices[0], id) } else { (vertices[1], id - b_offset) };
+    match list.get(k as usize) {
+        Some(p) => Cow::Borrowed(p),
+        None => Cow::Owned(Point::explicit(points[id as usize])),
     }
 }
 
@@ -189,13 +215,14 @@ impl EdgePoints {
     }
 
     /// From (edge, point id) entries: the points of each edge in their exact order from
-    /// its lower vertex id to the higher (`positions`: the mesh's vertices; `point`: a
-    /// point id's exact point).
-    fn build<'p>(
+    /// its lower vertex id to the higher (`mesh`: the operand, whose vertices end the
+    /// edges; `point`: a point id's exact point).
+    fn build<'p, S: Solid>(
         mut entries: Vec<((u32, u32), u32)>,
-        positions: &[DVec3],
+        mesh: &'p S,
         point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
     ) -> EdgePoints {
+        let positions = mesh.rounded();
         entries.par_sort_unstable();
         let mut e =
             EdgePoints { edges: Vec::new(), starts: Vec::new(), ids: Vec::with_capacity(entries.len()) };
@@ -208,7 +235,8 @@ impl EdgePoints {
         }
         e.starts.push(e.ids.len() as u32);
         // Every point lies exactly on its edge's line: their order along the edge is their
-        // order along the axis where the edge is longest.
+        // order along an axis where its ends differ (the longest, unless implicit ends
+        // round to one position: see `separating_axis`).
         let mut runs: Vec<&mut [u32]> = Vec::with_capacity(e.edges.len());
         let mut rest: &mut [u32] = &mut e.ids;
         for w in e.starts.windows(2) {
@@ -221,8 +249,9 @@ impl EdgePoints {
                 return;
             }
             let d = positions[q as usize] - positions[p as usize];
-            let axis = d.abs().max_position();
-            let forward = d[axis] > 0.0;
+            let Some((axis, forward)) = separating_axis(d, || (mesh.point(p), mesh.point(q))) else {
+                unreachable!("an edge's ends are distinct points")
+            };
             let exact: Vec<(u32, Cow<'p, Point>)> = run.iter().map(|&id| (id, point(id))).collect();
             let mut order: Vec<usize> = (0..run.len()).collect();
             order.sort_by(|&i, &j| {
@@ -241,17 +270,12 @@ impl EdgePoints {
 /// (step 1), one id per intersection key (step 2) and its exact point, the points on
 /// each mesh's edges and inside its triangles, the segments per triangle and the cut
 /// curve, then each side re-triangulated.
-pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineError> {
+pub fn refine<A: Solid, B: Solid>(a: &A, b: &B) -> Result<Refinement, RefineError> {
     let exact_before = implicit::exact_signs();
-    let ops = Operands {
-        a_positions: &a.positions,
-        a_triangles: &a.triangles,
-        b_positions: &b.positions,
-        b_triangles: &b.triangles,
-    };
-    let (meetings, mut stats) = meetings(&ops, a, b);
+    let ops = Operands::new(a, b);
+    let (meetings, mut stats) = meetings(&ops);
     let keys = meeting_keys(&meetings);
-    let (na, nb) = (a.positions.len() as u32, b.positions.len() as u32);
+    let (na, nb) = (a.rounded().len() as u32, b.rounded().len() as u32);
     let KeyIds { ids, new_keys, vertex_keys, b_alias } = KeyIds::assign(&keys, na, nb);
     // B's welded ids → point ids (aliased onto A's coincident vertices).
     let b_id = |v: u32| b_alias[v as usize];
@@ -259,27 +283,29 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     let implicit = implicit_points(&ops, &new_keys)?;
     stats.new_points = implicit.len();
     let mut points = Vec::with_capacity(first as usize + implicit.len());
-    points.extend_from_slice(&a.positions);
-    points.extend_from_slice(&b.positions);
+    points.extend_from_slice(a.rounded());
+    points.extend_from_slice(b.rounded());
     let roundings_before = implicit::exact_roundings();
     points.par_extend(implicit.par_iter().with_min_len(256).map(Point::position));
     stats.exact_roundings = implicit::exact_roundings() - roundings_before;
-    let point = |id: u32| point_of(&points, first, &implicit, id);
+    let vertices = [exact_vertices(a), exact_vertices(b)];
+    let vertex_lists = [&vertices[0][..], &vertices[1][..]];
+    let point = |id: u32| point_of(&points, (na, first), vertex_lists, &implicit, id);
 
     // Points on edges and inside triangles, per mesh: exactly where their keys say.
     let (a_edge_entries, a_inside) = on_simplices(&keys, &ids, |k| k.a);
     let (b_edge_entries, b_inside) = on_simplices(&keys, &ids, |k| k.b);
     let (a_edges, b_edges) = rayon::join(
-        || EdgePoints::build(a_edge_entries, &a.positions, &point),
-        || EdgePoints::build(b_edge_entries, &b.positions, &point),
+        || EdgePoints::build(a_edge_entries, a, &point),
+        || EdgePoints::build(b_edge_entries, b, &point),
     );
     let id_of =
         |k: &Key| ids[keys.binary_search(k).unwrap_or_else(|_| unreachable!("every key was collected"))];
     let (a_segments, b_segments, coplanar) = segments(meetings);
     let curve = cut_curve(&a_segments, &b_segments, &id_of);
 
-    let a_input = SideInput { side: Side::A, soup: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
-    let b_input = SideInput { side: Side::B, soup: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
+    let a_input = SideInput { side: Side::A, mesh: a, vertex_id: &|v| v, edges: &a_edges, inside: &a_inside };
+    let b_input = SideInput { side: Side::B, mesh: b, vertex_id: &b_id, edges: &b_edges, inside: &b_inside };
     let ((ra, cut_a), (rb, cut_b)) = rayon::join(
         || refine_side(&a_input, a_segments, &points, &point, &id_of),
         || refine_side(&b_input, b_segments, &points, &point, &id_of),
@@ -294,6 +320,7 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     stats.exact_signs = implicit::exact_signs() - exact_before;
     Ok(Refinement {
         points,
+        vertices,
         implicit,
         new_keys,
         first_new: first,
@@ -308,10 +335,23 @@ pub fn refine(a: &TriangleSoup, b: &TriangleSoup) -> Result<Refinement, RefineEr
     })
 }
 
+/// An operand's vertices as exact points when it is not explicit (none for a file
+/// operand: its positions are its points).
+fn exact_vertices<S: Solid>(mesh: &S) -> Vec<Point> {
+    if S::EXPLICIT {
+        return Vec::new();
+    }
+    (0..mesh.rounded().len() as u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|v| mesh.point(v).into_owned())
+        .collect()
+}
+
 /// Step 1: the candidate pairs of A's and B's triangles (boxes that meet) and how each
 /// pair that does meet meets; the statistics counted so far.
-fn meetings(ops: &Operands, a: &TriangleSoup, b: &TriangleSoup) -> (Vec<(u32, u32, Meeting)>, RefineStats) {
-    let (a_boxes, b_boxes) = rayon::join(|| a.boxes(), || b.boxes());
+fn meetings<A: Solid, B: Solid>(ops: &Operands<A, B>) -> (Vec<(u32, u32, Meeting)>, RefineStats) {
+    let (a_boxes, b_boxes) = rayon::join(|| ops.a.boxes(), || ops.b.boxes());
     let pairs = candidate_pairs(&a_boxes, &b_boxes);
     let meetings: Vec<(u32, u32, Meeting)> = pairs
         .par_iter()
@@ -395,7 +435,10 @@ impl KeyIds {
 }
 
 /// The exact point of every new key.
-fn implicit_points(ops: &Operands, new_keys: &[Key]) -> Result<Vec<Point>, RefineError> {
+fn implicit_points<A: Solid, B: Solid>(
+    ops: &Operands<A, B>,
+    new_keys: &[Key],
+) -> Result<Vec<Point>, RefineError> {
     let implicit: Vec<Option<Point>> = new_keys.par_iter().with_min_len(256).map(|k| k.point(ops)).collect();
     if let Some(k) = implicit.iter().position(Option::is_none) {
         return Err(RefineError::Point { key: new_keys[k] });
@@ -495,9 +538,9 @@ impl Chain<'_> {
 }
 
 /// What refining one side needs to know about it.
-struct SideInput<'a> {
+struct SideInput<'a, S: Solid> {
     side: Side,
-    soup: &'a TriangleSoup,
+    mesh: &'a S,
     /// Welded vertex id → point id.
     vertex_id: &'a (dyn Fn(u32) -> u32 + Sync),
     edges: &'a EdgePoints,
@@ -507,8 +550,8 @@ struct SideInput<'a> {
 
 /// Re-triangulates the cut triangles of one side. Returns the refined mesh and the cut
 /// edges found on this side.
-fn refine_side<'p>(
-    input: &SideInput,
+fn refine_side<'p, S: Solid>(
+    input: &SideInput<S>,
     segments: Vec<TriangleSegment>,
     points: &[DVec3],
     point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
@@ -521,8 +564,8 @@ fn refine_side<'p>(
         .par_iter()
         .with_min_len(16)
         .map(|&t| {
-            let soup = input.soup;
-            let tri = soup.triangles[t as usize];
+            let mesh = input.mesh;
+            let tri = mesh.triangles()[t as usize];
             let corners = tri.map(|v| (input.vertex_id)(v));
             let chains = [0, 1, 2].map(|e| {
                 let (p, q) = (tri[e], tri[(e + 1) % 3]);
@@ -535,12 +578,13 @@ fn refine_side<'p>(
                 .collect();
             cons.sort_unstable();
             cons.dedup();
-            retriangulate(soup.triangle(t as usize), corners, chains, &inside, &cons, points, point)
+            let shape = Shape { support: mesh.support(t), rounded: tri.map(|v| mesh.rounded()[v as usize]) };
+            retriangulate(shape, corners, chains, &inside, &cons, points, point)
                 .map(|pieces| (t, pieces))
                 .map_err(|(reason, near)| RefineError::Triangulate {
                     side: input.side,
                     triangle: t,
-                    face: soup.face_of[t as usize],
+                    face: mesh.face(t),
                     near,
                     reason,
                 })
@@ -559,17 +603,17 @@ fn run_of<T>(list: &[(u32, T)], t: u32) -> std::ops::Range<usize> {
 
 /// The segments of one side as constraints (point id pairs) per triangle, sorted by
 /// triangle, and the pieces of the triangles' edges that segments run along (as edge keys).
-fn constraints_and_edge_pieces(
-    input: &SideInput,
+fn constraints_and_edge_pieces<S: Solid>(
+    input: &SideInput<S>,
     mut segments: Vec<TriangleSegment>,
     id_of: &(dyn Fn(&Key) -> u32 + Sync),
 ) -> (Vec<(u32, [u32; 2])>, Vec<u64>) {
-    let soup = input.soup;
+    let triangles = input.mesh.triangles();
     segments.par_sort_unstable_by_key(|s| s.triangle);
     let mut constraints: Vec<(u32, [u32; 2])> = Vec::with_capacity(segments.len());
     let mut cut_edges: Vec<u64> = Vec::new();
     for s in &segments {
-        let tri = soup.triangles[s.triangle as usize];
+        let tri = triangles[s.triangle as usize];
         let (i0, i1) = (id_of(&s.ends[0]), id_of(&s.ends[1]));
         if i0 == i1 {
             continue;
@@ -606,19 +650,19 @@ fn constraints_and_edge_pieces(
 
 /// Which triangles are cut: points inside, constraints, or points on an edge. Only edges
 /// between two vertices that end an edge with points are looked up.
-fn cut_triangles(input: &SideInput, constraints: &[(u32, [u32; 2])]) -> Vec<bool> {
-    let soup = input.soup;
-    let mut ends = vec![false; soup.positions.len()];
+fn cut_triangles<S: Solid>(input: &SideInput<S>, constraints: &[(u32, [u32; 2])]) -> Vec<bool> {
+    let triangles = input.mesh.triangles();
+    let mut ends = vec![false; input.mesh.rounded().len()];
     for &(p, q) in &input.edges.edges {
         ends[p as usize] = true;
         ends[q as usize] = true;
     }
-    let mut cut = vec![false; soup.triangles.len()];
+    let mut cut = vec![false; triangles.len()];
     for t in input.inside.iter().map(|x| x.0).chain(constraints.iter().map(|x| x.0)) {
         cut[t as usize] = true;
     }
     cut.par_iter_mut().with_min_len(4096).enumerate().for_each(|(t, c)| {
-        let tri = soup.triangles[t];
+        let tri = triangles[t];
         *c = *c
             || (0..3).any(|e| {
                 let (p, q) = (tri[e], tri[(e + 1) % 3]);
@@ -630,14 +674,14 @@ fn cut_triangles(input: &SideInput, constraints: &[(u32, [u32; 2])]) -> Vec<bool
 
 /// The side's triangles in order: each cut one replaced by its pieces (whose segment edges
 /// join `cut_edges`), the others kept with their welded corners.
-fn assemble_side(
-    input: &SideInput,
+fn assemble_side<S: Solid>(
+    input: &SideInput<S>,
     cut: Vec<bool>,
     pieces: Vec<Result<(u32, Constrained), RefineError>>,
     cut_edges: &mut Vec<u64>,
 ) -> Result<Refined, RefineError> {
-    let soup = input.soup;
-    let n = soup.triangles.len();
+    let triangles = input.mesh.triangles();
+    let n = triangles.len();
     let extra = 4 * (pieces.len());
     let mut refined = Refined {
         triangles: Vec::with_capacity(n + extra),
@@ -658,7 +702,7 @@ fn assemble_side(
             }
             cut_edges.extend(next.1.segment_edges.iter().map(|&[x, y]| edge_key(x, y)));
         } else {
-            refined.triangles.push(soup.triangles[t as usize].map(|v| (input.vertex_id)(v)));
+            refined.triangles.push(triangles[t as usize].map(|v| (input.vertex_id)(v)));
             refined.parent.push(t);
         }
     }
@@ -685,15 +729,23 @@ pub fn plane_axes(tri: [DVec3; 3]) -> Option<[usize; 2]> {
     })
 }
 
-/// Re-triangulates one cut triangle (corners `pos`, point ids `corners`): outline =
-/// corners and the points on each edge (`chains[e]`: the points of edge e in increasing
+/// A cut triangle's plane and rounded corners.
+struct Shape {
+    /// The input triangle whose plane holds it, oriented like it (explicit).
+    support: [DVec3; 3],
+    /// Its corners rounded (for messages).
+    rounded: [DVec3; 3],
+}
+
+/// Re-triangulates one cut triangle (`shape`, point ids `corners`): outline = corners
+/// and the points on each edge (`chains[e]`: the points of edge e in increasing
 /// vertex-id order, and whether that runs against the triangle's direction), plus
 /// interior points and constraints. Every decision is an exact orientation of the exact
-/// points (`point`) in the axis-aligned projection that keeps the triangle
-/// counter-clockwise; the rounded `points` only shape the triangles. Returns the pieces
-/// over point ids.
+/// points (`point`) in the axis-aligned projection that keeps the support plane (and so
+/// the triangle) counter-clockwise; the rounded `points` only shape the triangles.
+/// Returns the pieces over point ids.
 fn retriangulate<'p>(
-    pos: [DVec3; 3],
+    shape: Shape,
     corners: [u32; 3],
     chains: [(&[u32], bool); 3],
     inside: &[u32],
@@ -701,6 +753,7 @@ fn retriangulate<'p>(
     points: &[DVec3],
     point: &(dyn Fn(u32) -> Cow<'p, Point> + Sync),
 ) -> Result<Constrained, (ConstrainedError, DVec3)> {
+    let pos = shape.rounded;
     let near = (pos[0] + pos[1] + pos[2]) / 3.0;
     let mut ids: Vec<u32> = Vec::with_capacity(8 + inside.len());
     // Per point, the triangle's edges it lies on (bit e: edge e, from corner e to e + 1):
@@ -722,7 +775,7 @@ fn retriangulate<'p>(
         Ok(i) => (&*exact[i].1, exact[i].2),
         Err(_) => unreachable!("every point of the triangle is listed"),
     };
-    let axes = plane_axes(pos).ok_or((ConstrainedError::Corners, near))?;
+    let axes = plane_axes(shape.support).ok_or((ConstrainedError::Corners, near))?;
     let orient = |a: u32, b: u32, c: u32| {
         let ((pa, ma), (pb, mb), (pc, mc)) = (get(a), get(b), get(c));
         if ma & mb & mc != 0 { 0 } else { orient2d_implicit(axes, pa, pb, pc) }
@@ -732,4 +785,114 @@ fn retriangulate<'p>(
         DVec2::new(p[axes[0]], p[axes[1]])
     };
     constrained::triangulate(corners, &ids, constraints, orient, at).map_err(|e| (e, near))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boolean::operand::ExactSolid;
+    use crate::boolean::{Names, Operation, Options, Transform, evaluate};
+    use crate::exact::implicit::{Definition, orient3d_implicit};
+    use crate::mesh::Mesh;
+    use crate::mesh::intersect::TriangleSoup;
+    use crate::mesh::procedural;
+
+    fn moved(mesh: &Mesh, steps: &str) -> Mesh {
+        Transform::parse(steps).unwrap().apply(mesh).unwrap()
+    }
+
+    /// Everything both refinements hold is the same: ids, triangles, rounded points, keys,
+    /// the points' definitions.
+    fn assert_same(x: &Refinement, y: &Refinement) {
+        assert_eq!(x.points, y.points);
+        assert_eq!(x.new_keys, y.new_keys);
+        assert_eq!(
+            x.implicit.iter().map(Point::definition).collect::<Vec<_>>(),
+            y.implicit.iter().map(Point::definition).collect::<Vec<_>>()
+        );
+        assert_eq!((x.first_new, x.b_offset), (y.first_new, y.b_offset));
+        assert_eq!(x.vertex_keys, y.vertex_keys);
+        for (p, q) in [(&x.a, &y.a), (&x.b, &y.b)] {
+            assert_eq!((&p.triangles, &p.parent, &p.cut), (&q.triangles, &q.parent, &q.cut));
+        }
+        assert_eq!((&x.cut_edges, &x.curve, &x.coplanar), (&y.cut_edges, &y.curve, &y.coplanar));
+    }
+
+    /// An exact operand whose points are all input vertices refines as the file operand
+    /// does, on either side: a cube against its exact 90° copy (coplanar faces) and against
+    /// a generic turn.
+    #[test]
+    fn exact_operands_of_input_points_refine_as_file_operands() {
+        let cube = procedural::cube();
+        let a = TriangleSoup::new(&cube);
+        for steps in ["matrix 0 -1 0 0 1 0 0 0 0 0 1 0", "rotate 1 2 3 10; translate 0.1 0.2 0.3"] {
+            let b = TriangleSoup::new(&moved(&cube, steps));
+            let (ea, eb) = (ExactSolid::from_soup(&a), ExactSolid::from_soup(&b));
+            let plain = refine(&a, &b).unwrap();
+            assert!(plain.stats.new_points > 0, "{steps}");
+            if steps.starts_with("matrix") {
+                assert!(plain.stats.coplanar_pairs > 0);
+            }
+            assert_same(&refine(&ea, &b).unwrap(), &plain);
+            assert_same(&refine(&a, &eb).unwrap(), &plain);
+            let both = refine(&ea, &eb).unwrap();
+            assert_same(&both, &plain);
+            assert_eq!(both.vertices.each_ref().map(Vec::len), [a.positions.len(), b.positions.len()]);
+            assert!(plain.vertices.iter().all(Vec::is_empty));
+        }
+    }
+
+    /// R = cube − (cube turned 1e-3° and shifted by a non-dyadic amount), kept exact, then
+    /// refined against a third cube that cuts R's cut curve: the new points include
+    /// segments between implicit points crossing a plane, and all are exact.
+    #[test]
+    fn an_exact_result_refines_exactly_against_a_third_solid() {
+        let cube = procedural::cube();
+        let b = moved(&cube, "rotate 1 2 3 0.001; translate 0.9 0.8 0.7");
+        let ev = evaluate(&cube, &b, Names::default(), &Options::default(), None).unwrap();
+        let r = ev.exact_result(Operation::Difference, true);
+        assert!(r.points.iter().any(|p| !matches!(p.definition(), Definition::Explicit(_))));
+        // Centred on the cut edge where B's face x ≈ −0.1 meets A's top, turned.
+        let c = moved(&cube, "scale 0.15; rotate 1 2 -1 17; translate -0.1 0.3 1");
+        let c = TriangleSoup::new(&ev.frame.mesh_in_ref(&c));
+        let x = refine(&r, &c).unwrap();
+        assert!(x.implicit.iter().any(|p| matches!(p.definition(), Definition::SegmentPlane(_))));
+        assert!(x.stats.cut_a > 0 && x.stats.cut_b > 0);
+
+        // Every piece's corners lie on its support plane; every new point is a corner of
+        // pieces of both sides.
+        let mut seen = vec![[false; 2]; x.implicit.len()];
+        for (k, refined) in [&x.a, &x.b].into_iter().enumerate() {
+            for (piece, &parent) in refined.triangles.iter().zip(&refined.parent) {
+                let support = if k == 0 { Solid::support(&r, parent) } else { Solid::support(&c, parent) };
+                let [p, q, s] = support.map(Point::explicit);
+                for &id in piece {
+                    assert_eq!(orient3d_implicit(&p, &q, &s, &x.point(id)), 0);
+                    if id >= x.first_new {
+                        seen[(id - x.first_new) as usize][k] = true;
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|s| s[0] && s[1]));
+
+        // The pieces of each of R's triangles cover its area.
+        let area = |t: [DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let mut sums = vec![0.0; r.triangles.len()];
+        for (piece, &parent) in x.a.triangles.iter().zip(&x.a.parent) {
+            sums[parent as usize] += area(piece.map(|i| x.points[i as usize]));
+        }
+        for (t, sum) in sums.iter().enumerate() {
+            let whole = area(r.triangles[t].map(|i| r.rounded[i as usize]));
+            assert!((sum - whole).abs() <= 1e-12 * whole, "triangle {t}: {sum} vs {whole}");
+        }
+
+        // The cut curve is closed.
+        assert!(!x.curve.is_empty());
+        let mut ends = vec![0u32; x.points.len()];
+        for s in &x.curve {
+            s.iter().for_each(|&i| ends[i as usize] += 1);
+        }
+        assert!(ends.iter().all(|n| n % 2 == 0));
+    }
 }

@@ -20,6 +20,8 @@ use std::str::FromStr;
 use glam::DVec3;
 
 use super::classify::Class;
+use super::operand::{ExactSolid, Solid};
+use super::refine::{Refined, Refinement};
 use crate::mesh::Mesh;
 
 /// A Boolean operation (`--op`), named as [`Operation::name`] says.
@@ -140,6 +142,58 @@ pub fn assemble(points: &[DVec3], triangles: &[[u32; 3]]) -> Mesh {
     let offsets = (0..=triangles.len()).map(|i| 3 * i).collect();
     Mesh::from_parts(positions, offsets, indices)
         .unwrap_or_else(|e| unreachable!("assembled triangles index their own points: {e}"))
+}
+
+/// The support of every triangle [`select`] picks, in its order: the support of its
+/// parent in its operand ([`Refined::parent`], [`Solid::support`]), two corners swapped
+/// where the selection reverses the triangle (as `select` swaps them).
+pub fn selected_supports<A: Solid, B: Solid>(
+    op: Operation,
+    regularized: bool,
+    r: &Refinement,
+    (a, class_a): (&A, &[Class]),
+    (b, class_b): (&B, &[Class]),
+) -> Vec<[DVec3; 3]> {
+    let mut out = Vec::new();
+    let mut side =
+        |from_a: bool, refined: &Refined, classes: &[Class], support: &dyn Fn(u32) -> [DVec3; 3]| {
+            for (&parent, &c) in refined.parent.iter().zip(classes) {
+                match op.keeps(from_a, c, regularized) {
+                    Some(false) => out.push(support(parent)),
+                    Some(true) => {
+                        let [x, y, z] = support(parent);
+                        out.push([x, z, y]);
+                    }
+                    None => {}
+                }
+            }
+        };
+    side(true, &r.a, class_a, &|t| a.support(t));
+    side(false, &r.b, class_b, &|t| b.support(t));
+    out
+}
+
+/// The exact operand made of `triangles` over the refinement's points (as [`assemble`]
+/// gets them from [`select`]) and their `support` ([`selected_supports`]): the points used,
+/// exactly ([`Refinement::point`]) and rounded, numbered in order of first use like
+/// [`assemble`]'s, so that the result does not depend on thread timing.
+pub fn assemble_exact(r: &Refinement, triangles: &[[u32; 3]], support: Vec<[DVec3; 3]>) -> ExactSolid {
+    debug_assert_eq!(triangles.len(), support.len());
+    let mut map = vec![u32::MAX; r.points.len()];
+    let mut points = Vec::new();
+    let mut rounded = Vec::new();
+    let mut tris = Vec::with_capacity(triangles.len());
+    for t in triangles {
+        tris.push(t.map(|v| {
+            if map[v as usize] == u32::MAX {
+                map[v as usize] = points.len() as u32;
+                points.push(r.point(v).into_owned());
+                rounded.push(r.points[v as usize]);
+            }
+            map[v as usize]
+        }));
+    }
+    ExactSolid { points, rounded, triangles: tris, support }
 }
 
 #[cfg(test)]
