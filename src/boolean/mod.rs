@@ -51,7 +51,7 @@ use crate::mesh::Mesh;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::TriangleSoup;
 use crate::mesh::solidity::{Memory, Solidity};
-use operand::ExactSolid;
+use operand::{ExactSolid, Solid};
 
 pub mod cgal;
 pub mod classify;
@@ -291,7 +291,7 @@ pub fn evaluate(
     };
 
     let start = Instant::now();
-    let (mut built, mut ray_tests) = (std::time::Duration::ZERO, 0);
+    let mut counts = TestCounts::default();
     // The operand whose lazily built method failed, to name it in the error.
     let mut failed = None;
     let mut test = |side: Side, points: &[DVec3]| -> inclusion::Result<Vec<inclusion::Class>> {
@@ -299,17 +299,8 @@ pub fn evaluate(
             Side::A => (0, a, &sa),
             Side::B => (1, b, &sb),
         };
-        if solvers[k].is_none() {
-            if points.len() <= classify::FEW_POINTS {
-                ray_tests += points.len();
-                return Ok(classify::ray_crossings(points, soup));
-            }
-            let start = Instant::now();
-            solvers[k] = Some(build(mesh).inspect_err(|_| failed = Some(side))?);
-            built += start.elapsed();
-        }
-        let Some(solver) = &mut solvers[k] else { unreachable!("built above") };
-        solver.classify_fine(points, 4)
+        let make = || build(mesh).inspect_err(|_| failed = Some(side));
+        point_test(soup, points, &mut solvers[k], make, &mut counts)
     };
     let classified = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test);
     let mut classification = match (classified, failed) {
@@ -319,10 +310,91 @@ pub fn evaluate(
         }
         (classified, _) => classified?,
     };
-    classification.stats.ray_tests = ray_tests;
-    timings.classifiers += built;
-    timings.classify = start.elapsed().saturating_sub(built);
+    classification.stats.ray_tests = counts.ray_tests;
+    timings.classifiers += counts.built;
+    timings.classify = start.elapsed().saturating_sub(counts.built);
     Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame })
+}
+
+/// What [`point_test`] did besides the method's tests.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TestCounts {
+    /// Points answered by exact ray crossings ([`classify::ray_crossings`]).
+    pub ray_tests: usize,
+    /// Time spent building methods when first needed.
+    pub built: Duration,
+}
+
+/// The classification's point tests against one operand `solid` ([`classify::PointTest`]):
+/// `solver` is its inclusion method, built by `build` when first needed. With none built
+/// yet, at most [`classify::FEW_POINTS`] points are answered by exact ray crossings over
+/// its triangles instead. On an operand with implicit points the method is the one built
+/// on its rounded mesh ([`rounded_mesh`]), whose Inside and Outside answers hold for the
+/// exact surface when [`rounded_method_is_exact`] (the argument is in [`classify`]'s
+/// documentation; its OnBoundary answers go to the exact parity there, as always); when
+/// that does not hold, every point is answered by exact ray crossings.
+pub fn point_test<S: Solid>(
+    solid: &S,
+    points: &[DVec3],
+    solver: &mut Option<Solver>,
+    build: impl FnOnce() -> inclusion::Result<Solver>,
+    counts: &mut TestCounts,
+) -> inclusion::Result<Vec<inclusion::Class>> {
+    let rays = solver.is_none() && points.len() <= classify::FEW_POINTS;
+    if rays || (!S::EXPLICIT && !rounded_method_is_exact(solid)) {
+        counts.ray_tests += points.len();
+        return Ok(classify::ray_crossings(points, solid));
+    }
+    if solver.is_none() {
+        let start = Instant::now();
+        *solver = Some(build()?);
+        counts.built += start.elapsed();
+    }
+    let Some(solver) = solver else { unreachable!("built above") };
+    solver.classify_fine(points, 4)
+}
+
+/// An operand's triangles over its rounded positions ([`Solid::rounded`]), for building
+/// inclusion methods (for an operand with implicit points see [`point_test`]).
+pub fn rounded_mesh<S: Solid>(solid: &S) -> Result<Mesh> {
+    let triangles = solid.triangles();
+    let offsets = (0..=triangles.len()).map(|t| 3 * t).collect();
+    Ok(Mesh::from_parts(solid.rounded().to_vec(), offsets, triangles.as_flattened().to_vec())?)
+}
+
+/// A bound on how far rounding moves any vertex of `solid` (Euclidean): 0 for an
+/// explicit operand; else each coordinate of an implicit point is rounded to nearest,
+/// off by at most half an ulp of the rounded value, ≤ 2⁻⁵³·|x| (plus the smallest
+/// subnormal's half), so √3 of that at the largest |x|, below 2⁻⁵²·max |x| + the smallest
+/// normal.
+pub fn rounding_displacement<S: Solid>(solid: &S) -> f64 {
+    if S::EXPLICIT {
+        return 0.0;
+    }
+    let largest =
+        solid.rounded().par_iter().with_min_len(4096).map(|p| p.abs().max_element()).reduce(|| 0.0, f64::max);
+    largest * f64::EPSILON + f64::MIN_POSITIVE
+}
+
+/// True when an inclusion method built on the rounded mesh of `solid` answers Inside and
+/// Outside for its exact surface too: always for an explicit operand; else when rounding
+/// moves no vertex by more than 1/64 of the methods' boundary band ε = 10⁻⁹ of the
+/// diagonal of the triangles' box ([`crate::inclusion`]; the surface's box, over every
+/// position, is no smaller). The room covers the methods' own f64 evaluation near ε,
+/// a few ulps of the coordinates. In the evaluation's frame (coordinates at most about
+/// 2) it fails only for an operand smaller than about 10⁻⁵ of the frame.
+pub fn rounded_method_is_exact<S: Solid>(solid: &S) -> bool {
+    if S::EXPLICIT {
+        return true;
+    }
+    let (positions, triangles) = (solid.rounded(), solid.triangles());
+    let (lo, hi) = triangles
+        .iter()
+        .flatten()
+        .map(|&v| positions[v as usize])
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let band = inclusion::surface::REL_TOL * (hi - lo).length();
+    64.0 * rounding_displacement(solid) < band
 }
 
 /// One operation's result, as it is written.

@@ -155,6 +155,14 @@ impl Refinement {
         point_of(&self.points, (self.b_offset, self.first_new), vertices, &self.implicit, id)
     }
 
+    /// True when point `id` is given by f64 coordinates (an operand's vertex that is an
+    /// explicit point), so that tests on its position are tests on the point: every
+    /// operand vertex of file operands (ids below [`Refinement::first_new`]); never an
+    /// intersection point.
+    pub fn is_explicit(&self, id: u32) -> bool {
+        id < self.first_new
+    }
+
     /// The key of point `id` when it lies on both surfaces (a new point, or an input
     /// vertex on the other surface).
     pub fn key_of(&self, id: u32) -> Option<Key> {
