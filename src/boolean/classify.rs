@@ -1218,7 +1218,9 @@ mod tests {
         let options = inclusion::Options { known_closed: true, ..inclusion::Options::default() };
         let mut solver = Some(Solver::new(Method::Octants, &tiny, &options, None, None).unwrap());
         let mut counts = TestCounts::default();
-        let points = [DVec3::ONE + size / 2.0, DVec3::ONE + 2.0 * size, DVec3::ONE];
+        // Inside (off the faces' diagonals, which a ray along x through y = z would meet),
+        // outside, at a corner.
+        let points = [DVec3::ONE + DVec3::new(0.5, 0.3, 0.6) * size, DVec3::ONE + 2.0 * size, DVec3::ONE];
         let unused = || -> inclusion::Result<Solver> { unreachable!("built") };
         let answers = point_test(&solid, &points, &mut solver, unused, &mut counts).unwrap();
         assert_eq!(counts.ray_tests, 3);

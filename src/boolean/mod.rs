@@ -382,7 +382,7 @@ pub fn rounding_displacement<S: Solid>(solid: &S) -> f64 {
 /// diagonal of the triangles' box ([`crate::inclusion`]; the surface's box, over every
 /// position, is no smaller). The room covers the methods' own f64 evaluation near ε,
 /// a few ulps of the coordinates. In the evaluation's frame (coordinates at most about
-/// 2) it fails only for an operand smaller than about 10⁻⁵ of the frame.
+/// 2) it fails only for an operand whose diagonal is under about 3·10⁻⁵.
 pub fn rounded_method_is_exact<S: Solid>(solid: &S) -> bool {
     if S::EXPLICIT {
         return true;
