@@ -469,3 +469,40 @@ fn a_tiny_solid_is_kept_whole() {
     let faces = |op| ev.result(op, true).unwrap().num_faces();
     assert!(faces(Operation::Union) > faces(Operation::Difference), "B dropped from A ∪ B");
 }
+
+/// A thin result used again inside one expression stays exact: `(a ^ b) ^ b` is a and
+/// `(a ^ b) & b` is b − a, for a UV sphere and its copy turned 1e-6° about a skew axis.
+/// The symmetric difference is slivers thinner than f64 can hold; rounded and used again
+/// (one operation at a time) these fail to give a valid solid, but as the next operand
+/// of an expression they are not rounded at all, and only the end result is.
+#[test]
+fn an_expression_keeps_a_sliver_result_exact_for_the_next_operation() {
+    use texgeo::boolean::expr::{self, Expr, Operand};
+    let turn = Transform::parse("rotate 1 2 3 1e-6").unwrap();
+    for (rings, text) in [(6, "(a ^ b) ^ b"), (8, "(a ^ b) & b")] {
+        let a = procedural::sphere(rings, 2 * rings);
+        let b = turn.apply(&a).unwrap();
+        let name = format!("sphere {rings}×{}: {text}", 2 * rings);
+        let operands = [("a", &a), ("b", &b)].map(|(n, m)| Operand {
+            name: n.to_string(),
+            label: n.to_string(),
+            mesh: m.clone(),
+        });
+        let mut repairs = Vec::new();
+        let r = expr::evaluate(&Expr::parse(text).unwrap(), &operands, &Options::default(), None, |s| {
+            repairs.push(s.repair.is_some())
+        })
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        // Only the last operation's result is rounded (and checked, and repaired).
+        assert_eq!(repairs, [false, true], "{name}");
+        assert_operand(&name, &r);
+        // b − a exactly, before any rounding.
+        let want = if text.ends_with("^ b") {
+            volume(&a)
+        } else {
+            let ev = boolean::evaluate(&b, &a, Names::default(), &Options::default(), None).unwrap();
+            ev.exact_volume(Operation::Difference, true).value
+        };
+        assert!((volume(&r) - want).abs() <= REL * volume(&a), "{name}: {} vs {want}", volume(&r));
+    }
+}

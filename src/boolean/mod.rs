@@ -30,7 +30,10 @@
 //!    once rounded to f64, and repaired where rounding alone made faces cross or fold;
 //!    one that cannot be made valid is an error, never written.
 //!
-//! [`expr`] evaluates CSG expressions (`(a | b) - c`) as a tree of these operations.
+//! [`expr`] evaluates CSG expressions (`(a | b) - c`) as a tree of these operations,
+//! whose inner results stay exact: [`operand`] holds such a result (implicit points,
+//! every triangle on an input plane) and the [`operand::Solid`] trait lets the refinement
+//! and the classification take it or a file's mesh alike ([`evaluate_exact`]).
 //!
 //! A mesh without faces is the empty solid, a valid operand and result: A ∪ ∅ = A,
 //! A ∩ ∅ = ∅, A − ∅ = A, ∅ − A = ∅, A ⊖ ∅ = A come out of the same steps.
@@ -42,7 +45,6 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::exact::implicit::Point;
 use crate::exact::rounding::Ball;
 use crate::exact::volume;
 use crate::gpu::Context;
@@ -167,6 +169,9 @@ pub struct Evaluation {
     /// The operands' common frame ([`crate::mesh::frame`]): everything above is in it,
     /// [`Evaluation::result`] gives the result back in the operands' units.
     pub frame: Frame,
+    /// The operands when they are exact results of earlier steps of an expression
+    /// ([`evaluate_exact`]); `a` and `b` are then their triangles over rounded points.
+    pub exact: Option<Box<[ExactSolid; 2]>>,
 }
 
 /// The two operands' names in messages (e.g. their file names).
@@ -211,6 +216,18 @@ pub fn evaluate(
     options: &Options,
     ctx: Option<&Context>,
 ) -> Result<Evaluation> {
+    evaluate_in(a, b, names, options, ctx, Frame::of(&[a, b]))
+}
+
+/// [`evaluate`] in a given frame (an expression's, common to all its operands).
+pub fn evaluate_in(
+    a: &Mesh,
+    b: &Mesh,
+    names: Names,
+    options: &Options,
+    ctx: Option<&Context>,
+    frame: Frame,
+) -> Result<Evaluation> {
     let mut timings = Timings::default();
     let start = Instant::now();
     let memory = options.remember_verdicts.then(|| {
@@ -219,7 +236,6 @@ pub fn evaluate(
     });
     let known = memory.as_ref().map_or([None, None], |m| m.each_ref().map(Memory::recall));
     let fresh = known.each_ref().map(Option::is_none);
-    let frame = Frame::of(&[a, b]);
     let (framed_a, framed_b) = rayon::join(|| frame.mesh_in_ref(a), || frame.mesh_in_ref(b));
     let [(sa, va), (sb, vb)] =
         check_operands(&framed_a, &framed_b, names, frame, options.allow_self_intersections, known)?;
@@ -238,7 +254,52 @@ pub fn evaluate(
     let (a, b) = rayon::join(|| sa.to_mesh(), || sb.to_mesh());
     let (a, b) = (&a?, &b?);
     timings.check = start.elapsed();
+    let (refinement, classification, method) =
+        refine_and_classify((&sa, &sb), (a, b), names, options, ctx, &mut timings)?;
+    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame, exact: None })
+}
 
+/// Evaluates two exact results of earlier steps of an expression against each other, in
+/// the expression's frame (where their points are): refinement and classification as
+/// [`evaluate`]'s, nothing rounded; their inclusion methods are built on their rounded
+/// meshes ([`point_test`]). They need no operand check: each is a refinement's product,
+/// closed and oriented ([`Evaluation::exact_result`] checks), and its faces do not cross.
+pub fn evaluate_exact(
+    a: ExactSolid,
+    b: ExactSolid,
+    names: Names,
+    options: &Options,
+    ctx: Option<&Context>,
+    frame: Frame,
+) -> Result<Evaluation> {
+    let mut timings = Timings::default();
+    let start = Instant::now();
+    let (ma, mb) = rayon::join(|| rounded_mesh(&a), || rounded_mesh(&b));
+    let (ma, mb) = (ma?, mb?);
+    timings.check = start.elapsed();
+    let (refinement, classification, method) =
+        refine_and_classify((&a, &b), (&ma, &mb), names, options, ctx, &mut timings)?;
+    let soup = |s: &ExactSolid| TriangleSoup {
+        positions: s.rounded.clone(),
+        triangles: s.triangles.clone(),
+        face_of: (0..s.triangles.len() as u32).collect(),
+        failed: Vec::new(),
+    };
+    let (sa, sb) = (soup(&a), soup(&b));
+    let exact = Some(Box::new([a, b]));
+    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame, exact })
+}
+
+/// Refinement and classification of two checked operands (`meshes`: their triangles, for
+/// the inclusion methods); the name of the method used.
+fn refine_and_classify<S: Solid>(
+    (sa, sb): (&S, &S),
+    (a, b): (&Mesh, &Mesh),
+    names: Names,
+    options: &Options,
+    ctx: Option<&Context>,
+    timings: &mut Timings,
+) -> Result<(Refinement, Classification, String)> {
     // The operands' closure is checked above.
     let inclusion = inclusion::Options { known_closed: true, ..options.inclusion };
     let build = |mesh: &Mesh| Solver::new(options.method, mesh, &inclusion, ctx, None);
@@ -268,7 +329,7 @@ pub fn evaluate(
     };
     let refine_timed = || {
         let start = Instant::now();
-        (refine::refine(&sa, &sb), start.elapsed())
+        (refine::refine(sa, sb), start.elapsed())
     };
     // GPU solvers hold the device: build them on this thread.
     let ((refinement, t_refine), (solvers, t_build)) = if options.overlap && options.method.is_cpu() && !lazy
@@ -296,13 +357,13 @@ pub fn evaluate(
     let mut failed = None;
     let mut test = |side: Side, points: &[DVec3]| -> inclusion::Result<Vec<inclusion::Class>> {
         let (k, mesh, soup) = match side {
-            Side::A => (0, a, &sa),
-            Side::B => (1, b, &sb),
+            Side::A => (0, a, sa),
+            Side::B => (1, b, sb),
         };
         let make = || build(mesh).inspect_err(|_| failed = Some(side));
         point_test(soup, points, &mut solvers[k], make, &mut counts)
     };
-    let classified = classify::classify(&refinement, &sa, &sb, options.grouping, &mut test);
+    let classified = classify::classify(&refinement, sa, sb, options.grouping, &mut test);
     let mut classification = match (classified, failed) {
         (Err(classify::ClassifyError::Inclusion(source)), Some(side)) => {
             let name = if side == Side::A { names.a } else { names.b };
@@ -313,7 +374,7 @@ pub fn evaluate(
     classification.stats.ray_tests = counts.ray_tests;
     timings.classifiers += counts.built;
     timings.classify = start.elapsed().saturating_sub(counts.built);
-    Ok(Evaluation { a: sa, b: sb, refinement, classification, timings, method, frame })
+    Ok((refinement, classification, method))
 }
 
 /// What [`point_test`] did besides the method's tests.
@@ -443,10 +504,14 @@ impl Evaluation {
     pub fn exact_volume(&self, op: Operation, regularized: bool) -> Volume {
         let (r, c) = (&self.refinement, &self.classification);
         let (tris, _) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
-        let first = r.first_new;
-        let implicit: Vec<[Ball; 3]> =
-            r.implicit.par_iter().with_min_len(256).map(Point::coordinates).collect();
-        // Intersection points are the ones rounded when written.
+        // Points that are rounded when written: the intersection points, and every point
+        // of an exact operand (explicit ones round to themselves).
+        let first = if self.exact.is_some() { 0 } else { r.first_new };
+        let implicit: Vec<[Ball; 3]> = (first..r.points.len() as u32)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|id| r.point(id).coordinates())
+            .collect();
         let v = volume::signed_volume(&tris, |id| {
             if id < first {
                 (r.points[id as usize].to_array().map(Ball::of), false)
@@ -460,11 +525,20 @@ impl Evaluation {
     /// The exact result of `op`, in the operands' frame, as an operand for a further step:
     /// the selected triangles over the exact points, nothing rounded
     /// ([`select::assemble_exact`]).
-    pub fn exact_result(&self, op: Operation, regularized: bool) -> ExactSolid {
+    pub fn exact_result(&self, op: Operation, regularized: bool) -> Result<ExactSolid> {
         let (r, c) = (&self.refinement, &self.classification);
         let (tris, _) = select::select(op, regularized, (&r.a.triangles, &c.a), (&r.b.triangles, &c.b));
-        let support = select::selected_supports(op, regularized, r, (&self.a, &c.a), (&self.b, &c.b));
-        select::assemble_exact(r, &tris, support)
+        if regularized {
+            let (boundary, misoriented) = crate::mesh::validate::edge_defects(&tris);
+            if boundary > 0 || misoriented > 0 {
+                return Err(BooleanError::NotClosed { op, boundary, misoriented });
+            }
+        }
+        let support = match self.exact.as_deref() {
+            Some([a, b]) => select::selected_supports(op, regularized, r, (a, &c.a), (b, &c.b)),
+            None => select::selected_supports(op, regularized, r, (&self.a, &c.a), (&self.b, &c.b)),
+        };
+        Ok(select::assemble_exact(r, &tris, support))
     }
 
     /// [`Evaluation::output`] in the operands' frame (a power-of-two scale: the rounding,
@@ -477,15 +551,18 @@ impl Evaluation {
             return Ok(Output { mesh, from_a, repair: Repair::default() });
         }
         // The same walk as `select`: which selected triangles are uncut input triangles.
+        // Exact operands' triangles are all rounded here for the first time, and all
+        // their points with them.
+        let exact = self.exact.is_some();
         let mut changed = Vec::with_capacity(tris.len());
         for (from_a, side, classes) in [(true, &r.a, &c.a), (false, &r.b, &c.b)] {
             for (t, &class) in classes.iter().enumerate() {
                 if op.keeps(from_a, class, regularized).is_some() {
-                    changed.push(side.cut[side.parent[t] as usize]);
+                    changed.push(exact || side.cut[side.parent[t] as usize]);
                 }
             }
         }
-        let first_new = (self.a.positions.len() + self.b.positions.len()) as u32;
+        let first_new = if exact { 0 } else { (self.a.positions.len() + self.b.positions.len()) as u32 };
         let (lo, hi) = self
             .a
             .positions

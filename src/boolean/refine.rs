@@ -157,10 +157,18 @@ impl Refinement {
 
     /// True when point `id` is given by f64 coordinates (an operand's vertex that is an
     /// explicit point), so that tests on its position are tests on the point: every
-    /// operand vertex of file operands (ids below [`Refinement::first_new`]); never an
-    /// intersection point.
+    /// operand vertex of file operands (ids below [`Refinement::first_new`]), the explicit
+    /// ones of an exact operand; never an intersection point.
     pub fn is_explicit(&self, id: u32) -> bool {
-        id < self.first_new
+        if id >= self.first_new {
+            return false;
+        }
+        let (list, k) = if id < self.b_offset {
+            (&self.vertices[0], id)
+        } else {
+            (&self.vertices[1], id - self.b_offset)
+        };
+        list.get(k as usize).is_none_or(|p| matches!(p.definition(), implicit::Definition::Explicit(_)))
     }
 
     /// The key of point `id` when it lies on both surfaces (a new point, or an input
@@ -858,7 +866,7 @@ mod tests {
         let cube = procedural::cube();
         let b = moved(&cube, "rotate 1 2 3 0.001; translate 0.9 0.8 0.7");
         let ev = evaluate(&cube, &b, Names::default(), &Options::default(), None).unwrap();
-        let r = ev.exact_result(Operation::Difference, true);
+        let r = ev.exact_result(Operation::Difference, true).unwrap();
         assert!(r.points.iter().any(|p| !matches!(p.definition(), Definition::Explicit(_))));
         // Centred on the cut edge where B's face x ≈ −0.1 meets A's top, turned.
         let c = moved(&cube, "scale 0.15; rotate 1 2 -1 17; translate -0.1 0.3 1");

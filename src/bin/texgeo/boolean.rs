@@ -286,10 +286,13 @@ pub fn run_expression(
             let mut step = evaluation_json(s.names.a, s.names.b, s.evaluation);
             step["expr"] = s.expr.to_string().into();
             step["op"] = s.op.name().into();
-            step["triangles"] = s.result.num_faces().into();
+            step["triangles"] = s.triangles.into();
             step["exact_volume"] = exact_volume.value.into();
             step["exact_volume_error"] = exact_volume.error.into();
-            step["repair"] = repair_json(&s.repair);
+            step["repair"] = match &s.repair {
+                Some(r) => repair_json(r),
+                None => serde_json::Value::Null,
+            };
             step["time"] = serde_json::json!({
                 "check_ms": ms(t.check),
                 "refine_ms": ms(t.refine),
@@ -306,10 +309,13 @@ pub fn run_expression(
             s.op.symbol(),
             s.names.b,
             s.expr,
-            s.result.num_faces()
+            s.triangles
         ));
         lines.extend(evaluation_lines(s.names.a, s.names.b, s.evaluation).map(|l| format!("  {l}")));
-        lines.push(format!("  after rounding to f64: {}", s.repair));
+        lines.push(match &s.repair {
+            Some(r) => format!("  after rounding to f64: {r}"),
+            None => "  kept exact for the next operation (not rounded)".to_string(),
+        });
         lines.push(format!(
             "  volume {} exact (± {:.1e}), before rounding to f64",
             exact_volume.value, exact_volume.error
