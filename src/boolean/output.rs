@@ -231,6 +231,12 @@ pub enum InvalidResult {
         near.x, near.y, near.z
     )]
     Flat { face: usize, near: DVec3 },
+    #[error(
+        "the faces around the edge at ({}, {}, {}) do not alternate in direction once rounded to f64 \
+         (a tiny piece hanging on the edge turned inside out)",
+        near.x, near.y, near.z
+    )]
+    Folded { near: DVec3 },
     #[error("it encloses no volume once rounded to f64 (volume {volume}) but is not empty")]
     NoVolume { volume: f64 },
     #[error("once rounded to f64 and repaired it is not a solid texgeo accepts as an operand: {reason}")]
@@ -245,6 +251,7 @@ impl InvalidResult {
                 InvalidResult::Crossing { a, b, near: frame.point_out(near) }
             }
             InvalidResult::Flat { face, near } => InvalidResult::Flat { face, near: frame.point_out(near) },
+            InvalidResult::Folded { near } => InvalidResult::Folded { near: frame.point_out(near) },
             InvalidResult::NoVolume { volume } => {
                 InvalidResult::NoVolume { volume: frame.volume_out(volume) }
             }

@@ -104,6 +104,17 @@ pub struct UnbalancedEdge {
     pub backward: u32,
 }
 
+/// An edge of more than two faces (balanced in direction) around which the faces, in
+/// their order about the edge, do not alternate in direction: the winding number beside
+/// it takes three values, so it is −1 or 2 somewhere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FoldedEdge {
+    pub a: u32,
+    pub b: u32,
+    /// How many faces use it.
+    pub faces: u32,
+}
+
 impl std::fmt::Display for UnbalancedEdge {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let (a, b) = (self.a, self.b);
@@ -377,6 +388,13 @@ impl Covering {
     /// surface (a 2-cycle), which is what the covering methods need; non-manifold edges
     /// (used twice each way) are fine.
     pub fn unbalanced_edge(&self) -> Option<UnbalancedEdge> {
+        self.edge_faults().0
+    }
+
+    /// The smallest edge whose uses do not pair up ([`Self::unbalanced_edge`]), and the
+    /// smallest balanced edge of more than two faces around which the faces do not
+    /// alternate in direction ([`FoldedEdge`]), from one walk over the edges.
+    pub fn edge_faults(&self) -> (Option<UnbalancedEdge>, Option<FoldedEdge>) {
         // The uses of each edge are adjacent in its lower vertex's bucket, edges in
         // increasing order: the first unbalanced one is the smallest.
         let half_edges = super::validate::HalfEdges::of_faces(
@@ -384,17 +402,92 @@ impl Covering {
             &self.polygon_indices,
             self.points.len(),
         );
-        half_edges.edges().find_map(|(lo, hi, run)| {
+        let (mut unbalanced, mut folded) = (None, None);
+        for (lo, hi, run) in half_edges.edges() {
             let forward = half_edges.forward(lo, run);
             let backward = run.len() - forward;
-            (forward != backward).then_some(UnbalancedEdge {
-                a: lo as u32,
-                b: hi,
-                forward: forward as u32,
-                backward: backward as u32,
-            })
-        })
+            if forward != backward {
+                unbalanced.get_or_insert(UnbalancedEdge {
+                    a: lo as u32,
+                    b: hi,
+                    forward: forward as u32,
+                    backward: backward as u32,
+                });
+            } else if run.len() > 2 && folded.is_none() && self.folds(lo as u32, hi, run) {
+                folded = Some(FoldedEdge { a: lo as u32, b: hi, faces: run.len() as u32 });
+            }
+            if unbalanced.is_some() && folded.is_some() {
+                break;
+            }
+        }
+        (unbalanced, folded)
     }
+
+    /// Whether the faces around edge lo–hi (its uses `run`, balanced, more than two) fail
+    /// to alternate in direction: [`folds`] of their covering triangles' third corners.
+    fn folds(&self, lo: u32, hi: u32, run: &[u64]) -> bool {
+        let (a, b) = (self.points[lo as usize], self.points[hi as usize]);
+        // Per use: the third corner of the covering triangle on the edge, and whether the
+        // face runs lo → hi.
+        let uses: Vec<(DVec3, bool)> = run
+            .iter()
+            .map(|&item| {
+                let corner = super::validate::corner(item);
+                let f = self.polygon_offsets.partition_point(|&o| o <= corner) - 1;
+                let face = self.polygon(f);
+                let forward = self.polygon_indices[corner] == lo;
+                let third = if face.len() == 3 {
+                    let k = corner - self.polygon_offsets[f];
+                    face[(k + 2) % 3]
+                } else {
+                    self.triangles[self.face_start[f] as usize][0]
+                };
+                (self.points[third as usize], forward)
+            })
+            .collect();
+        folds(a, b, &uses)
+    }
+}
+
+/// Whether faces around the edge a–b, given by their third corners and whether they run
+/// a → b, fail to alternate in direction when taken in their exact order around the edge.
+/// Passing a face changes the winding number by one, up or down with the face's direction
+/// along the edge: faces that alternate leave two values beside the edge, two neighbours
+/// of one direction leave three, so −1 or 2 somewhere (a piece hanging on the edge turned
+/// inside out, or inside a part facing its way). Faces at one angle (overlapping) are left
+/// to the self-intersection test.
+pub(crate) fn folds(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> bool {
+    use crate::exact::orient3d;
+    // Angles about the axis a→b from the first use's half-plane: (half, position),
+    // half 0 for [0, π), 1 for [π, 2π); a point off the common plane tells the two
+    // sides of the axis apart for corners in the first use's plane.
+    let reference = uses[0].0;
+    let Some(off) = uses.iter().map(|u| u.0).find(|&t| orient3d(a, b, reference, t) != 0) else {
+        return false;
+    };
+    let side = |t: DVec3| orient3d(a, b, off, t);
+    let half = |t: DVec3| match orient3d(a, b, reference, t) {
+        0 if side(t) == side(reference) => 0,
+        0 => 1,
+        s if s > 0 => 0,
+        _ => 1,
+    };
+    let mut order: Vec<(u8, DVec3, bool)> = uses.iter().map(|&(t, f)| (half(t), t, f)).collect();
+    let mut tie = false;
+    order.sort_by(|x, y| {
+        x.0.cmp(&y.0).then_with(|| match orient3d(a, b, x.1, y.1) {
+            0 => {
+                tie = true;
+                std::cmp::Ordering::Equal
+            }
+            s if s > 0 => std::cmp::Ordering::Less,
+            _ => std::cmp::Ordering::Greater,
+        })
+    });
+    if tie {
+        return false;
+    }
+    (0..order.len()).any(|i| order[i].2 == order[(i + 1) % order.len()].2)
 }
 
 #[cfg(test)]

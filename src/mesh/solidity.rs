@@ -14,7 +14,10 @@
 //! A valid solid is:
 //!
 //! 1. **closed and consistently oriented**: every directed edge a→b is matched by a twin
-//!    b→a (non-manifold edges are fine when they pair up);
+//!    b→a (non-manifold edges are fine when they pair up, and when the faces around them
+//!    alternate in direction in their exact order about the edge: two neighbours facing
+//!    the same way make the winding number −1 or 2 beside it — a piece hanging on the edge
+//!    turned inside out);
 //! 2. **measurable**: its area and volume are finite in f64 (measured in the mesh's
 //!    [`Frame`], then scaled back: every size whose measures fit f64 is measurable);
 //! 3. **outward**: every shell (a connected component of faces) faces away from the
@@ -51,7 +54,7 @@
 
 use glam::DVec3;
 
-use super::covering::{Covering, UnbalancedEdge, compensated_sum};
+use super::covering::{Covering, FoldedEdge, UnbalancedEdge, compensated_sum};
 use super::disjoint_sets::UnionFind;
 use super::frame::Frame;
 use super::{Mesh, intersect};
@@ -81,6 +84,12 @@ pub struct Shell {
 pub enum Defect {
     #[error("the surface is not closed and consistently oriented: {0}")]
     Open(UnbalancedEdge),
+    #[error(
+        "the {faces} faces around edge {a}–{b} do not alternate in direction about it: the winding number \
+         beside it is −1 or 2 (a piece hanging on the edge faces the wrong way)",
+        a = .0.a, b = .0.b, faces = .0.faces
+    )]
+    FoldedEdge(FoldedEdge),
     #[error("its area or volume overflows f64 (coordinates up to {largest:e}); scale the mesh down")]
     Overflow { largest: f64 },
     #[error("the solid is inverted: its faces point inwards (signed volume {volume})")]
@@ -109,6 +118,7 @@ impl Defect {
     pub fn slug(&self) -> &'static str {
         match self {
             Defect::Open(_) => "not-closed",
+            Defect::FoldedEdge(_) => "folded-edge",
             Defect::Overflow { .. } => "overflow",
             Defect::Inverted { .. } => "inverted",
             Defect::InvertedShell { .. } => "inverted-shell",
@@ -211,7 +221,7 @@ fn check_framed(mesh: &Mesh) -> Solidity {
     let covering = Covering::new(mesh);
     let area = covering.area();
     let mut report = Solidity { area, volume: None, shells: Vec::new(), defects: Vec::new() };
-    let unbalanced = covering.unbalanced_edge();
+    let (unbalanced, folded) = covering.edge_faults();
     if let Some(e) = unbalanced {
         report.defects.push(Defect::Open(e));
     }
@@ -232,6 +242,9 @@ fn check_framed(mesh: &Mesh) -> Solidity {
         return report;
     }
     report.volume = Some(volume);
+    if let Some(e) = folded {
+        report.defects.push(Defect::FoldedEdge(e));
+    }
     nesting(mesh, &covering, &groups, &mut report);
     orientation(&mut report);
     // Exact triangle–triangle tests: faces that cross make the winding number 2 (or −1)
@@ -382,6 +395,9 @@ pub fn allow_open_note(defect: &Defect) -> &'static str {
              w = 2: inside)"
         }
         Defect::Open(_) => "inside by winding number ≥ ½ with --allow-open",
+        Defect::FoldedEdge(_) => {
+            "inside by winding number ≥ ½ with --allow-open (beside the edge w is −1, outside, or 2, inside)"
+        }
     }
 }
 
@@ -494,9 +510,8 @@ impl Memory {
 
 /// Names the rules of this module in every cached verdict's key: change it whenever what
 /// counts as a solid (or what [`check`] measures) changes, and old verdicts are not used.
-pub const RULES: &str =
-    "texgeo solidity rules 2 (closed, measurable, outward, not self-intersecting; in the mesh's frame)";
-const CACHE_KIND: &str = "solidity-v2";
+pub const RULES: &str = "texgeo solidity rules 3 (closed, alternating at non-manifold edges, measurable, outward, not self-intersecting; in the mesh's frame)";
+const CACHE_KIND: &str = "solidity-v3";
 
 /// The cache key of `mesh`: its positions (bit for bit) and faces, under [`RULES`].
 pub fn verdict_key(mesh: &Mesh) -> crate::cache::Key {
@@ -641,6 +656,58 @@ mod tests {
         // Two overlapping cubes: some vertices of each lie inside the other.
         let overlap = union(&[cube.clone(), box_between(DVec3::splat(0.0), DVec3::splat(2.0))]);
         assert!(matches!(check(&overlap).defects[..], [Defect::CrossingShells { .. }, ..]));
+    }
+
+    /// The cube with a tetrahedron on its edge between its first face's first two corners,
+    /// outside it or inside it, facing out or in.
+    fn cube_with_tetra_on_an_edge(outside: bool, outward: bool) -> Mesh {
+        let cube = procedural::cube();
+        let mut positions = cube.positions().to_vec();
+        let mut faces: Vec<Vec<u32>> = cube.faces().map(<[u32]>::to_vec).collect();
+        let (a, b) = (faces[0][0], faces[0][1]);
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        let m = (pa + pb) / 2.0;
+        // The cube's outward normals at the edge: the axes where the midpoint is on a side.
+        let axes: Vec<DVec3> = (0..3)
+            .filter(|&i| m[i].abs() == 1.0)
+            .map(|i| DVec3::from_array(std::array::from_fn(|j| if j == i { m[i] } else { 0.0 })))
+            .collect();
+        let (n1, n2) = (axes[0], axes[1]);
+        let d = if outside { n1 + n2 } else { -(n1 + n2) };
+        let (mut p, mut q) = (m + 0.4 * d + 0.1 * (n1 - n2), m + 0.4 * d - 0.1 * (n1 - n2));
+        if (pb - pa).dot((p - pa).cross(q - pa)) < 0.0 {
+            std::mem::swap(&mut p, &mut q);
+        }
+        let (ip, iq) = (positions.len() as u32, positions.len() as u32 + 1);
+        positions.extend([p, q]);
+        // Tetra (a, b, p, q) of positive volume, faces outward.
+        let mut tetra = vec![vec![a, ip, b], vec![a, b, iq], vec![b, ip, iq], vec![a, iq, ip]];
+        if !outward {
+            for f in &mut tetra {
+                f.reverse();
+            }
+        }
+        faces.extend(tetra);
+        Mesh::new(positions, faces).unwrap()
+    }
+
+    #[test]
+    fn faces_around_a_non_manifold_edge_alternate() {
+        // Outside facing out (w = 1 in it) and inside facing in (a cavity, w = 0): solids.
+        for (outside, outward) in [(true, true), (false, false)] {
+            let s = check(&cube_with_tetra_on_an_edge(outside, outward));
+            assert!(s.is_solid(), "outside {outside}, outward {outward}: {:?}", s.defects);
+        }
+        // Outside facing in (w = −1 in it) and inside facing out (w = 2): the faces about the
+        // shared edge do not alternate.
+        for (outside, outward) in [(true, false), (false, true)] {
+            let s = check(&cube_with_tetra_on_an_edge(outside, outward));
+            assert!(
+                matches!(s.defects.first(), Some(Defect::FoldedEdge(FoldedEdge { faces: 4, .. }))),
+                "outside {outside}, outward {outward}: {:?}",
+                s.defects
+            );
+        }
     }
 
     #[test]

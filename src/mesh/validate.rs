@@ -10,6 +10,8 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
+use glam::DVec3;
+
 use super::Mesh;
 use super::disjoint_sets::UnionFind;
 
@@ -200,6 +202,28 @@ pub fn edge_defects(triangles: &[[u32; 3]]) -> (usize, usize) {
         }
     }
     (boundary, misoriented)
+}
+
+/// The first edge of `triangles` (over `positions`), balanced and of more than two
+/// triangles, around which they do not alternate in direction
+/// ([`super::covering::FoldedEdge`]): the exact check of a Boolean result that nothing
+/// moved after rounding, beside its closure test.
+pub fn folded_edge(positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<(u32, u32)> {
+    let half_edges = HalfEdges::of_triangles(triangles, positions.len());
+    half_edges.edges().find_map(|(lo, hi, run)| {
+        if run.len() <= 2 || 2 * half_edges.forward(lo, run) != run.len() {
+            return None;
+        }
+        let uses: Vec<(DVec3, bool)> = run
+            .iter()
+            .map(|&item| {
+                let c = corner(item);
+                let (t, k) = (c / 3, c % 3);
+                (positions[triangles[t][(k + 2) % 3] as usize], triangles[t][k] as usize == lo)
+            })
+            .collect();
+        super::covering::folds(positions[lo], positions[hi as usize], &uses).then_some((lo as u32, hi))
+    })
 }
 
 /// Builds the [`Report`] of `mesh`.
@@ -403,5 +427,31 @@ mod tests {
         let t: Vec<[u32; 3]> = cube.faces().skip(1).map(|f| [f[0], f[1], f[2]]).collect();
         let (boundary, misoriented) = edge_defects(&t);
         assert!(boundary == 3 && misoriented == 0, "{boundary} {misoriented}");
+    }
+
+    #[test]
+    fn faces_about_an_edge_of_two_tetrahedra_alternate_or_fold() {
+        // Two tetrahedra on the edge a–b in opposite wedges: both outward alternate; one
+        // turned inside out leaves two neighbours of one direction about the edge.
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, 0.2),
+            DVec3::new(0.5, 0.2, 1.0),
+            DVec3::new(0.5, -1.0, -0.2),
+            DVec3::new(0.5, -0.2, -1.0),
+        ];
+        let tetra = |[a, b, p, q]: [u32; 4]| -> Vec<[u32; 3]> {
+            let [pa, pb, pp, pq] = [a, b, p, q].map(|i| positions[i as usize]);
+            let (p, q) = if (pb - pa).dot((pp - pa).cross(pq - pa)) > 0.0 { (p, q) } else { (q, p) };
+            vec![[a, p, b], [a, b, q], [b, p, q], [a, q, p]]
+        };
+        let first = tetra([0, 1, 2, 3]);
+        let second = tetra([0, 1, 4, 5]);
+        let both: Vec<[u32; 3]> = first.iter().chain(&second).copied().collect();
+        assert_eq!(folded_edge(&positions, &both), None);
+        let inverted: Vec<[u32; 3]> =
+            first.iter().copied().chain(second.iter().map(|&[a, b, c]| [a, c, b])).collect();
+        assert_eq!(folded_edge(&positions, &inverted), Some((0, 1)));
     }
 }
