@@ -571,27 +571,14 @@ impl Evaluation {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let diagonal = (hi - lo).length();
         // The closure test runs beside the check after rounding; its verdict comes first.
-        let (done, ((boundary, misoriented), folded)) = rayon::join(
+        let (done, (boundary, misoriented)) = rayon::join(
             || output::finish(&r.points, first_new, &tris, &changed, diagonal),
-            || {
-                use crate::mesh::validate::{edge_defects, folded_edge};
-                (edge_defects(&tris), folded_edge(&r.points, &tris))
-            },
+            || crate::mesh::validate::edge_defects(&tris),
         );
         if boundary > 0 || misoriented > 0 {
             return Err(BooleanError::NotClosed { op, boundary, misoriented });
         }
-        let invalid = |reason: InvalidResult| BooleanError::Invalid { op, reason: reason.out_of(self.frame) };
-        let done = done.map_err(invalid)?;
-        // Rounding alone can turn a tiny piece hanging on an edge inside out without making
-        // faces cross: a result the repair left as rounded is checked for it here (a
-        // repaired one gets the whole operand check below).
-        if let Some((a, b)) = folded
-            && done.repair.is_clean()
-        {
-            let near = (r.points[a as usize] + r.points[b as usize]) / 2.0;
-            return Err(invalid(InvalidResult::Folded { near }));
-        }
+        let done = done.map_err(|reason| BooleanError::Invalid { op, reason: reason.out_of(self.frame) })?;
         let from_a = done.origin.iter().filter(|&&o| (o as usize) < from_a).count();
         let repair = Repair { moved: self.frame.length_out(done.repair.moved), ..done.repair };
         let mesh = select::assemble(&done.positions, &done.triangles);

@@ -13,6 +13,10 @@
 //!   checked) and uncut ones of different operands were found apart by the refinement's
 //!   exact tests;
 //! - faces with no area, among the changed triangles;
+//! - edges of more than two faces, one of them changed, around which the faces do not
+//!   alternate in direction in their exact order about the edge (the operand check's fold
+//!   test, [`folded_edges`]): rounding alone can turn a tiny piece hanging on such an edge
+//!   inside out (the winding number −1 or 2 beside it) without making faces cross;
 //! - the operand rule's volume, per shell and for the whole result.
 //!
 //! Closedness is checked by the caller. Nesting and orientation of shells are those of
@@ -76,6 +80,20 @@
 //! repair changed gets the whole operand check once assembled (the caller,
 //! [`InvalidResult::NotOperand`]). Anything still invalid is an error naming the faces and
 //! the place: never a silently invalid result.
+//!
+//! **Folds.** A folded edge is a defect like a crossing: the points near the corners of
+//! its faces are snapped, their shortest edge collapsed (past the sheets any of their
+//! edges up to [`COLLAPSE`] × the diagonal, past those their corners merged with a point a
+//! hair away), their intersection points moved by an ulp. A closed piece on a folded edge
+//! (its faces joined across edges of exactly two faces and balanced among their own, so
+//! that it hangs on the rest only by edges of more than two) that holds no volume worth
+//! keeping, by the measures a shell is dropped by (no wider than [`COLLAPSE`] × the
+//! diagonal, or thinner on average than a flat region), is dropped where that leaves fewer
+//! defects around it, once no collapse applies ([`Cleanup::drop_pieces`]). Every "fewer
+//! defects around it" above counts crossings, faces without area and folded edges
+//! together, each side as it is once such pieces on its folded edges are dropped
+//! ([`count_near`]): a collapse that removes a crossing and leaves a sliver beside it
+//! turned inside out is judged by what the repair then makes of it.
 
 use crate::mesh::hash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
@@ -90,6 +108,7 @@ use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate, soup_self_intersections_near, weld_by_position};
 use crate::mesh::triangulate::{self, Projection};
+use crate::mesh::validate::{Fold, folded_edges};
 
 /// Longest edge a repair collapses, relative to the operands' bounding-box diagonal: far
 /// below any feature of a real model (the volume moved is of the order of its square
@@ -127,6 +146,10 @@ pub struct Repair {
     pub crossings: usize,
     /// Triangles without area after rounding, before any repair.
     pub flat_triangles: usize,
+    /// Edges of more than two triangles around which they do not alternate in direction
+    /// after rounding, before any repair (a tiny piece hanging on the edge turned inside
+    /// out: the operand check's fold test).
+    pub folded_edges: usize,
     /// Points snapped onto a point a few ulps away (the corners of crossing or flat
     /// triangles: nearly coincident points of the two operands and the cut).
     pub snapped: usize,
@@ -171,6 +194,10 @@ pub struct Repair {
     /// Shells dropped because they enclose no volume (or are specks no wider than the
     /// longest edge a repair collapses, or sheets thinner on average than a flat region).
     pub dropped_shells: usize,
+    /// Closed pieces hanging on the rest by edges of more than two triangles, dropped
+    /// where their faces did not alternate about such an edge: pieces that hold no volume
+    /// worth keeping by the same measures as a dropped shell.
+    pub dropped_pieces: usize,
     /// Farthest any point moved.
     pub moved: f64,
 }
@@ -180,6 +207,7 @@ impl Repair {
     pub fn is_clean(&self) -> bool {
         self.crossings == 0
             && self.flat_triangles == 0
+            && self.folded_edges == 0
             && self.removed_triangles == 0
             && self.split_edges == 0
             && self.pockets == 0
@@ -187,6 +215,7 @@ impl Repair {
             && self.flipped == 0
             && self.merged == 0
             && self.dropped_shells == 0
+            && self.dropped_pieces == 0
     }
 }
 
@@ -194,12 +223,14 @@ impl std::fmt::Display for Repair {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} triangles tested, {} crossing pairs and {} triangles without area after rounding, {} points snapped, \
+            "{} triangles tested, {} crossing pairs, {} triangles without area and {} folded edges after rounding, {} points snapped, \
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
-             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped",
+             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped, \
+             {} flat pieces hanging on a folded edge dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
+            self.folded_edges,
             self.snapped,
             self.split_edges,
             self.ulp_moves,
@@ -213,7 +244,8 @@ impl std::fmt::Display for Repair {
             self.joined_sheets,
             self.flipped,
             self.merged,
-            self.dropped_shells
+            self.dropped_shells,
+            self.dropped_pieces
         )
     }
 }
@@ -233,7 +265,8 @@ pub enum InvalidResult {
     Flat { face: usize, near: DVec3 },
     #[error(
         "the faces around the edge at ({}, {}, {}) do not alternate in direction once rounded to f64 \
-         (a tiny piece hanging on the edge turned inside out)",
+         (a tiny piece hanging on the edge turned inside out), and no snap, short-edge collapse, ulp move \
+         or drop of a piece without volume there removes it",
         near.x, near.y, near.z
     )]
     Folded { near: DVec3 },
@@ -300,58 +333,61 @@ pub fn finish(
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let (mut nudges, mut sheets, mut longer, mut joined, mut merged) = (0, 0, 0, 0, 0);
+    let (mut nudges, mut sheets, mut longer, mut joined, mut merged, mut pieces) = (0, 0, 0, 0, 0, 0);
     for round in 0.. {
-        let (crossings, flat) = c.defects();
+        let found = c.defects();
         if round == 0 {
-            c.repair.crossings = crossings.len();
-            c.repair.flat_triangles = flat.len();
+            c.repair.crossings = found.crossings.len();
+            c.repair.flat_triangles = found.flat.len();
+            c.repair.folded_edges = found.folds.len();
         }
-        if crossings.is_empty() && flat.is_empty() {
+        if found.is_empty() {
             break;
         }
         let more = round < ROUNDS;
-        if more && (c.snap(&crossings, &flat) || c.split_edges(&crossings, &flat)) {
+        if more && (c.snap(&found) || c.split_edges(&found)) {
             continue;
         }
-        let plan = c.plan(&crossings, &flat);
+        let plan = c.plan(&found);
         if more && (c.split_neighbours(&plan.long_flat) || c.rebuild_pockets(&plan.wide)) {
             continue;
         }
         // Past the last round no collapse is planned: the ulp moves get their turn below.
         let map = if more { c.choose_collapses(plan.edges) } else { HashMap::new() };
         if map.is_empty() {
-            let err = plan
-                .stuck
-                .or_else(|| crossings.first().map(|x| c.crossing(x)))
-                .unwrap_or_else(|| c.flat_face(flat[0]));
-            if nudges < NUDGES
-                && nudge(&mut c.soup, &crossings, &flat, first_new, &mut c.unmoved, &mut c.repair)
-            {
+            let err = plan.stuck.unwrap_or_else(|| c.first_error(&found));
+            // Folds no collapse removed: the closed pieces of no volume hanging on them.
+            if pieces < ROUNDS && c.drop_pieces(&found.folds) {
+                pieces += 1;
+                continue;
+            }
+            if nudges < NUDGES && nudge(&mut c.soup, &found, first_new, &mut c.unmoved, &mut c.repair) {
                 nudges += 1;
                 continue;
             }
+            let crossings = &found.crossings;
             // Past the ulp moves, the sheets at the crossings (each where it leaves fewer
             // defects around it).
-            if sheets < ROUNDS && c.rebuild_sheets(&crossings, false) {
+            if sheets < ROUNDS && c.rebuild_sheets(crossings, false) {
                 sheets += 1;
                 continue;
             }
             // Past the sheets, the sheets keeping their own edges that cross none of their
-            // others ([`flatten`]), then the other short edges of the crossing triangles.
-            if longer < ROUNDS && (c.rebuild_sheets(&crossings, true) || c.collapse_longer(&crossings)) {
+            // others ([`flatten`]), then the other short edges of the crossing triangles
+            // (and of those around a folded edge).
+            if longer < ROUNDS && (c.rebuild_sheets(crossings, true) || c.collapse_longer(&found)) {
                 longer += 1;
                 continue;
             }
             // Past those, the sheets again, each rebuilt together with the sheets beside it
             // where its outline's splits leave those crossing ([`Cleanup::split_sheet`]).
-            if joined < ROUNDS && c.join_sheets(&crossings) {
+            if joined < ROUNDS && c.join_sheets(crossings) {
                 joined += 1;
                 continue;
             }
-            // Past every other: a corner of a crossing triangle merged with any point a hair
-            // away.
-            if merged < ROUNDS && c.merge_near(&crossings) {
+            // Past every other: a corner of a crossing triangle (or of one around a folded
+            // edge) merged with any point a hair away.
+            if merged < ROUNDS && c.merge_near(&found) {
                 merged += 1;
                 continue;
             }
@@ -360,6 +396,44 @@ pub fn finish(
         c.collapse(&map);
     }
     c.finished()
+}
+
+/// What the check after rounding finds among the changed triangles: pairs that cross,
+/// triangles without area, and edges of more than two triangles around which they do not
+/// alternate in direction (the operand check's fold test, [`folded_edges`]).
+struct Defects {
+    crossings: Vec<(usize, usize)>,
+    flat: Vec<usize>,
+    folds: Vec<Fold>,
+}
+
+impl Defects {
+    fn is_empty(&self) -> bool {
+        self.crossings.is_empty() && self.flat.is_empty() && self.folds.is_empty()
+    }
+
+    /// The triangles of each defect: a crossing pair, a flat triangle, the triangles
+    /// around a folded edge; in that order.
+    fn groups(&self) -> impl Iterator<Item = Vec<usize>> + '_ {
+        let crossings = self.crossings.iter().map(|&(a, b)| vec![a, b]);
+        let flat = self.flat.iter().map(|&f| vec![f]);
+        crossings.chain(flat).chain(self.folds.iter().map(|f| f.triangles.clone()))
+    }
+
+    /// The triangles of every defect ([`Defects::groups`]), one after the other.
+    fn faces(&self) -> impl Iterator<Item = usize> + '_ {
+        let crossings = self.crossings.iter().flat_map(|&(a, b)| [a, b]);
+        crossings
+            .chain(self.flat.iter().copied())
+            .chain(self.folds.iter().flat_map(|f| f.triangles.iter().copied()))
+    }
+
+    /// The triangles of the crossings and then of the folds, as groups: those whose other
+    /// short edges and nearby points the last resorts try.
+    fn crossing_groups(&self) -> impl Iterator<Item = Vec<usize>> + '_ {
+        let crossings = self.crossings.iter().map(|&(a, b)| vec![a, b]);
+        crossings.chain(self.folds.iter().map(|f| f.triangles.clone()))
+    }
 }
 
 /// The result triangles while [`finish`] repairs them: the soup, each triangle's origin
@@ -456,14 +530,44 @@ impl Cleanup {
         v >= self.first_new
     }
 
-    /// The changed triangles that cross another, and those without area.
-    fn defects(&self) -> (Vec<(usize, usize)>, Vec<usize>) {
-        let crossings = soup_self_intersections_near(&self.soup, &self.changed, usize::MAX);
-        let flat: Vec<usize> = (0..self.soup.triangles.len())
-            .into_par_iter()
-            .filter(|&t| self.changed[t] && is_degenerate(self.soup.triangle(t)))
-            .collect();
-        (crossings, flat)
+    /// The measures of the pieces [`Cleanup::drop_pieces`] drops, for [`count_near`].
+    fn pieces(&self) -> Pieces {
+        Some((self.limit, self.thickness))
+    }
+
+    /// The changed triangles that cross another, those without area, and the edges with a
+    /// changed triangle around which the triangles do not alternate in direction (uncut
+    /// input triangles alone are as exact as the operands).
+    fn defects(&self) -> Defects {
+        let ((crossings, flat), folds) = rayon::join(
+            || {
+                let crossings = soup_self_intersections_near(&self.soup, &self.changed, usize::MAX);
+                let flat: Vec<usize> = (0..self.soup.triangles.len())
+                    .into_par_iter()
+                    .filter(|&t| self.changed[t] && is_degenerate(self.soup.triangle(t)))
+                    .collect();
+                (crossings, flat)
+            },
+            || {
+                let changed = |on: &[usize]| on.iter().any(|&t| self.changed[t]);
+                folded_edges(&self.soup.positions, &self.soup.triangles, changed)
+            },
+        );
+        Defects { crossings, flat, folds }
+    }
+
+    /// The error to give for the first of the defects found.
+    fn first_error(&self, found: &Defects) -> InvalidResult {
+        if let Some(x) = found.crossings.first() {
+            return self.crossing(x);
+        }
+        if let Some(&f) = found.flat.first() {
+            return self.flat_face(f);
+        }
+        let near = found.folds.first().map_or(DVec3::ZERO, |f| {
+            (self.soup.positions[f.a as usize] + self.soup.positions[f.b as usize]) / 2.0
+        });
+        InvalidResult::Folded { near }
     }
 
     fn crossing(&self, &(a, b): &(usize, usize)) -> InvalidResult {
@@ -475,9 +579,8 @@ impl Cleanup {
     }
 
     /// Snaps the points near the defects' corners together; true when any moved.
-    fn snap(&mut self, crossings: &[(usize, usize)], flat: &[usize]) -> bool {
-        let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
-        let map = snap_map(&self.soup, corners, self.snap);
+    fn snap(&mut self, found: &Defects) -> bool {
+        let map = snap_map(&self.soup, found.faces(), self.snap);
         if map.is_empty() {
             return false;
         }
@@ -522,10 +625,11 @@ impl Cleanup {
     }
 
     /// Per defect, the shortest collapsible edge of its triangles, or the defect set
-    /// aside (with the first such crossing as the error to give).
-    fn plan(&self, crossings: &[(usize, usize)], flat: &[usize]) -> Plan {
+    /// aside (with the first such crossing as the error to give; a folded edge without one
+    /// is left to the stages past the collapses).
+    fn plan(&self, found: &Defects) -> Plan {
         let mut plan = Plan { edges: Vec::new(), wide: Vec::new(), long_flat: Vec::new(), stuck: None };
-        for c in crossings {
+        for c in &found.crossings {
             match self.shortest_edge(&[c.0, c.1]) {
                 Some(e) => plan.edges.push(e),
                 None => {
@@ -534,12 +638,13 @@ impl Cleanup {
                 }
             }
         }
-        for &f in flat {
+        for &f in &found.flat {
             match self.shortest_edge(&[f]) {
                 Some(e) => plan.edges.push(e),
                 None => plan.long_flat.push(f),
             }
         }
+        plan.edges.extend(found.folds.iter().filter_map(|f| self.shortest_edge(&f.triangles)));
         plan
     }
 
@@ -620,7 +725,7 @@ impl Cleanup {
                 if !(both || f.opposed) || f.removed.iter().any(|&t| gone[t]) {
                     continue;
                 }
-                let (before, after) = local_rebuild(&self.soup, &boxes, &f);
+                let (before, after) = local_rebuild(&self.soup, &boxes, &f, self.pieces());
                 if after >= before {
                     continue;
                 }
@@ -683,8 +788,8 @@ impl Cleanup {
             let mut used = HashSet::new();
             used.extend(edit.soup.triangles.iter().flatten().copied());
             let present: Vec<u32> = edit.at.iter().copied().filter(|v| used.contains(v)).collect();
-            let before = local_defects(&self.soup, boxes, &edit.at, same).0;
-            let after = local_defects(&edit.soup, &edit.soup.boxes(), &present, same).0;
+            let before = local_defects(&self.soup, boxes, &edit.at, self.pieces(), same).0;
+            let after = local_defects(&edit.soup, &edit.soup.boxes(), &present, self.pieces(), same).0;
             if after < before {
                 for (&gone, &keep) in &edit.snaps {
                     let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
@@ -793,15 +898,15 @@ impl Cleanup {
         })
     }
 
-    /// The last resort for crossings past the sheets: any edge of either triangle at most
-    /// `limit` long, not only the shortest ([`Cleanup::plan`]), shortest first, collapsed
-    /// the way that leaves the fewest crossings and triangles without area around it
+    /// The last resort for crossings (and folded edges) past the sheets: any edge of their
+    /// triangles at most `limit` long, not only the shortest ([`Cleanup::plan`]), shortest
+    /// first, collapsed the way that leaves the fewest defects around it
     /// ([`Cleanup::collapse_way`], as a round's collapses), where that is fewer than before.
     /// True when one was.
-    fn collapse_longer(&mut self, crossings: &[(usize, usize)]) -> bool {
+    fn collapse_longer(&mut self, found: &Defects) -> bool {
         let boxes = self.soup.boxes();
-        for &(a, b) in crossings {
-            let edges: Vec<(f64, u32, u32)> = [a, b]
+        for faces in found.crossing_groups() {
+            let edges: Vec<(f64, u32, u32)> = faces
                 .iter()
                 .flat_map(|&f| {
                     let t = self.soup.triangles[f];
@@ -835,8 +940,8 @@ impl Cleanup {
         false
     }
 
-    /// The last resort past the joined sheets: a corner of a crossing triangle and any point
-    /// at most `limit` from it, not only along the crossing triangles' own edges
+    /// The last resort past the joined sheets: a corner of a crossing triangle (or of one
+    /// around a folded edge) and any point at most `limit` from it, not only along the crossing triangles' own edges
     /// ([`Cleanup::collapse_longer`]): one it shares no edge with (the two operands'
     /// vertices and the cut a hair apart, where a needle of one lies along a needle of the
     /// other) or an edge of triangles beside them (a corner of a face and of its reversed
@@ -844,11 +949,11 @@ impl Cleanup {
     /// first, merged the way that leaves the fewest crossings and triangles without
     /// area around it ([`Cleanup::collapse_way`]), where that is fewer than before. True
     /// when one was.
-    fn merge_near(&mut self, crossings: &[(usize, usize)]) -> bool {
+    fn merge_near(&mut self, found: &Defects) -> bool {
         let boxes = self.soup.boxes();
         let grid = UsedGrid::new(&self.soup, self.limit);
-        for &(a, b) in crossings {
-            let mut corners: Vec<u32> = [a, b].iter().flat_map(|&f| self.soup.triangles[f]).collect();
+        for faces in found.crossing_groups() {
+            let mut corners: Vec<u32> = faces.iter().flat_map(|&f| self.soup.triangles[f]).collect();
             corners.sort_unstable();
             corners.dedup();
             let positions = &self.soup.positions;
@@ -868,6 +973,83 @@ impl Cleanup {
             }
         }
         false
+    }
+
+    /// Folded edges that no snap or collapse removed: a closed piece on such an edge — its
+    /// triangles joined to each other across edges of exactly two triangles, every edge of
+    /// it balanced among its own, so that it hangs on the rest only by edges of more than
+    /// two — that holds no volume worth keeping, by the measures a shell left by a repair is
+    /// dropped by ([`Shape::is_leftover`]: no wider than the longest edge a collapse
+    /// removes, or thinner on average than a flat region), is dropped where that leaves
+    /// fewer defects around it (rounding turned it inside out, or left it beside a part
+    /// facing its way). Smallest volume first, none sharing a point with one dropped
+    /// before (so each is judged on the triangles around it as they stay). Removing a
+    /// closed piece leaves every other edge balanced. True when any was.
+    fn drop_pieces(&mut self, folds: &[Fold]) -> bool {
+        if folds.is_empty() {
+            return false;
+        }
+        let by_edge = edge_faces(&self.soup);
+        let mut seen = HashSet::new();
+        let mut pieces: Vec<(f64, Vec<usize>)> = Vec::new();
+        for &t in folds.iter().flat_map(|f| &f.triangles) {
+            if seen.contains(&t) {
+                continue;
+            }
+            let Some(piece) = hanging_piece(&self.soup, &by_edge, t) else {
+                continue;
+            };
+            seen.extend(piece.iter().copied());
+            let shape = Shape::of(&self.soup, &piece);
+            if shape.is_leftover(self.limit, self.thickness) {
+                pieces.push((shape.volume.abs(), piece));
+            }
+        }
+        pieces.sort_by(|x, y| x.0.total_cmp(&y.0).then_with(|| x.1.cmp(&y.1)));
+        let boxes = self.soup.boxes();
+        let mut busy = HashSet::new();
+        let mut gone = vec![false; self.soup.triangles.len()];
+        for (_, piece) in pieces {
+            let mut at: Vec<u32> = piece.iter().flat_map(|&t| self.soup.triangles[t]).collect();
+            at.sort_unstable();
+            at.dedup();
+            if at.iter().any(|v| busy.contains(v)) {
+                continue;
+            }
+            let (before, after) =
+                local_defects(&self.soup, &boxes, &at, None, |sub, origin, changed, local| {
+                    // The piece's triangles in the sub-soup, by their corners.
+                    let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
+                    let mut removed: HashMap<[u32; 3], usize> = HashMap::new();
+                    for &t in &piece {
+                        if let [Some(a), Some(b), Some(c)] = self.soup.triangles[t].map(id) {
+                            *removed.entry([a, b, c]).or_default() += 1;
+                        }
+                    }
+                    let marked: Vec<bool> = sub
+                        .triangles
+                        .iter()
+                        .map(|t| match removed.get_mut(t) {
+                            Some(n) if *n > 0 => {
+                                *n -= 1;
+                                true
+                            }
+                            _ => false,
+                        })
+                        .collect();
+                    replace_marked(sub, origin, changed, &marked, Vec::new());
+                    local.to_vec()
+                });
+            if after >= before {
+                continue;
+            }
+            busy.extend(at);
+            for &t in &piece {
+                gone[t] = true;
+            }
+            self.repair.dropped_pieces += 1;
+        }
+        self.replace(&gone, Vec::new())
     }
 
     /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
@@ -915,7 +1097,7 @@ impl Cleanup {
         };
         ways.iter()
             .filter_map(|&(keep, gone)| {
-                let (before, after) = local_crossings(&self.soup, boxes, keep, gone);
+                let (before, after) = local_crossings(&self.soup, boxes, keep, gone, self.pieces());
                 (after < before).then_some((after, keep, gone))
             })
             .min_by_key(|w| w.0)
@@ -926,20 +1108,20 @@ impl Cleanup {
     }
 
     /// Splits the edges that pass within a few ulps of a corner of the defects' triangles
-    /// ([`edge_splits`]) at that corner, each only where it leaves fewer crossings and
-    /// triangles without area around it than before (as a collapse); faces that then
-    /// coincide with opposite orientations cancel. True when any edge was split.
-    fn split_edges(&mut self, crossings: &[(usize, usize)], flat: &[usize]) -> bool {
-        let corners = crossings.iter().flat_map(|&(a, b)| [a, b]).chain(flat.iter().copied());
-        let candidates = edge_splits(&self.soup, corners, self.snap);
+    /// ([`edge_splits`]) at that corner, each only where it leaves fewer defects around it
+    /// than before (as a collapse); faces that then coincide with opposite orientations
+    /// cancel. True when any edge was split.
+    fn split_edges(&mut self, found: &Defects) -> bool {
+        let candidates = edge_splits(&self.soup, found.faces(), self.snap);
         if candidates.is_empty() {
             return false;
         }
         let boxes = self.soup.boxes();
+        let pieces = self.pieces();
         let mut chosen: Vec<((u32, u32), u32)> = candidates
             .into_par_iter()
             .filter(|&(edge, at)| {
-                let (before, after) = local_split(&self.soup, &boxes, edge, at);
+                let (before, after) = local_split(&self.soup, &boxes, edge, at, pieces);
                 after < before
             })
             .collect();
@@ -1169,6 +1351,92 @@ fn split_neighbour(soup: &TriangleSoup, by_edge: &EdgeFaces, f: usize) -> Option
         return None;
     }
     Some((g, [[b, m, c], [m, a, c]]))
+}
+
+/// The piece of triangle `seed`: the triangles joined to it across edges of exactly two
+/// triangles, where every edge of theirs is balanced among them (a closed surface of its
+/// own, hanging on the rest only by edges of more than two); `None` where it is not closed,
+/// or beyond [`hanging_piece`]'s limit (the rest of a result).
+fn hanging_piece(soup: &TriangleSoup, by_edge: &EdgeFaces, seed: usize) -> Option<Vec<usize>> {
+    /// Beyond this many triangles the search gives up: not a piece of no volume.
+    const MOST: usize = 4096;
+    let mut piece = vec![seed];
+    let mut seen = HashSet::from_iter([seed]);
+    let mut next = 0;
+    let mut balance: HashMap<(u32, u32), i32> = HashMap::new();
+    while next < piece.len() {
+        let tri = soup.triangles[piece[next]];
+        next += 1;
+        for k in 0..3 {
+            let (p, q) = (tri[k], tri[(k + 1) % 3]);
+            *balance.entry((p.min(q), p.max(q))).or_default() += if p < q { 1 } else { -1 };
+            let [x, y] = by_edge.get(&(p.min(q), p.max(q)))?.as_slice() else {
+                continue;
+            };
+            for t in [*x, *y] {
+                if seen.insert(t) {
+                    piece.push(t);
+                    if piece.len() > MOST {
+                        return None;
+                    }
+                }
+            }
+        }
+    }
+    balance.values().all(|&b| b == 0).then(|| {
+        piece.sort_unstable();
+        piece
+    })
+}
+
+/// The measures of a set of triangles by which a repair's leftover is told: the signed
+/// volume they enclose (from the centre of their own box: from one far away, the rounding
+/// of each term would outweigh a sheet's volume), their box and their area.
+struct Shape {
+    volume: f64,
+    lo: DVec3,
+    hi: DVec3,
+    area: f64,
+}
+
+impl Shape {
+    fn of(soup: &TriangleSoup, triangles: &[usize]) -> Shape {
+        let mut shape = Shape { volume: 0.0, lo: DVec3::INFINITY, hi: DVec3::NEG_INFINITY, area: 0.0 };
+        for &t in triangles {
+            shape.add(soup.triangle(t));
+        }
+        for &t in triangles {
+            shape.add_volume(soup.triangle(t));
+        }
+        shape
+    }
+
+    /// Adds a triangle to the box and the area.
+    fn add(&mut self, [a, b, c]: [DVec3; 3]) {
+        self.lo = self.lo.min(a.min(b).min(c));
+        self.hi = self.hi.max(a.max(b).max(c));
+        self.area += 0.5 * (b - a).cross(c - a).length();
+    }
+
+    /// Adds a triangle's volume, from the centre of the box (once the box is complete).
+    fn add_volume(&mut self, [a, b, c]: [DVec3; 3]) {
+        self.volume += signed_tetra_volume((self.lo + self.hi) * 0.5, a, b, c);
+    }
+
+    /// Encloses no volume by the operand rule ([`is_flat`]).
+    fn is_flat(&self) -> bool {
+        is_flat(self.volume, self.lo, self.hi)
+    }
+
+    /// What a repair leaves of a sliver: flat, no wider than `speck` (the longest edge a
+    /// repair collapses) in every direction, or a mean thickness (twice its volume over its
+    /// area) of at most `thickness` (a sheet between two nearly coincident surfaces, too
+    /// thin for f64).
+    fn is_leftover(&self, speck: f64, thickness: f64) -> bool {
+        self.is_flat()
+            || (self.hi - self.lo).max_element() <= speck
+            || 2.0 * self.volume.abs() <= thickness * self.area
+    }
 }
 
 /// The triangles on each edge (ends in increasing order).
@@ -1509,11 +1777,16 @@ fn windings(triangles: &[[u32; 3]], along: impl Fn(u32, u32) -> i32, edges: usiz
 /// Crossings and triangles without area at the corners of a flat region before and after
 /// it is rebuilt ([`flatten`]): its triangles and their neighbours against those whose
 /// boxes meet theirs.
-fn local_rebuild(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], f: &Flattened) -> (usize, usize) {
+fn local_rebuild(
+    soup: &TriangleSoup,
+    boxes: &[(DVec3, DVec3)],
+    f: &Flattened,
+    pieces: Pieces,
+) -> (usize, usize) {
     let mut at: Vec<u32> = f.removed.iter().flat_map(|&t| soup.triangles[t]).collect();
     at.sort_unstable();
     at.dedup();
-    local_defects(soup, boxes, &at.clone(), |sub, origin, changed, local| {
+    local_defects(soup, boxes, &at.clone(), pieces, |sub, origin, changed, local| {
         let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
         // The region's triangles in the sub-soup, by their corners.
         let mut removed: HashMap<[u32; 3], usize> = HashMap::new();
@@ -1548,9 +1821,15 @@ fn local_rebuild(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], f: &Flattened) -
 
 /// Crossings and triangles without area at `gone` and `keep` before and after `gone`
 /// collapses onto `keep`: their triangles against those whose boxes meet theirs.
-fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gone: u32) -> (usize, usize) {
+fn local_crossings(
+    soup: &TriangleSoup,
+    boxes: &[(DVec3, DVec3)],
+    keep: u32,
+    gone: u32,
+    pieces: Pieces,
+) -> (usize, usize) {
     // The collapse moves the triangles at `gone` towards `keep`, inside their box.
-    local_defects(soup, boxes, &[keep, gone], |sub, origin, changed, local| {
+    local_defects(soup, boxes, &[keep, gone], pieces, |sub, origin, changed, local| {
         let (k, g) = (local[0], local[1]);
         collapse(sub, origin, changed, &HashMap::from_iter([(g, k)]), true, &mut Repair::default());
         vec![k]
@@ -1560,8 +1839,14 @@ fn local_crossings(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], keep: u32, gon
 /// Crossings and triangles without area at the ends of `edge` and at `at` before and after
 /// the edge is split at `at` (and faces that then coincide with opposite orientations
 /// cancel): their triangles against those whose boxes meet theirs.
-fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), at: u32) -> (usize, usize) {
-    local_defects(soup, boxes, &[edge.0, edge.1, at], |sub, origin, changed, local| {
+fn local_split(
+    soup: &TriangleSoup,
+    boxes: &[(DVec3, DVec3)],
+    edge: (u32, u32),
+    at: u32,
+    pieces: Pieces,
+) -> (usize, usize) {
+    local_defects(soup, boxes, &[edge.0, edge.1, at], pieces, |sub, origin, changed, local| {
         let (p, q) = (local[0], local[1]);
         let splits = HashMap::from_iter([((p.min(q), p.max(q)), local[2])]);
         split_edges(sub, origin, changed, &splits);
@@ -1570,13 +1855,16 @@ fn local_split(soup: &TriangleSoup, boxes: &[(DVec3, DVec3)], edge: (u32, u32), 
     })
 }
 
-/// Crossings and triangles without area at the points `at` before and after `edit`, made
-/// on the triangles whose boxes meet the box of those at `at` (as a soup of their own:
-/// `edit` gets it with the points' ids in it, and returns the points to count at after).
+/// Defects at the points `at` before and after `edit` ([`found_near`]: crossings,
+/// triangles without area and folded edges; with `pieces`, each count as it is once the
+/// pieces of no volume hanging on its folded edges are dropped, [`count_near`]), made on
+/// the triangles whose boxes meet the box of those at `at` (as a soup of their own: `edit`
+/// gets it with the points' ids in it, and returns the points to count at after).
 fn local_defects(
     soup: &TriangleSoup,
     boxes: &[(DVec3, DVec3)],
     at: &[u32],
+    pieces: Pieces,
     edit: impl FnOnce(&mut TriangleSoup, &mut Vec<u32>, &mut Vec<bool>, &[u32]) -> Vec<u32>,
 ) -> (usize, usize) {
     let around: HashSet<u32> = at.iter().copied().collect();
@@ -1586,8 +1874,7 @@ fn local_defects(
     let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
     let count = |sub: &TriangleSoup, at: &[u32]| {
         let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
-        let flat = (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).count();
-        soup_self_intersections_near(sub, &near, usize::MAX).len() + flat
+        count_near(sub, &near, pieces)
     };
     let local: Vec<u32> = at.iter().map(|v| ids[v]).collect();
     let before = count(&sub, &local);
@@ -1595,6 +1882,77 @@ fn local_defects(
     let mut changed = vec![true; sub.triangles.len()];
     let after = edit(&mut sub, &mut origin, &mut changed, &local);
     (before, count(&sub, &after))
+}
+
+/// The measures of a piece a repair may drop, (speck, thickness) as in [`Shape::is_leftover`],
+/// where defects are counted as they are once the pieces of no volume hanging on folded
+/// edges are dropped ([`count_near`]); `None` to count them as they are.
+type Pieces = Option<(f64, f64)>;
+
+/// How many defects [`found_near`] finds; with `pieces`, the fewer of that and of those left
+/// once every closed piece of no volume on one of its folded edges ([`hanging_piece`],
+/// [`Shape::is_leftover`]) is dropped, as [`Cleanup::drop_pieces`] drops them: an edit that
+/// leaves such a piece turned inside out (a collapse that removes a crossing beside a
+/// sliver) is judged by what the repair makes of it, and so is the state before it.
+fn count_near(sub: &TriangleSoup, near: &[bool], pieces: Pieces) -> usize {
+    let found = found_near(sub, near);
+    let Some((speck, thickness)) = pieces else {
+        return found.len();
+    };
+    if !found.iter().any(|d| matches!(d, Local::Folded(..))) {
+        return found.len();
+    }
+    let folds = folded_edges(&sub.positions, &sub.triangles, |on| on.iter().any(|&t| near[t]));
+    let by_edge = edge_faces(sub);
+    let mut gone = vec![false; sub.triangles.len()];
+    for &t in folds.iter().flat_map(|f| &f.triangles) {
+        if gone[t] {
+            continue;
+        }
+        if let Some(piece) = hanging_piece(sub, &by_edge, t)
+            && Shape::of(sub, &piece).is_leftover(speck, thickness)
+        {
+            for p in piece {
+                gone[p] = true;
+            }
+        }
+    }
+    if !gone.contains(&true) {
+        return found.len();
+    }
+    let mut rest = sub.clone();
+    let (mut origin, mut changed) = (vec![0; sub.triangles.len()], vec![true; sub.triangles.len()]);
+    let near_rest: Vec<bool> = near.iter().zip(&gone).filter(|(_, g)| !**g).map(|(n, _)| *n).collect();
+    replace_marked(&mut rest, &mut origin, &mut changed, &gone, Vec::new());
+    found.len().min(found_near(&rest, &near_rest).len())
+}
+
+/// A defect [`found_near`] counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Local {
+    /// Two triangles that cross.
+    Crossing(usize, usize),
+    /// A triangle without area.
+    Flat(usize),
+    /// An edge around which the triangles do not alternate in direction.
+    Folded(u32, u32),
+}
+
+/// The defects of `sub` at the triangles marked `near`, in order: pairs with such a
+/// triangle that cross, such triangles without area, and edges of such triangles around
+/// which the triangles do not alternate in direction ([`folded_edges`]: every triangle on
+/// an edge of a triangle in `sub` whose corners lie in the box it was cut out for is in it
+/// too, so the test sees all of them).
+fn found_near(sub: &TriangleSoup, near: &[bool]) -> Vec<Local> {
+    let crossings = soup_self_intersections_near(sub, near, usize::MAX);
+    let mut found: Vec<Local> = crossings.into_iter().map(|(a, b)| Local::Crossing(a, b)).collect();
+    found.extend(
+        (0..sub.triangles.len()).filter(|&t| near[t] && is_degenerate(sub.triangle(t))).map(Local::Flat),
+    );
+    let folds = folded_edges(&sub.positions, &sub.triangles, |on| on.iter().any(|&t| near[t]));
+    found.extend(folds.into_iter().map(|f| Local::Folded(f.a, f.b)));
+    found.sort_unstable();
+    found
 }
 
 /// The triangles of `soup` whose boxes meet the box `lo`..`hi`, as a soup of their own
@@ -1661,21 +2019,21 @@ fn neighbour_positions(p: DVec3) -> Vec<DVec3> {
         .collect()
 }
 
-/// The last resort for crossings (and triangles without area) that no snap or collapse
-/// removed: rounding put them there by an ulp, so one of the intersection points among
-/// their corners (ids from `first_new` on) goes to a neighbouring f64 position
+/// The last resort for crossings (and triangles without area, and folded edges) that no
+/// snap or collapse removed: rounding put them there by an ulp, so one of the intersection
+/// points among their corners (ids from `first_new` on) goes to a neighbouring f64 position
 /// ([`neighbour_positions`], nearest first) — the first one after which, by the exact
-/// tests over the triangles at that point against those whose boxes meet theirs, no
-/// triangle there crosses another or has no area; failing that, the first one after which
-/// fewer do and none that did not before. Never onto another point's position (the file
+/// tests over the triangles at that point against those whose boxes meet theirs
+/// ([`found_near`]), no triangle there crosses another or has no area and no edge there is
+/// folded; failing that, the first one after which fewer defects are left and none that
+/// was not there before. Never onto another point's position (the file
 /// read back would make them one). The topology does not change, so the result stays
 /// closed and oriented. True when a point moved (the caller checks everything again).
 /// A point for which no position was found, with the same triangles around it as then
 /// (`unmoved`), is not tried again: the tests would give the same answer.
 fn nudge(
     soup: &mut TriangleSoup,
-    crossings: &[(usize, usize)],
-    flat: &[usize],
+    found: &Defects,
     first_new: u32,
     unmoved: &mut Unmoved,
     repair: &mut Repair,
@@ -1691,8 +2049,7 @@ fn nudge(
     }
     let mut boxes = soup.boxes();
     let mut moved = HashSet::new();
-    let defects = crossings.iter().map(|&(a, b)| vec![a, b]).chain(flat.iter().map(|&f| vec![f]));
-    for faces in defects {
+    for faces in found.groups() {
         let mut corners: Vec<u32> =
             faces.iter().flat_map(|&f| soup.triangles[f]).filter(|&v| v >= first_new).collect();
         corners.sort_unstable();
@@ -1714,16 +2071,7 @@ fn nudge(
             }
             let at = ids[&v];
             let near: Vec<bool> = sub.triangles.iter().map(|t| t.contains(&at)).collect();
-            let defects = |sub: &TriangleSoup| {
-                let mut found: Vec<(usize, usize)> = soup_self_intersections_near(sub, &near, usize::MAX);
-                found.extend(
-                    (0..sub.triangles.len())
-                        .filter(|&t| near[t] && is_degenerate(sub.triangle(t)))
-                        .map(|t| (t, t)),
-                );
-                found.sort_unstable();
-                found
-            };
+            let defects = |sub: &TriangleSoup| found_near(sub, &near);
             let before = defects(&sub);
             if before.is_empty() {
                 continue; // an earlier move here removed them
@@ -1894,30 +2242,22 @@ fn drop_flat_shells(
         sets.union(t[0], t[1]);
         sets.union(t[0], t[2]);
     }
-    // Per shell root: volume, box and area; the volume from the centre of the shell's own
-    // box (from one far away, the rounding of each term would outweigh a sheet's volume).
-    let mut shells: HashMap<u32, (f64, DVec3, DVec3, f64)> = HashMap::new();
+    // Per shell root: its volume, box and area.
+    let mut shells: HashMap<u32, Shape> = HashMap::new();
     let roots: Vec<u32> = soup.triangles.iter().map(|t| sets.find(t[0])).collect();
-    for (t, &r) in soup.triangles.iter().zip(&roots) {
-        let [a, b, c] = t.map(|v| soup.positions[v as usize]);
-        let e = shells.entry(r).or_insert((0.0, DVec3::INFINITY, DVec3::NEG_INFINITY, 0.0));
-        e.1 = e.1.min(a.min(b).min(c));
-        e.2 = e.2.max(a.max(b).max(c));
-        e.3 += 0.5 * (b - a).cross(c - a).length();
+    let empty = || Shape { volume: 0.0, lo: DVec3::INFINITY, hi: DVec3::NEG_INFINITY, area: 0.0 };
+    for (t, &r) in roots.iter().enumerate() {
+        shells.entry(r).or_insert_with(empty).add(soup.triangle(t));
     }
-    for (t, &r) in soup.triangles.iter().zip(&roots) {
-        let [a, b, c] = t.map(|v| soup.positions[v as usize]);
-        if let Some(e) = shells.get_mut(&r) {
-            e.0 += signed_tetra_volume((e.1 + e.2) * 0.5, a, b, c);
+    for (t, r) in roots.iter().enumerate() {
+        if let Some(shell) = shells.get_mut(r) {
+            shell.add_volume(soup.triangle(t));
         }
     }
     let flat: HashSet<u32> = shells
         .iter()
         .filter(|(_, s)| {
-            is_flat(s.0, s.1, s.2)
-                || leftovers.is_some_and(|(speck, thickness)| {
-                    (s.2 - s.1).max_element() <= speck || 2.0 * s.0.abs() <= thickness * s.3
-                })
+            s.is_flat() || leftovers.is_some_and(|(speck, thickness)| s.is_leftover(speck, thickness))
         })
         .map(|(&r, _)| r)
         .collect();
@@ -1927,8 +2267,8 @@ fn drop_flat_shells(
         retain_marked(&mut soup.triangles, &keep);
         retain_marked(origin, &keep);
     }
-    let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.0).sum();
-    let bound = flatness_bound(shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| (s.1, s.2)));
+    let volume: f64 = shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| s.volume).sum();
+    let bound = flatness_bound(shells.iter().filter(|(r, _)| !flat.contains(r)).map(|(_, s)| (s.lo, s.hi)));
     if !soup.triangles.is_empty() && volume.abs() <= bound {
         return Err(InvalidResult::NoVolume { volume });
     }

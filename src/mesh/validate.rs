@@ -204,26 +204,52 @@ pub fn edge_defects(triangles: &[[u32; 3]]) -> (usize, usize) {
     (boundary, misoriented)
 }
 
-/// The first edge of `triangles` (over `positions`), balanced and of more than two
-/// triangles, around which they do not alternate in direction
-/// ([`super::covering::FoldedEdge`]): the exact check of a Boolean result that nothing
-/// moved after rounding, beside its closure test.
-pub fn folded_edge(positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<(u32, u32)> {
+/// An edge of triangles around which they do not alternate in direction
+/// ([`super::covering::FoldedEdge`]), with the triangles on it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fold {
+    pub a: u32,
+    pub b: u32,
+    /// The triangles on the edge (indices into the triangles given).
+    pub triangles: Vec<usize>,
+}
+
+/// Every edge of `triangles` (over `positions`), balanced and of more than two triangles,
+/// around which they do not alternate in direction in their exact order about it
+/// ([`super::covering::folds`], the operand check's test), among those whose triangles
+/// `consider` accepts; in increasing order of their ends. Only edges of more than two
+/// triangles are tested: the walk over the others is the closure test's.
+pub fn folded_edges(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    consider: impl Fn(&[usize]) -> bool,
+) -> Vec<Fold> {
     let half_edges = HalfEdges::of_triangles(triangles, positions.len());
-    half_edges.edges().find_map(|(lo, hi, run)| {
-        if run.len() <= 2 || 2 * half_edges.forward(lo, run) != run.len() {
-            return None;
-        }
-        let uses: Vec<(DVec3, bool)> = run
-            .iter()
-            .map(|&item| {
-                let c = corner(item);
-                let (t, k) = (c / 3, c % 3);
-                (positions[triangles[t][(k + 2) % 3] as usize], triangles[t][k] as usize == lo)
+    half_edges
+        .edges()
+        .filter_map(|(lo, hi, run)| {
+            if run.len() <= 2 || 2 * half_edges.forward(lo, run) != run.len() {
+                return None;
+            }
+            let on: Vec<usize> = run.iter().map(|&item| corner(item) / 3).collect();
+            if !consider(&on) {
+                return None;
+            }
+            let uses: Vec<(DVec3, bool)> = run
+                .iter()
+                .map(|&item| {
+                    let c = corner(item);
+                    let (t, k) = (c / 3, c % 3);
+                    (positions[triangles[t][(k + 2) % 3] as usize], triangles[t][k] as usize == lo)
+                })
+                .collect();
+            super::covering::folds(positions[lo], positions[hi as usize], &uses).then_some(Fold {
+                a: lo as u32,
+                b: hi,
+                triangles: on,
             })
-            .collect();
-        super::covering::folds(positions[lo], positions[hi as usize], &uses).then_some((lo as u32, hi))
-    })
+        })
+        .collect()
 }
 
 /// Builds the [`Report`] of `mesh`.
@@ -449,9 +475,17 @@ mod tests {
         let first = tetra([0, 1, 2, 3]);
         let second = tetra([0, 1, 4, 5]);
         let both: Vec<[u32; 3]> = first.iter().chain(&second).copied().collect();
-        assert_eq!(folded_edge(&positions, &both), None);
+        let folded = |tris: &[[u32; 3]]| -> Vec<(u32, u32)> {
+            folded_edges(&positions, tris, |_| true).iter().map(|f| (f.a, f.b)).collect()
+        };
+        assert_eq!(folded(&both), []);
         let inverted: Vec<[u32; 3]> =
             first.iter().copied().chain(second.iter().map(|&[a, b, c]| [a, c, b])).collect();
-        assert_eq!(folded_edge(&positions, &inverted), Some((0, 1)));
+        assert_eq!(folded(&inverted), [(0, 1)]);
+        // The triangles on it, and only those its filter accepts.
+        let on = folded_edges(&positions, &inverted, |_| true).remove(0).triangles;
+        assert_eq!(on.len(), 4);
+        assert!(on.iter().all(|&t| inverted[t].contains(&0) && inverted[t].contains(&1)));
+        assert!(folded_edges(&positions, &inverted, |on| on.contains(&100)).is_empty());
     }
 }

@@ -212,6 +212,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "tested": r.tested,
         "crossings": r.crossings,
         "flat_triangles": r.flat_triangles,
+        "folded_edges": r.folded_edges,
         "snapped": r.snapped,
         "split_edges": r.split_edges,
         "ulp_moves": r.ulp_moves,
@@ -225,6 +226,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "sheet_triangles": r.sheet_triangles,
         "joined_sheets": r.joined_sheets,
         "dropped_shells": r.dropped_shells,
+        "dropped_pieces": r.dropped_pieces,
         "moved": r.moved,
     })
 }
