@@ -461,18 +461,27 @@ pub(crate) fn folds(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> bool {
     // Angles about the axis a→b from the first use's half-plane: (half, position),
     // half 0 for [0, π), 1 for [π, 2π); a point off the common plane tells the two
     // sides of the axis apart for corners in the first use's plane.
+    // Each sign is taken once (the reference's own is 0): on a result's cut curve every
+    // edge has four faces, and a sign of coinciding points is one the filter cannot give.
     let reference = uses[0].0;
-    let Some(off) = uses.iter().map(|u| u.0).find(|&t| orient3d(a, b, reference, t) != 0) else {
+    let signs: Vec<_> = uses
+        .iter()
+        .enumerate()
+        .map(|(i, u)| if i == 0 { 0 } else { orient3d(a, b, reference, u.0) })
+        .collect();
+    let Some(k) = signs.iter().position(|&s| s != 0) else {
         return false;
     };
-    let side = |t: DVec3| orient3d(a, b, off, t);
-    let half = |t: DVec3| match orient3d(a, b, reference, t) {
-        0 if side(t) == side(reference) => 0,
+    let off = uses[k].0;
+    let side_of_reference = orient3d(a, b, off, reference);
+    let half = |i: usize| match signs[i] {
+        0 if i == 0 || orient3d(a, b, off, uses[i].0) == side_of_reference => 0,
         0 => 1,
         s if s > 0 => 0,
         _ => 1,
     };
-    let mut order: Vec<(u8, DVec3, bool)> = uses.iter().map(|&(t, f)| (half(t), t, f)).collect();
+    let mut order: Vec<(u8, DVec3, bool)> =
+        uses.iter().enumerate().map(|(i, &(t, f))| (half(i), t, f)).collect();
     let mut tie = false;
     order.sort_by(|x, y| {
         x.0.cmp(&y.0).then_with(|| match orient3d(a, b, x.1, y.1) {
