@@ -91,9 +91,10 @@
 //! diagonal, or thinner on average than a flat region), is dropped where that leaves fewer
 //! defects around it, once no collapse applies ([`Cleanup::drop_pieces`]). Every "fewer
 //! defects around it" above counts crossings, faces without area and folded edges
-//! together, each side as it is once such pieces on its folded edges are dropped
-//! ([`count_near`]): a collapse that removes a crossing and leaves a sliver beside it
-//! turned inside out is judged by what the repair then makes of it.
+//! together; but for the ulp moves' and the drops' own tests, each side is counted as it is
+//! once such pieces on its folded edges are dropped ([`count_near`]): a collapse that
+//! removes a crossing and leaves a sliver beside it turned inside out is judged by what the
+//! repair then makes of it.
 
 use crate::mesh::hash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
