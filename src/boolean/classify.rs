@@ -638,75 +638,110 @@ pub const FEW_POINTS: usize = 1024;
 /// in the yz projection on the corner points, the side of the point and the normal's sign
 /// along x on the triangle's support (explicit), the ranges from certain boxes.
 pub fn ray_crossings<S: Solid>(points: &[DVec3], other: &S) -> Vec<inclusion::Class> {
-    if !S::EXPLICIT {
-        return ray_crossings_implicit(points, other);
-    }
     use crate::exact::orient2d;
-    let (order, sorted) = sorted_by_y(points);
-    let (triangles, positions) = (other.triangles(), other.rounded());
-    // Per sorted point: the winding number so far and whether the ray was degenerate.
-    let state = (0..triangles.len())
-        .into_par_iter()
-        .with_min_len(4096)
-        .fold(
-            || vec![(0i32, false); sorted.len()],
-            |mut acc, t| {
-                let [a, b, c] = triangles[t].map(|i| positions[i as usize]);
-                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-                let yz = |v: DVec3| glam::DVec2::new(v.y, v.z);
-                let (pa, pb, pc) = (yz(a), yz(b), yz(c));
-                // The triangle's normal along x (the orientation of its projection), taken
-                // once, for the first point in its projection.
-                let mut normal_x = None;
-                let first = sorted.partition_point(|p| p.y < lo.y);
-                for (k, p) in sorted.iter().enumerate().skip(first) {
-                    if p.y > hi.y {
-                        break;
-                    }
-                    if p.z < lo.z || p.z > hi.z || p.x > hi.x || acc[k].1 {
-                        continue;
-                    }
-                    let pp = yz(*p);
-                    let e = [orient2d(pa, pb, pp), orient2d(pb, pc, pp), orient2d(pc, pa, pp)];
-                    if e.contains(&1) && e.contains(&-1) {
-                        continue;
-                    }
-                    let s = *normal_x.get_or_insert_with(|| orient2d(pa, pb, pc));
-                    if s == 0 || e.contains(&0) {
-                        acc[k].1 = true;
-                        continue;
-                    }
-                    // p strictly inside the projection: the ray meets the plane once, at
-                    // t > 0 exactly when p lies on the side the normal turns away from +x.
-                    match orient3d(a, b, c, *p) {
-                        0 => acc[k].1 = true,
-                        o if o == -s => acc[k].0 += i32::from(s),
-                        _ => {}
-                    }
+    let yz = |v: DVec3| glam::DVec2::new(v.y, v.z);
+    let triangles = other.triangles();
+    let sorted = sorted_by_y(points);
+    if S::EXPLICIT {
+        let positions = other.rounded();
+        return windings(&sorted, triangles.len(), 4096, |t| {
+            let [a, b, c] = triangles[t].map(|i| positions[i as usize]);
+            let (pa, pb, pc) = (yz(a), yz(b), yz(c));
+            // The triangle's normal along x (the orientation of its projection), taken
+            // once, for the first point in its projection.
+            let mut normal_x = None;
+            let crossing = move |_: usize, p: DVec3| {
+                let pp = yz(p);
+                let e = [orient2d(pa, pb, pp), orient2d(pb, pc, pp), orient2d(pc, pa, pp)];
+                if e.contains(&1) && e.contains(&-1) {
+                    return Crossing::Apart;
                 }
-                acc
-            },
-        )
-        .reduce(|| vec![(0i32, false); sorted.len()], merge_windings);
-    classes_of(&order, &state)
+                let s = *normal_x.get_or_insert_with(|| orient2d(pa, pb, pc));
+                if s == 0 || e.contains(&0) {
+                    return Crossing::Grazing;
+                }
+                side_crossing(s, orient3d(a, b, c, p))
+            };
+            ((a.min(b).min(c), a.max(b).max(c)), crossing)
+        });
+    }
+    // Implicit corners: the edge tests on them, the plane tests on the support (explicit,
+    // in the triangle's plane and oriented like it: the same sign along x), the ranges
+    // from certain boxes.
+    const YZ: [usize; 2] = [1, 2];
+    let exact: Vec<Point> = sorted.1.iter().map(|&p| Point::explicit(p)).collect();
+    let boxes = other.boxes();
+    windings(&sorted, triangles.len(), 1024, |t| {
+        let mut corners = None;
+        let mut normal_x = None;
+        let exact = &exact;
+        let crossing = move |k: usize, p: DVec3| {
+            let [a, b, c] = corners.get_or_insert_with(|| triangles[t].map(|v| other.point(v)));
+            let pp = &exact[k];
+            let e = [
+                orient2d_implicit(YZ, a, b, pp),
+                orient2d_implicit(YZ, b, c, pp),
+                orient2d_implicit(YZ, c, a, pp),
+            ];
+            if e.contains(&1) && e.contains(&-1) {
+                return Crossing::Apart;
+            }
+            let [sa, sb, sc] = other.support(t as u32);
+            let s = *normal_x.get_or_insert_with(|| orient2d(yz(sa), yz(sb), yz(sc)));
+            if s == 0 || e.contains(&0) {
+                return Crossing::Grazing;
+            }
+            side_crossing(s, orient3d(sa, sb, sc, p))
+        };
+        (boxes[t], crossing)
+    })
 }
 
-/// [`ray_crossings`] against an operand with implicit points.
-fn ray_crossings_implicit<S: Solid>(points: &[DVec3], other: &S) -> Vec<inclusion::Class> {
-    use crate::exact::orient2d;
-    const YZ: [usize; 2] = [1, 2];
-    let (order, sorted) = sorted_by_y(points);
-    let exact: Vec<Point> = sorted.iter().map(|&p| Point::explicit(p)).collect();
-    let boxes = other.boxes();
-    let state = (0..boxes.len())
+/// What the ray from a point towards +x does at one triangle.
+enum Crossing {
+    /// Misses it.
+    Apart,
+    /// Meets an edge, a vertex or its plane (or starts on it): not decided by rays.
+    Grazing,
+    /// Crosses its interior, adding this to the winding number.
+    Through(i32),
+}
+
+/// The crossing of a ray towards +x with a triangle whose projection holds its start
+/// strictly inside: `normal_x` is the sign of the triangle's normal along x, `side` the
+/// start's side of its plane; the ray meets the plane at t > 0 exactly when the start
+/// lies on the side the normal turns away from +x.
+fn side_crossing(normal_x: crate::exact::Sign, side: crate::exact::Sign) -> Crossing {
+    match side {
+        0 => Crossing::Grazing,
+        o if o == -normal_x => Crossing::Through(i32::from(normal_x)),
+        _ => Crossing::Apart,
+    }
+}
+
+/// The classes of [`ray_crossings`] for the points as [`sorted_by_y`] gives them (their
+/// order, and the points in it): `triangle(t)` gives triangle t's box (certain to hold it)
+/// and its crossing test, called with (index among the sorted points, point) for the
+/// points in its y-range, in its z-range and not beyond its x-range, whose rays have not
+/// grazed yet.
+fn windings<T, C>(
+    (order, sorted): &(Vec<u32>, Vec<DVec3>),
+    count: usize,
+    min_len: usize,
+    triangle: T,
+) -> Vec<inclusion::Class>
+where
+    T: Fn(usize) -> ((DVec3, DVec3), C) + Sync,
+    C: FnMut(usize, DVec3) -> Crossing,
+{
+    // Per sorted point: the winding number so far and whether the ray was degenerate.
+    let state = (0..count)
         .into_par_iter()
-        .with_min_len(1024)
+        .with_min_len(min_len)
         .fold(
             || vec![(0i32, false); sorted.len()],
             |mut acc, t| {
-                let (lo, hi) = boxes[t];
-                let mut corners = None;
-                let mut normal_x = None;
+                let ((lo, hi), mut crossing) = triangle(t);
                 let first = sorted.partition_point(|p| p.y < lo.y);
                 for (k, p) in sorted.iter().enumerate().skip(first) {
                     if p.y > hi.y {
@@ -715,39 +750,17 @@ fn ray_crossings_implicit<S: Solid>(points: &[DVec3], other: &S) -> Vec<inclusio
                     if p.z < lo.z || p.z > hi.z || p.x > hi.x || acc[k].1 {
                         continue;
                     }
-                    let [a, b, c] =
-                        corners.get_or_insert_with(|| other.triangles()[t].map(|v| other.point(v)));
-                    let pp = &exact[k];
-                    let e = [
-                        orient2d_implicit(YZ, a, b, pp),
-                        orient2d_implicit(YZ, b, c, pp),
-                        orient2d_implicit(YZ, c, a, pp),
-                    ];
-                    if e.contains(&1) && e.contains(&-1) {
-                        continue;
-                    }
-                    // The support lies in the triangle's plane, oriented like it: the same
-                    // normal direction, so the same sign along x.
-                    let [sa, sb, sc] = other.support(t as u32);
-                    let s = *normal_x.get_or_insert_with(|| {
-                        let yz = |v: DVec3| glam::DVec2::new(v.y, v.z);
-                        orient2d(yz(sa), yz(sb), yz(sc))
-                    });
-                    if s == 0 || e.contains(&0) {
-                        acc[k].1 = true;
-                        continue;
-                    }
-                    match orient3d(sa, sb, sc, *p) {
-                        0 => acc[k].1 = true,
-                        o if o == -s => acc[k].0 += i32::from(s),
-                        _ => {}
+                    match crossing(k, *p) {
+                        Crossing::Apart => {}
+                        Crossing::Grazing => acc[k].1 = true,
+                        Crossing::Through(w) => acc[k].0 += w,
                     }
                 }
                 acc
             },
         )
         .reduce(|| vec![(0i32, false); sorted.len()], merge_windings);
-    classes_of(&order, &state)
+    classes_of(order, &state)
 }
 
 /// The points' order by y, and the points in it.
