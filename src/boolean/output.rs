@@ -1021,23 +1021,7 @@ impl Cleanup {
                 local_defects(&self.soup, &boxes, &at, None, |sub, origin, changed, local| {
                     // The piece's triangles in the sub-soup, by their corners.
                     let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
-                    let mut removed: HashMap<[u32; 3], usize> = HashMap::new();
-                    for &t in &piece {
-                        if let [Some(a), Some(b), Some(c)] = self.soup.triangles[t].map(id) {
-                            *removed.entry([a, b, c]).or_default() += 1;
-                        }
-                    }
-                    let marked: Vec<bool> = sub
-                        .triangles
-                        .iter()
-                        .map(|t| match removed.get_mut(t) {
-                            Some(n) if *n > 0 => {
-                                *n -= 1;
-                                true
-                            }
-                            _ => false,
-                        })
-                        .collect();
+                    let marked = copies_in(&sub.triangles, piece.iter().map(|&t| self.soup.triangles[t]), id);
                     replace_marked(sub, origin, changed, &marked, Vec::new());
                     local.to_vec()
                 });
@@ -1775,6 +1759,31 @@ fn windings(triangles: &[[u32; 3]], along: impl Fn(u32, u32) -> i32, edges: usiz
     winding.into_iter().collect()
 }
 
+/// Marks the triangles of a sub-soup (`sub`, over its local ids) that are the soup's
+/// triangles `of` (over soup ids, `id` mapping them to local ones), found by their
+/// corners in order: as many marked as there are such copies among `of`.
+fn copies_in(
+    sub: &[[u32; 3]],
+    of: impl Iterator<Item = [u32; 3]>,
+    id: impl Fn(u32) -> Option<u32>,
+) -> Vec<bool> {
+    let mut wanted: HashMap<[u32; 3], usize> = HashMap::new();
+    for t in of {
+        if let [Some(a), Some(b), Some(c)] = t.map(&id) {
+            *wanted.entry([a, b, c]).or_default() += 1;
+        }
+    }
+    sub.iter()
+        .map(|t| match wanted.get_mut(t) {
+            Some(n) if *n > 0 => {
+                *n -= 1;
+                true
+            }
+            _ => false,
+        })
+        .collect()
+}
+
 /// Crossings and triangles without area at the corners of a flat region before and after
 /// it is rebuilt ([`flatten`]): its triangles and their neighbours against those whose
 /// boxes meet theirs.
@@ -1790,23 +1799,7 @@ fn local_rebuild(
     local_defects(soup, boxes, &at.clone(), pieces, |sub, origin, changed, local| {
         let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
         // The region's triangles in the sub-soup, by their corners.
-        let mut removed: HashMap<[u32; 3], usize> = HashMap::new();
-        for &t in &f.removed {
-            if let [Some(a), Some(b), Some(c)] = soup.triangles[t].map(id) {
-                *removed.entry([a, b, c]).or_default() += 1;
-            }
-        }
-        let gone: Vec<bool> = sub
-            .triangles
-            .iter()
-            .map(|t| match removed.get_mut(t) {
-                Some(n) if *n > 0 => {
-                    *n -= 1;
-                    true
-                }
-                _ => false,
-            })
-            .collect();
+        let gone = copies_in(&sub.triangles, f.removed.iter().map(|&t| soup.triangles[t]), id);
         let added: Vec<([u32; 3], u32)> = f
             .added
             .iter()
