@@ -211,6 +211,9 @@ def main():
     ap.add_argument("--texgeo", required=True)
     ap.add_argument("--cgal", default="")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--cgal-from", default="",
+                    help="take CGAL's answers from an earlier run's results.csv instead of running it "
+                         "again (they do not depend on texgeo; pairs it lacks are skipped for CGAL)")
     ap.add_argument("--resume", action="store_true",
                     help="keep the models OUT/results.csv already holds and run only the others")
     args = ap.parse_args()
@@ -227,6 +230,9 @@ def main():
     work = os.path.join(args.out, "work")
     os.makedirs(work, exist_ok=True)
     rows = read_rows(args.out) if args.resume else []
+    if args.cgal_from and not os.path.exists(args.cgal_from):
+        sys.exit(f"boolean-compare: {args.cgal_from}: no such file")
+    earlier = cgal_answers(args.cgal_from) if args.cgal_from else None
     done = {r["model"] for r in rows}
     for name in names:
         src = os.path.join(args.corpus, name)
@@ -256,7 +262,9 @@ def main():
             b_path = os.path.join(work, f"{stem}.{tname}.B.off")
             write_off(b_path, pb, tb)
             ref, cgal_dt = ({}, None)
-            if not args.no_cgal:
+            if earlier is not None:
+                ref, cgal_dt = earlier.get((stem, len(tris), tname), ({}, None))
+            elif not args.no_cgal:
                 ref, cgal_dt = cgal_all(args.cgal, a_path, b_path, args.timeout)
             for op in ops:
                 cgal_outcome, cgal_volume = ref.get(op, ("skipped", None))
@@ -302,9 +310,20 @@ FIELDS = ["model", "triangles", "transform", "op", "tool", "outcome", "seconds",
           "rel_volume_diff", "valid", "message", "written_volume", "written_rel_volume_diff"]
 
 
-def read_rows(out):
+def cgal_answers(path):
+    """CGAL's answers in an earlier results.csv: {(model, triangles, transform): ({op: (outcome,
+    volume)}, seconds)}; the triangle count keys them to the same input."""
+    found = {}
+    for r in read_rows(os.path.dirname(path) or ".", os.path.basename(path)):
+        if r["tool"] == "cgal":
+            ref, _ = found.setdefault((r["model"], r["triangles"], r["transform"]), ({}, r["seconds"]))
+            ref[r["op"]] = (r["outcome"], r["volume"])
+    return found
+
+
+def read_rows(out, name="results.csv"):
     """The rows of an earlier run's results.csv, numbers as numbers (empty when there is none)."""
-    path = os.path.join(out, "results.csv")
+    path = os.path.join(out, name)
     if not os.path.exists(path):
         return []
     rows = []
