@@ -72,7 +72,13 @@
 //! triangles or by none (a vertex of one operand and its turned copy in the other a hair
 //! apart, where needles of both lie along each other; a corner of a face and of its
 //! reversed copy a hair off its plane), nearest first, the way a collapse goes and only
-//! where it leaves fewer defects around it ([`Repair::merged`]). A shell that encloses no
+//! where it leaves fewer defects around it ([`Repair::merged`]). Past those, the sheets
+//! once more, each with every intersection point within [`COLLAPSE`] × the diagonal of its
+//! corners merged onto them first, all at once ([`Cleanup::merged_sheets`]): where a face's
+//! plane passes within rounding of a vertex of the other operand (a result used again
+//! against the solid that cut it: its vertices were intersection points on that solid's
+//! faces), it cuts the edges at that vertex at points a hair from it, and the sheet's
+//! outline crosses itself among them. A shell that encloses no
 //! volume by the
 //! operand rule (a sliver flattened by rounding), no wider than [`COLLAPSE`] × the
 //! diagonal in every direction (a speck left of a sliver), or thinner on average (twice its
@@ -184,6 +190,11 @@ pub struct Repair {
     /// outline's splits left crossings in this one beside it (across a crease of the
     /// outline).
     pub joined_sheets: usize,
+    /// Of those sheets, the ones rebuilt with the intersection points a hair from their
+    /// corners (within [`COLLAPSE`] × the diagonal) merged onto them first, where their
+    /// outline crossed itself among such points (those merges are counted with
+    /// [`Repair::merged`]).
+    pub merged_sheets: usize,
     /// Points merged with a point a hair away, past every other repair (a corner of a
     /// crossing triangle and a point it shares no edge with, or an edge of triangles
     /// beside it: the two operands' vertices and the cut a hair apart, along needles of
@@ -213,6 +224,7 @@ impl Repair {
             && self.split_edges == 0
             && self.pockets == 0
             && self.sheets == 0
+            && self.merged_sheets == 0
             && self.flipped == 0
             && self.merged == 0
             && self.dropped_shells == 0
@@ -226,7 +238,8 @@ impl std::fmt::Display for Repair {
             f,
             "{} triangles tested, {} crossing pairs, {} triangles without area and {} folded edges after rounding, {} points snapped, \
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
-             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped, \
+             ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them, \
+             {} with the points a hair from their corners merged first), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped, \
              {} flat pieces hanging on a folded edge dropped",
             self.tested,
             self.crossings,
@@ -243,6 +256,7 @@ impl std::fmt::Display for Repair {
             self.sheets,
             self.sheet_triangles,
             self.joined_sheets,
+            self.merged_sheets,
             self.flipped,
             self.merged,
             self.dropped_shells,
@@ -335,6 +349,7 @@ pub fn finish(
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
     let (mut nudges, mut sheets, mut longer, mut joined, mut merged, mut pieces) = (0, 0, 0, 0, 0, 0);
+    let mut merged_sheets = 0;
     for round in 0.. {
         let found = c.defects();
         if round == 0 {
@@ -390,6 +405,12 @@ pub fn finish(
             // edge) merged with any point a hair away.
             if merged < ROUNDS && c.merge_near(&found) {
                 merged += 1;
+                continue;
+            }
+            // Past those, the sheets at the crossings with the intersection points a hair
+            // from their corners merged onto them first.
+            if merged_sheets < ROUNDS && c.merged_sheets(crossings) {
+                merged_sheets += 1;
                 continue;
             }
             return Err(err);
@@ -455,6 +476,10 @@ struct Cleanup {
     /// The points for which [`nudge`] found no position, with the triangles around them
     /// then: with the same triangles it finds none again.
     unmoved: Unmoved,
+    /// In [`Cleanup::merged_sheets`]: a sheet's corners take the intersection points within
+    /// `limit` of them before it is rebuilt, not the points within `snap`
+    /// ([`Cleanup::sheet_snaps`]).
+    wide: bool,
 }
 
 /// Per point, the triangles around it (as [`sub_soup`] gives them) where [`nudge`] found no
@@ -524,6 +549,7 @@ impl Cleanup {
             thickness: flat_thickness(max_abs, diagonal),
             snap: snap_distance(max_abs),
             unmoved: Unmoved::new(),
+            wide: false,
         }
     }
 
@@ -855,7 +881,7 @@ impl Cleanup {
         let mut scratch = Repair::default();
         // Corners a few ulps apart first (two that differ only across the plane are one
         // point in its projection): snapped together, as at a defect.
-        let snaps = snap_map(&soup, region.iter().copied(), self.snap);
+        let snaps = self.sheet_snaps(&soup, &region);
         collapse(&mut soup, &mut origin, &mut changed, &snaps, true, &mut scratch);
         let find = |soup: &TriangleSoup, tris: Vec<[u32; 3]>| {
             let index: HashMap<[u32; 3], usize> =
@@ -897,6 +923,53 @@ impl Cleanup {
             removed: scratch.removed_triangles,
             rebuilt,
         })
+    }
+
+    /// The snaps [`Cleanup::sheet_edit`] makes at a sheet's corners before it is rebuilt:
+    /// every point within `snap` (per coordinate) of one of them onto the lowest id of its
+    /// cluster ([`snap_map`]); in [`Cleanup::merged_sheets`], every intersection point within
+    /// `limit` of one of them, the same way, where that moves it at most `limit` (input
+    /// vertices stay).
+    fn sheet_snaps(&self, soup: &TriangleSoup, region: &[usize]) -> HashMap<u32, u32> {
+        if !self.wide {
+            return snap_map(soup, region.iter().copied(), self.snap);
+        }
+        let mut map = snap_map(soup, region.iter().copied(), self.limit);
+        let positions = &soup.positions;
+        map.retain(|&gone, &mut keep| {
+            self.is_new(gone) && positions[gone as usize].distance(positions[keep as usize]) <= self.limit
+        });
+        map
+    }
+
+    /// The last resort past every other: the sheets at the crossings rebuilt as
+    /// [`Cleanup::join_sheets`] rebuilds them, each with every intersection point within
+    /// `limit` of its corners merged onto them first, all at once ([`Cleanup::sheet_snaps`];
+    /// the lowest id of a cluster stays: an input vertex where it has one).
+    ///
+    /// Where a face's plane passes within rounding of a vertex of the other operand — in a
+    /// result used again against the solid that cut it, whose vertices were intersection
+    /// points on that solid's faces, rounded — the plane cuts every edge at that vertex at a
+    /// point a hair from it, at a grazing angle. Rounded, those points and the vertex lie in
+    /// any order in the sheet's plane, its outline crosses itself among them, and the
+    /// sheet cannot be rebuilt; merging any one of them alone leaves the outline crossing
+    /// ([`Cleanup::merge_near`] finds no merge that leaves fewer defects). Merged
+    /// together, they are one corner and the outline is a simple one. Each merge moves an
+    /// intersection point at most `limit`, as a collapse does, and keeps every directed edge
+    /// balanced (the result stays closed and oriented); the rebuild changes the volume by no
+    /// more than the operand rule's flatness ([`flatten`]); and the whole edit is made only
+    /// where it leaves fewer defects at the sheet's corners than before, as every edit past
+    /// the collapses. True when one was made.
+    fn merged_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
+        let before = self.repair;
+        self.wide = true;
+        let done = self.join_sheets(crossings);
+        self.wide = false;
+        // The edit's snaps are merges of points a hair apart, not of points a few ulps apart.
+        self.repair.merged += self.repair.snapped - before.snapped;
+        self.repair.snapped = before.snapped;
+        self.repair.merged_sheets += self.repair.sheets - before.sheets;
+        done
     }
 
     /// The last resort for crossings (and folded edges) past the sheets: any edge of their

@@ -225,6 +225,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "sheets": r.sheets,
         "sheet_triangles": r.sheet_triangles,
         "joined_sheets": r.joined_sheets,
+        "merged_sheets": r.merged_sheets,
         "dropped_shells": r.dropped_shells,
         "dropped_pieces": r.dropped_pieces,
         "moved": r.moved,
