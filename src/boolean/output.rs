@@ -954,7 +954,8 @@ impl Cleanup {
     /// any order in the sheet's plane, its outline crosses itself among them, and the
     /// sheet cannot be rebuilt; merging any one of them alone leaves the outline crossing
     /// ([`Cleanup::merge_near`] finds no merge that leaves fewer defects). Merged
-    /// together, they are one corner and the outline is a simple one. Each merge moves an
+    /// together, they are one corner, and the outline no longer crosses itself there (where
+    /// it still does, the sheet is not rebuilt and nothing is made). Each merge moves an
     /// intersection point at most `limit`, as a collapse does, and keeps every directed edge
     /// balanced (the result stays closed and oriented); the rebuild changes the volume by no
     /// more than the operand rule's flatness ([`flatten`]); and the whole edit is made only
