@@ -109,7 +109,7 @@ use rayon::prelude::*;
 
 use super::input::{flatness_bound, is_flat};
 use crate::exact::orient2d;
-use crate::mesh::boxgrid::{Box3, box_pairs};
+use crate::mesh::boxgrid::{Box3, BoxIndex, box_pairs};
 use crate::mesh::covering::signed_tetra_volume;
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
@@ -736,7 +736,7 @@ impl Cleanup {
     /// and triangles without area around it ([`local_rebuild`]). True when any was.
     fn rebuild_sheets(&mut self, crossings: &[(usize, usize)], keep: bool) -> bool {
         let by_edge = edge_faces(&self.soup);
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         let mut gone = vec![false; self.soup.triangles.len()];
         let mut added = Vec::new();
         for &(a, b) in crossings {
@@ -780,7 +780,7 @@ impl Cleanup {
         /// Sheets rebuilt after the first where the one before left crossings beside it.
         const JOINED: usize = 3;
         let by_edge = edge_faces(&self.soup);
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         [false, true].into_iter().any(|keep| {
             crossings.iter().any(|&(a, b)| {
                 [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, JOINED))
@@ -800,7 +800,7 @@ impl Cleanup {
     fn split_sheet(
         &mut self,
         by_edge: &EdgeFaces,
-        boxes: &[(DVec3, DVec3)],
+        boxes: &BoxIndex,
         seed: usize,
         keep: bool,
         most: usize,
@@ -816,7 +816,8 @@ impl Cleanup {
             used.extend(edit.soup.triangles.iter().flatten().copied());
             let present: Vec<u32> = edit.at.iter().copied().filter(|v| used.contains(v)).collect();
             let before = local_defects(&self.soup, boxes, &edit.at, self.pieces(), same).0;
-            let after = local_defects(&edit.soup, &edit.soup.boxes(), &present, self.pieces(), same).0;
+            let after =
+                local_defects(&edit.soup, &BoxIndex::new(edit.soup.boxes()), &present, self.pieces(), same).0;
             if after < before {
                 for (&gone, &keep) in &edit.snaps {
                     let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
@@ -979,7 +980,7 @@ impl Cleanup {
     /// ([`Cleanup::collapse_way`], as a round's collapses), where that is fewer than before.
     /// True when one was.
     fn collapse_longer(&mut self, found: &Defects) -> bool {
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         for faces in found.crossing_groups() {
             let edges: Vec<(f64, u32, u32)> = faces
                 .iter()
@@ -1002,7 +1003,7 @@ impl Cleanup {
 
     /// Collapses the first of `pairs` (length, p, q), shortest first, that
     /// [`Cleanup::collapse_way`] takes; true when one was.
-    fn collapse_first(&mut self, boxes: &[(DVec3, DVec3)], mut pairs: Vec<(f64, u32, u32)>) -> bool {
+    fn collapse_first(&mut self, boxes: &BoxIndex, mut pairs: Vec<(f64, u32, u32)>) -> bool {
         pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         pairs.dedup();
         for (length, p, q) in pairs {
@@ -1025,7 +1026,7 @@ impl Cleanup {
     /// area around it ([`Cleanup::collapse_way`]), where that is fewer than before. True
     /// when one was.
     fn merge_near(&mut self, found: &Defects) -> bool {
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         let grid = UsedGrid::new(&self.soup, self.limit);
         for faces in found.crossing_groups() {
             let mut corners: Vec<u32> = faces.iter().flat_map(|&f| self.soup.triangles[f]).collect();
@@ -1081,7 +1082,7 @@ impl Cleanup {
             }
         }
         pieces.sort_by(|x, y| x.0.total_cmp(&y.0).then_with(|| x.1.cmp(&y.1)));
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         let mut busy = HashSet::new();
         let mut gone = vec![false; self.soup.triangles.len()];
         for (_, piece) in pieces {
@@ -1127,7 +1128,7 @@ impl Cleanup {
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
         let mut map: HashMap<u32, u32> = HashMap::new();
         let mut busy = HashSet::new();
-        let boxes = if edges.is_empty() { Vec::new() } else { self.soup.boxes() };
+        let boxes = BoxIndex::new(if edges.is_empty() { Vec::new() } else { self.soup.boxes() });
         for (length, keep, gone) in edges {
             if busy.contains(&keep) || busy.contains(&gone) {
                 continue;
@@ -1148,7 +1149,7 @@ impl Cleanup {
     /// without area around it, if fewer than before: (those left, the end kept, the end
     /// that goes). An intersection point goes onto an input vertex; between two of a kind,
     /// either way, `q` onto `p` first (the first of two that leave as few).
-    fn collapse_way(&self, boxes: &[(DVec3, DVec3)], p: u32, q: u32) -> Option<(usize, u32, u32)> {
+    fn collapse_way(&self, boxes: &BoxIndex, p: u32, q: u32) -> Option<(usize, u32, u32)> {
         let ways: &[(u32, u32)] = match (self.is_new(p), self.is_new(q)) {
             (true, false) => &[(q, p)],
             (false, true) => &[(p, q)],
@@ -1175,7 +1176,7 @@ impl Cleanup {
         if candidates.is_empty() {
             return false;
         }
-        let boxes = self.soup.boxes();
+        let boxes = BoxIndex::new(self.soup.boxes());
         let pieces = self.pieces();
         let mut chosen: Vec<((u32, u32), u32)> = candidates
             .into_par_iter()
@@ -1861,12 +1862,7 @@ fn copies_in(
 /// Crossings and triangles without area at the corners of a flat region before and after
 /// it is rebuilt ([`flatten`]): its triangles and their neighbours against those whose
 /// boxes meet theirs.
-fn local_rebuild(
-    soup: &TriangleSoup,
-    boxes: &[(DVec3, DVec3)],
-    f: &Flattened,
-    pieces: Pieces,
-) -> (usize, usize) {
+fn local_rebuild(soup: &TriangleSoup, boxes: &BoxIndex, f: &Flattened, pieces: Pieces) -> (usize, usize) {
     let mut at: Vec<u32> = f.removed.iter().flat_map(|&t| soup.triangles[t]).collect();
     at.sort_unstable();
     at.dedup();
@@ -1891,7 +1887,7 @@ fn local_rebuild(
 /// collapses onto `keep`: their triangles against those whose boxes meet theirs.
 fn local_crossings(
     soup: &TriangleSoup,
-    boxes: &[(DVec3, DVec3)],
+    boxes: &BoxIndex,
     keep: u32,
     gone: u32,
     pieces: Pieces,
@@ -1909,7 +1905,7 @@ fn local_crossings(
 /// cancel): their triangles against those whose boxes meet theirs.
 fn local_split(
     soup: &TriangleSoup,
-    boxes: &[(DVec3, DVec3)],
+    boxes: &BoxIndex,
     edge: (u32, u32),
     at: u32,
     pieces: Pieces,
@@ -1930,15 +1926,21 @@ fn local_split(
 /// gets it with the points' ids in it, and returns the points to count at after).
 fn local_defects(
     soup: &TriangleSoup,
-    boxes: &[(DVec3, DVec3)],
+    boxes: &BoxIndex,
     at: &[u32],
     pieces: Pieces,
     edit: impl FnOnce(&mut TriangleSoup, &mut Vec<u32>, &mut Vec<bool>, &[u32]) -> Vec<u32>,
 ) -> (usize, usize) {
-    let around: HashSet<u32> = at.iter().copied().collect();
-    let (lo, hi) = (0..soup.triangles.len())
-        .filter(|&t| soup.triangles[t].iter().any(|v| around.contains(v)))
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
+    // A triangle at a point has a box that holds the point.
+    let (lo, hi) = at
+        .iter()
+        .flat_map(|&v| {
+            let p = soup.positions[v as usize];
+            boxes.meeting(&(p, p)).into_iter().filter(move |&t| soup.triangles[t].contains(&v))
+        })
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), t| {
+            (lo.min(boxes.boxes()[t].0), hi.max(boxes.boxes()[t].1))
+        });
     let (mut sub, ids) = sub_soup(soup, boxes, lo, hi);
     let count = |sub: &TriangleSoup, at: &[u32]| {
         let near: Vec<bool> = sub.triangles.iter().map(|t| t.iter().any(|v| at.contains(v))).collect();
@@ -2027,13 +2029,11 @@ fn found_near(sub: &TriangleSoup, near: &[bool]) -> Vec<Local> {
 /// (triangle k of it is `local[k]`), and the ids of their corners in it.
 fn sub_soup(
     soup: &TriangleSoup,
-    boxes: &[(DVec3, DVec3)],
+    boxes: &BoxIndex,
     lo: DVec3,
     hi: DVec3,
 ) -> (TriangleSoup, HashMap<u32, u32>) {
-    let local: Vec<usize> = (0..soup.triangles.len())
-        .filter(|&t| boxes[t].0.cmple(hi).all() && lo.cmple(boxes[t].1).all())
-        .collect();
+    let local = boxes.meeting(&(lo, hi));
     let mut sub = TriangleSoup {
         positions: Vec::new(),
         triangles: Vec::with_capacity(local.len()),
@@ -2115,7 +2115,7 @@ fn nudge(
             taken.insert(key(soup.positions[v as usize]));
         }
     }
-    let mut boxes = soup.boxes();
+    let mut boxes = BoxIndex::new(soup.boxes());
     let mut moved = HashSet::new();
     for faces in found.groups() {
         let mut corners: Vec<u32> =
@@ -2130,9 +2130,9 @@ fn nudge(
             let around = &star[&v];
             // Every candidate lies within two ulps per coordinate.
             let reach = |k: i64| DVec3::new(step_ulps(p.x, k), step_ulps(p.y, k), step_ulps(p.z, k));
-            let (lo, hi) = around
-                .iter()
-                .fold((reach(-2), reach(2)), |(lo, hi), &t| (lo.min(boxes[t].0), hi.max(boxes[t].1)));
+            let (lo, hi) = around.iter().fold((reach(-2), reach(2)), |(lo, hi), &t| {
+                (lo.min(boxes.boxes()[t].0), hi.max(boxes.boxes()[t].1))
+            });
             let (mut sub, ids) = sub_soup(soup, &boxes, lo, hi);
             if unmoved.get(&v).is_some_and(|(t, p)| *t == sub.triangles && *p == sub.positions) {
                 continue;
@@ -2173,7 +2173,7 @@ fn nudge(
             soup.positions[v as usize] = q;
             for &t in around {
                 let [a, b, c] = soup.triangle(t);
-                boxes[t] = (a.min(b).min(c), a.max(b).max(c));
+                boxes.set(t, (a.min(b).min(c), a.max(b).max(c)));
             }
             moved.insert(v);
             repair.ulp_moves += 1;

@@ -8,6 +8,9 @@
 //! would make too many entries), so a cell holds a few triangles of each surface
 //! crossing it, and only cells where the two sets meet give pairs — like the thesis'
 //! octree over both meshes, whose leaves concentrate where the meshes meet (§6.4).
+//!
+//! The same grid answers queries by box ([`BoxIndex`]): the boxes meeting a given one,
+//! from the cells it touches.
 
 use glam::{DVec3, UVec3};
 use rayon::prelude::*;
@@ -277,6 +280,93 @@ fn pairs_in_cells(
         })
 }
 
+/// The boxes meeting a query box, found in the grid cells it touches instead of by a scan
+/// of all of them: the output repair asks this for every candidate edit, thousands on a
+/// result of 100 k triangles. A box may change afterwards ([`BoxIndex::set`]); one that
+/// leaves the cells it was entered in is tested by every query from then on.
+pub struct BoxIndex {
+    boxes: Vec<Box3>,
+    /// None when there is no box (or none with finite corners).
+    grid: Option<Grid>,
+    /// Cell c's boxes are `entries[start[c]..start[c + 1]]`, by id.
+    start: Vec<u32>,
+    entries: Vec<u32>,
+    /// The cells each box was entered in.
+    cells: Vec<(UVec3, UVec3)>,
+    /// Boxes that left their cells.
+    moved: Vec<u32>,
+}
+
+impl BoxIndex {
+    pub fn new(boxes: Vec<Box3>) -> BoxIndex {
+        let mut index = BoxIndex {
+            boxes,
+            grid: None,
+            start: Vec::new(),
+            entries: Vec::new(),
+            cells: Vec::new(),
+            moved: Vec::new(),
+        };
+        let Some((region, all)) = entries_in_region(&index.boxes, None) else {
+            // Nothing to grid: every box is tested by every query.
+            index.moved = (0..index.boxes.len() as u32).collect();
+            return index;
+        };
+        let grid = fit_grid(&region, &all);
+        let Some((start, entries, _)) = sort_by_cell(&grid, &region, &all, u64::MAX) else {
+            unreachable!("no bound on the tests")
+        };
+        // Entries are places in `all`; boxes outside the region (none with finite corners,
+        // the region being their hull) are tested by every query.
+        index.entries = entries.into_iter().map(|k| all[k as usize].0).collect();
+        let mut entered = vec![false; index.boxes.len()];
+        for (id, _) in &all {
+            entered[*id as usize] = true;
+        }
+        index.moved = (0..index.boxes.len() as u32).filter(|&t| !entered[t as usize]).collect();
+        index.cells = index.boxes.iter().map(|b| grid.cells_of(&b.clamp_to(&region))).collect();
+        index.start = start;
+        index.grid = Some(grid);
+        index
+    }
+
+    pub fn boxes(&self) -> &[Box3] {
+        &self.boxes
+    }
+
+    /// Box `t` is now `b`.
+    pub fn set(&mut self, t: usize, b: Box3) {
+        self.boxes[t] = b;
+        if let Some(grid) = &self.grid
+            && let Some(&(lo, hi)) = self.cells.get(t)
+        {
+            // A cell is monotone in each coordinate (clamped to the grid), so a box whose
+            // cells lie among those it was entered in meets a query only where the query's
+            // cells meet those.
+            let (new_lo, new_hi) = grid.cells_of(&b);
+            if new_lo.cmpge(lo).all() && new_hi.cmple(hi).all() {
+                return;
+            }
+        }
+        if !self.moved.contains(&(t as u32)) {
+            self.moved.push(t as u32);
+        }
+    }
+
+    /// The ids of the boxes meeting `query` (touching counts), in increasing order.
+    pub fn meeting(&self, query: &Box3) -> Vec<usize> {
+        let mut found: Vec<u32> = self.moved.clone();
+        if let Some(grid) = &self.grid {
+            grid.each_cell(grid.cells_of(query), |c| {
+                found.extend_from_slice(&self.entries[self.start[c] as usize..self.start[c + 1] as usize]);
+            });
+        }
+        found.sort_unstable();
+        found.dedup();
+        found.into_iter().map(|t| t as usize).filter(|&t| overlaps(&self.boxes[t], query)).collect()
+    }
+}
+
 trait ClampTo {
     fn clamp_to(&self, region: &Box3) -> Box3;
 }
@@ -372,6 +462,35 @@ mod tests {
         assert_eq!(sorted(box_pairs_near(&spread, &all)), brute(&spread, Some(&all)));
         assert_eq!(box_pairs_near(&[], &all), vec![]);
         assert_eq!(box_pairs_near(&near, &[]), vec![]);
+    }
+
+    #[test]
+    fn an_index_finds_the_boxes_a_scan_finds() {
+        let mut all = random_boxes(2000, 7, 0.0);
+        let scan =
+            |all: &[Box3], q: &Box3| (0..all.len()).filter(|&t| overlaps(&all[t], q)).collect::<Vec<_>>();
+        let mut index = BoxIndex::new(all.clone());
+        let queries: Vec<Box3> = random_boxes(300, 8, -1.0)
+            .into_iter()
+            .chain([all[3], (all[5].1, all[5].1), (DVec3::splat(-9.0), DVec3::splat(-8.0))])
+            .collect();
+        for q in &queries {
+            assert_eq!(index.meeting(q), scan(&all, q));
+        }
+        // Boxes moved a little (within their cells) and far (out of them, and of the hull).
+        for (t, shift) in [(3, 1e-9), (11, 3.0), (12, -20.0)] {
+            let b = (all[t].0 + DVec3::splat(shift), all[t].1 + DVec3::splat(shift));
+            all[t] = b;
+            index.set(t, b);
+        }
+        for q in &queries {
+            assert_eq!(index.meeting(q), scan(&all, q));
+        }
+        for t in [11, 12] {
+            assert_eq!(index.meeting(&all[t]), scan(&all, &all[t]));
+            assert!(index.meeting(&all[t]).contains(&t));
+        }
+        assert_eq!(BoxIndex::new(Vec::new()).meeting(&queries[0]), Vec::<usize>::new());
     }
 
     #[test]
