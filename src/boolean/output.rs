@@ -101,6 +101,16 @@
 //! once such pieces on its folded edges are dropped ([`count_near`]): a collapse that
 //! removes a crossing and leaves a sliver beside it turned inside out is judged by what the
 //! repair then makes of it.
+//!
+//! Past every other step, a closed piece on a folded edge that lies doubled over the rest —
+//! inside the rest's solid facing out, or outside it facing in, so that the winding number
+//! in it is 2 or −1, as counted from the exact order of the faces about each edge where it
+//! hangs ([`doubled_at`]) — is dropped whatever its volume, the pieces on one edge together,
+//! where that leaves fewer defects around them ([`Cleanup::drop_doubled`]): every point in
+//! it is inside (or outside) with it and without it, so the solid keeps its points and only
+//! loses a double cover. Rounding and the collapses around a sliver can leave such a piece
+//! too thick to count as one of no volume: a lens 0.09 long and 2e-10 thick on average,
+//! folded by nanometres over an edge of the rest into the solid.
 
 use crate::mesh::hash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
@@ -110,7 +120,7 @@ use rayon::prelude::*;
 use super::input::{flatness_bound, is_flat};
 use crate::exact::orient2d;
 use crate::mesh::boxgrid::{Box3, BoxIndex, box_pairs};
-use crate::mesh::covering::signed_tetra_volume;
+use crate::mesh::covering::{order_about, signed_tetra_volume};
 use crate::mesh::disjoint_sets::UnionFind;
 use crate::mesh::frame::Frame;
 use crate::mesh::intersect::{TriangleSoup, is_degenerate, soup_self_intersections_near, weld_by_position};
@@ -210,6 +220,10 @@ pub struct Repair {
     /// where their faces did not alternate about such an edge: pieces that hold no volume
     /// worth keeping by the same measures as a dropped shell.
     pub dropped_pieces: usize,
+    /// Closed pieces on a folded edge that lie inside the rest facing out, or outside it
+    /// facing in (the winding number 2 or −1 in them, [`doubled_at`]), dropped past every
+    /// other repair whatever their volume: the solid holds the same points without them.
+    pub doubled_pieces: usize,
     /// Farthest any point moved.
     pub moved: f64,
 }
@@ -229,6 +243,7 @@ impl Repair {
             && self.merged == 0
             && self.dropped_shells == 0
             && self.dropped_pieces == 0
+            && self.doubled_pieces == 0
     }
 }
 
@@ -240,7 +255,7 @@ impl std::fmt::Display for Repair {
              {} edges split at a corner beside them, {} points moved by an ulp or two, {} edges collapsed, {} triangles removed by the snaps and collapses, points moved at most {:e}, {} flat slivers removed \
              ({} triangles rebuilt), {} sheets between opposite faces rebuilt ({} triangles, {} together with the sheet beside them, \
              {} with the points a hair from their corners merged first), {} long flat triangles split away, {} points merged with one a hair away, {} flat shells dropped, \
-             {} flat pieces hanging on a folded edge dropped",
+             {} flat pieces hanging on a folded edge dropped, {} pieces lying doubled over the rest dropped",
             self.tested,
             self.crossings,
             self.flat_triangles,
@@ -260,7 +275,8 @@ impl std::fmt::Display for Repair {
             self.flipped,
             self.merged,
             self.dropped_shells,
-            self.dropped_pieces
+            self.dropped_pieces,
+            self.doubled_pieces
         )
     }
 }
@@ -350,6 +366,7 @@ pub fn finish(
     // Rounds of ulp moves, once nothing else applies (each moves at least one point).
     let (mut nudges, mut sheets, mut longer, mut joined, mut merged, mut pieces) = (0, 0, 0, 0, 0, 0);
     let mut merged_sheets = 0;
+    let mut doubled = 0;
     for round in 0.. {
         let found = c.defects();
         if round == 0 {
@@ -411,6 +428,12 @@ pub fn finish(
             // from their corners merged onto them first.
             if merged_sheets < ROUNDS && c.merged_sheets(crossings) {
                 merged_sheets += 1;
+                continue;
+            }
+            // Past every other: the closed pieces on the folded edges that lie doubled over
+            // the rest, dropped whatever their volume (the solid's points stay).
+            if doubled < ROUNDS && c.drop_doubled(&found) {
+                doubled += 1;
                 continue;
             }
             return Err(err);
@@ -1112,6 +1135,144 @@ impl Cleanup {
         self.replace(&gone, Vec::new())
     }
 
+    /// Folded edges that nothing else removed: the closed pieces on them ([`hanging_piece`])
+    /// that lie doubled over the rest. About each edge of more than two triangles where
+    /// such a piece hangs, the winding number is counted from the faces' exact order
+    /// ([`doubled_at`]): where the other faces there (or all but those of other pieces
+    /// doubled with it) alternate, and the piece's lie together between two of them with
+    /// its first face running the way of the rest's face before it, the winding number in
+    /// the piece is 2 (a piece facing out, inside the rest's solid) or −1 (facing in,
+    /// outside it). A piece found so about every such edge where the order decides (and at
+    /// one at least), whose faces cross none, and whose volume, where it is not flat by the
+    /// operand rule, has the sign its faces there give it, adds nothing to the solid: every
+    /// point in it is inside with it and without it (winding number 2, then 1) or outside
+    /// (−1, then 0), so dropping it keeps the solid's points whatever its volume (only the
+    /// signed volume, which counted those points twice, changes by the piece's own). This
+    /// is what rounding and the repairs around a sliver can leave: a thin piece (the torus'
+    /// A ⊖ B with a copy turned 1e-6°, then ⊖ A: a lens 0.09 long and 2e-10 thick on
+    /// average) folded over an edge of the rest by nanometres, too thick to be dropped as a
+    /// piece of no volume. The pieces on one folded edge are dropped together (two pieces,
+    /// one facing out in the solid and one facing in outside it, each leave the edge folded
+    /// alone), each group where that leaves fewer defects around it, none sharing a point
+    /// with one dropped before. Removing closed pieces leaves every other edge balanced.
+    /// True when any was.
+    fn drop_doubled(&mut self, found: &Defects) -> bool {
+        if found.folds.is_empty() {
+            return false;
+        }
+        let by_edge = edge_faces(&self.soup);
+        // The pieces of the triangles on the folded edges and on the other edges of more
+        // than two triangles of those pieces, as they are asked for, each with the sign of
+        // its volume (0 where it is flat by the operand rule: no sign to go by).
+        let mut pieces: Vec<(Vec<usize>, i32)> = Vec::new();
+        let mut piece_of: HashMap<usize, Option<usize>> = HashMap::new();
+        let mut find = |t: usize, pieces: &mut Vec<(Vec<usize>, i32)>| -> Option<usize> {
+            if let Some(&p) = piece_of.get(&t) {
+                return p;
+            }
+            let Some(piece) = hanging_piece(&self.soup, &by_edge, t) else {
+                piece_of.insert(t, None);
+                return None;
+            };
+            let shape = Shape::of(&self.soup, &piece);
+            let sign = if shape.is_flat() { 0 } else { shape.volume.signum() as i32 };
+            let k = pieces.len();
+            piece_of.extend(piece.iter().map(|&u| (u, Some(k))));
+            pieces.push((piece, sign));
+            Some(k)
+        };
+        let mut candidates: Vec<usize> = Vec::new();
+        for f in &found.folds {
+            candidates.extend(f.triangles.iter().filter_map(|&t| find(t, &mut pieces)));
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        let crossing: HashSet<usize> = found.crossings.iter().flat_map(|&(a, b)| [a, b]).collect();
+        // Per edge of more than two triangles, each piece's verdict there.
+        let mut verdicts: HashMap<(u32, u32), Vec<(usize, bool)>> = HashMap::new();
+        let mut qualifies: HashSet<usize> = HashSet::new();
+        for &k in &candidates {
+            if pieces[k].0.iter().any(|t| crossing.contains(t)) {
+                continue;
+            }
+            let mut edges: Vec<(u32, u32)> = pieces[k]
+                .0
+                .iter()
+                .flat_map(|&t| {
+                    let tri = self.soup.triangles[t];
+                    (0..3).map(move |i| (tri[i].min(tri[(i + 1) % 3]), tri[i].max(tri[(i + 1) % 3])))
+                })
+                .filter(|e| by_edge[e].len() > 2)
+                .collect();
+            edges.sort_unstable();
+            edges.dedup();
+            let (mut any, mut against) = (false, false);
+            for e in edges {
+                let at = verdicts.entry(e).or_insert_with(|| {
+                    let faces = &by_edge[&e];
+                    let ids: Vec<Option<usize>> = faces.iter().map(|&t| find(t, &mut pieces)).collect();
+                    let signs: Vec<i32> = pieces.iter().map(|p| p.1).collect();
+                    doubled_at(&self.soup, e, faces, &ids, &signs).unwrap_or_default()
+                });
+                for &(_, doubled) in at.iter().filter(|v| v.0 == k) {
+                    any |= doubled;
+                    against |= !doubled;
+                }
+            }
+            if any && !against {
+                qualifies.insert(k);
+            }
+        }
+        // The qualifying pieces on one folded edge go together.
+        let mut groups = UnionFind::new(pieces.len());
+        for f in &found.folds {
+            let on: Vec<usize> = f
+                .triangles
+                .iter()
+                .filter_map(|t| piece_of.get(t).copied().flatten())
+                .filter(|k| qualifies.contains(k))
+                .collect();
+            for w in on.windows(2) {
+                groups.union(w[0] as u32, w[1] as u32);
+            }
+        }
+        let mut by_root: HashMap<u32, Vec<usize>> = HashMap::new();
+        for k in (0..pieces.len()).filter(|k| qualifies.contains(k)) {
+            by_root.entry(groups.find(k as u32)).or_default().push(k);
+        }
+        let mut groups: Vec<Vec<usize>> = by_root.into_values().collect();
+        groups.sort_unstable();
+        let boxes = BoxIndex::new(self.soup.boxes());
+        let mut busy = HashSet::new();
+        let mut gone = vec![false; self.soup.triangles.len()];
+        for group in groups {
+            let triangles: Vec<usize> = group.iter().flat_map(|&k| pieces[k].0.iter().copied()).collect();
+            let mut at: Vec<u32> = triangles.iter().flat_map(|&t| self.soup.triangles[t]).collect();
+            at.sort_unstable();
+            at.dedup();
+            if at.iter().any(|v| busy.contains(v)) {
+                continue;
+            }
+            let (before, after) =
+                local_defects(&self.soup, &boxes, &at, None, |sub, origin, changed, local| {
+                    let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
+                    let marked =
+                        copies_in(&sub.triangles, triangles.iter().map(|&t| self.soup.triangles[t]), id);
+                    replace_marked(sub, origin, changed, &marked, Vec::new());
+                    local.to_vec()
+                });
+            if after >= before {
+                continue;
+            }
+            busy.extend(at);
+            for &t in &triangles {
+                gone[t] = true;
+            }
+            self.repair.doubled_pieces += group.len();
+        }
+        self.replace(&gone, Vec::new())
+    }
+
     /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
     fn replace(&mut self, gone: &[bool], added: Vec<([u32; 3], u32)>) -> bool {
         if !gone.iter().any(|&g| g) {
@@ -1447,6 +1608,93 @@ fn hanging_piece(soup: &TriangleSoup, by_edge: &EdgeFaces, seed: usize) -> Optio
         piece.sort_unstable();
         piece
     })
+}
+
+/// For each closed piece on the edge `edge` (ends in increasing order), whether it lies
+/// doubled over the rest about it: `faces` the triangles on the edge, `ids` the piece of
+/// each (`None`: in none), `signs` each piece's volume's sign (0: flat, no sign to go by).
+/// Taken in their exact order about the edge ([`order_about`]), passing a face changes the
+/// winding number by one, down for one that runs along the edge's direction, up for one
+/// against it. For a set of the pieces, the rest is every other face; where the rest's
+/// faces alternate (two at least), the winding number of the rest alone is 1 after one
+/// running against the edge and 0 after one along it, and a piece's faces together between
+/// two of the rest's, alternating, add to it 1 (a piece facing out: its first face runs
+/// against the edge) or −1 (facing in) between its first and last face — where that sign
+/// is its volume's: the piece is outside itself beyond them. So the winding number in the
+/// piece there is 2 or −1, the piece doubled over the rest, exactly when its first face
+/// runs the way of the rest's face before it. A piece is doubled when it is so in a set
+/// all of whose pieces are (two pieces on one edge, one inside facing out and one outside
+/// facing in, leave the rest alternating only together). `None` where the order does not
+/// decide (faces at one angle or all in one plane) or more than six pieces meet there.
+fn doubled_at(
+    soup: &TriangleSoup,
+    (lo, hi): (u32, u32),
+    faces: &[usize],
+    ids: &[Option<usize>],
+    signs: &[i32],
+) -> Option<Vec<(usize, bool)>> {
+    /// Beyond this many pieces on one edge, the sets of them are not tried.
+    const MOST: usize = 6;
+    // Whether each face runs lo → hi, and its third corner.
+    let uses: Vec<(DVec3, bool)> = faces
+        .iter()
+        .map(|&t| {
+            let tri = soup.triangles[t];
+            let k = tri.iter().position(|&v| v == lo).unwrap_or(0);
+            let third = tri.into_iter().find(|&v| v != lo && v != hi).unwrap_or(lo);
+            (soup.positions[third as usize], tri[(k + 1) % 3] == hi)
+        })
+        .collect();
+    let mut on: Vec<usize> = ids.iter().flatten().copied().collect();
+    on.sort_unstable();
+    on.dedup();
+    if on.is_empty() || on.len() > MOST {
+        return None;
+    }
+    let order = order_about(soup.positions[lo as usize], soup.positions[hi as usize], &uses)?;
+    let n = order.len();
+    let along = |i: usize| uses[order[i % n]].1;
+    // Each face's piece as a bit of the sets.
+    let bit = |i: usize| ids[order[i % n]].map_or(0u32, |p| 1 << on.partition_point(|&q| q < p));
+    let mut doubled = 0u32;
+    for set in 1..1u32 << on.len() {
+        let rest: Vec<usize> = (0..n).filter(|&i| bit(i) & set == 0).collect();
+        if rest.len() < 2 || (0..rest.len()).any(|j| along(rest[j]) == along(rest[(j + 1) % rest.len()])) {
+            continue;
+        }
+        // From the first face of the rest, once round.
+        let start = rest[0];
+        let (mut before, mut seen, mut i) = (along(start), 0u32, start + 1);
+        let all = loop {
+            if i >= start + n {
+                break true;
+            }
+            let b = bit(i);
+            if b & set == 0 {
+                before = along(i);
+                i += 1;
+                continue;
+            }
+            let run = (i..start + n).take_while(|&j| bit(j) == b).count();
+            let piece = on[b.trailing_zeros() as usize];
+            let sign = if along(i) { -1 } else { 1 };
+            let alternates = run % 2 == 0 && (i..i + run - 1).all(|j| along(j) != along(j + 1));
+            // Its faces in two runs: others lie between them.
+            if seen & b != 0
+                || !alternates
+                || along(i) != before
+                || (signs[piece] != 0 && signs[piece] != sign)
+            {
+                break false;
+            }
+            seen |= b;
+            i += run;
+        };
+        if all {
+            doubled |= set;
+        }
+    }
+    Some(on.iter().enumerate().map(|(k, &p)| (p, doubled & (1 << k) != 0)).collect())
 }
 
 /// The measures of a set of triangles by which a repair's leftover is told: the signed

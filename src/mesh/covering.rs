@@ -457,6 +457,18 @@ impl Covering {
 /// inside out, or inside a part facing its way). Faces at one angle (overlapping) are left
 /// to the self-intersection test.
 pub(crate) fn folds(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> bool {
+    order_about(a, b, uses).is_some_and(|order| {
+        (0..order.len()).any(|i| uses[order[i]].1 == uses[order[(i + 1) % order.len()]].1)
+    })
+}
+
+/// The faces around the edge a–b, given by their third corners (and whether they run
+/// a → b, unused here), in their exact order about the axis a → b: by increasing angle in
+/// the right-hand sense, from the first. Going that way, a face that runs a → b is passed
+/// from the side its normal points away from to the side it points to (the winding number
+/// goes down by one), one that runs b → a the other way (up by one). `None` where every
+/// corner lies in one plane with the edge or two lie at one angle (overlapping faces).
+pub(crate) fn order_about(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> Option<Vec<usize>> {
     use crate::exact::orient3d;
     // Angles about the axis a→b from the first use's half-plane: (half, position),
     // half 0 for [0, π), 1 for [π, 2π); a point off the common plane tells the two
@@ -469,22 +481,20 @@ pub(crate) fn folds(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> bool {
         .enumerate()
         .map(|(i, u)| if i == 0 { 0 } else { orient3d(a, b, reference, u.0) })
         .collect();
-    let Some(k) = signs.iter().position(|&s| s != 0) else {
-        return false;
-    };
+    let k = signs.iter().position(|&s| s != 0)?;
     let off = uses[k].0;
     let side_of_reference = orient3d(a, b, off, reference);
     let half = |i: usize| match signs[i] {
-        0 if i == 0 || orient3d(a, b, off, uses[i].0) == side_of_reference => 0,
+        0 if i == 0 || orient3d(a, b, off, uses[i].0) == side_of_reference => 0u8,
         0 => 1,
         s if s > 0 => 0,
         _ => 1,
     };
-    let mut order: Vec<(u8, DVec3, bool)> =
-        uses.iter().enumerate().map(|(i, &(t, f))| (half(i), t, f)).collect();
+    let halves: Vec<u8> = (0..uses.len()).map(half).collect();
+    let mut order: Vec<usize> = (0..uses.len()).collect();
     let mut tie = false;
-    order.sort_by(|x, y| {
-        x.0.cmp(&y.0).then_with(|| match orient3d(a, b, x.1, y.1) {
+    order.sort_by(|&x, &y| {
+        halves[x].cmp(&halves[y]).then_with(|| match orient3d(a, b, uses[x].0, uses[y].0) {
             0 => {
                 tie = true;
                 std::cmp::Ordering::Equal
@@ -493,10 +503,7 @@ pub(crate) fn folds(a: DVec3, b: DVec3, uses: &[(DVec3, bool)]) -> bool {
             _ => std::cmp::Ordering::Greater,
         })
     });
-    if tie {
-        return false;
-    }
-    (0..order.len()).any(|i| order[i].2 == order[(i + 1) % order.len()].2)
+    (!tie).then_some(order)
 }
 
 #[cfg(test)]

@@ -228,6 +228,7 @@ fn repair_json(r: &boolean::Repair) -> serde_json::Value {
         "merged_sheets": r.merged_sheets,
         "dropped_shells": r.dropped_shells,
         "dropped_pieces": r.dropped_pieces,
+        "doubled_pieces": r.doubled_pieces,
         "moved": r.moved,
     })
 }
