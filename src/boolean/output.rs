@@ -139,6 +139,48 @@ const ROUNDS: usize = 32;
 /// Rounds of ulp moves before giving up.
 const NUDGES: usize = 16;
 
+/// The repairs past the snaps, splits and collapses, in the order they are tried once
+/// those make no edit: each only where every one before it made none, at most its number
+/// of times.
+#[derive(Clone, Copy, Debug)]
+enum LastResort {
+    /// Folds no collapse removed: the closed pieces of no volume hanging on them
+    /// ([`Cleanup::drop_pieces`]).
+    DropPieces,
+    /// Intersection points moved by an ulp or two ([`nudge`]).
+    Nudge,
+    /// The sheets at the crossings, each where it leaves fewer defects around it
+    /// ([`Cleanup::rebuild_sheets`]).
+    Sheets,
+    /// The sheets keeping their own edges that cross none of their others ([`flatten`]),
+    /// then the other short edges of the crossing triangles (and of those around a folded
+    /// edge, [`Cleanup::collapse_longer`]).
+    Longer,
+    /// The sheets again, each rebuilt together with the sheets beside it where its
+    /// outline's splits leave those crossing ([`Cleanup::join_sheets`]).
+    Joined,
+    /// A corner of a crossing triangle (or of one around a folded edge) merged with any
+    /// point a hair away ([`Cleanup::merge_near`]).
+    Merged,
+    /// The sheets at the crossings with the intersection points a hair from their corners
+    /// merged onto them first ([`Cleanup::merged_sheets`]).
+    MergedSheets,
+    /// The closed pieces on the folded edges that lie doubled over the rest, dropped
+    /// whatever their volume: the solid's points stay ([`Cleanup::drop_doubled`]).
+    Doubled,
+}
+
+const LAST_RESORTS: [(LastResort, usize); 8] = [
+    (LastResort::DropPieces, ROUNDS),
+    (LastResort::Nudge, NUDGES),
+    (LastResort::Sheets, ROUNDS),
+    (LastResort::Longer, ROUNDS),
+    (LastResort::Joined, ROUNDS),
+    (LastResort::Merged, ROUNDS),
+    (LastResort::MergedSheets, ROUNDS),
+    (LastResort::Doubled, ROUNDS),
+];
+
 /// How thin a region between two nearly coincident faces may be to count as flat, for
 /// points with coordinates up to `max_abs` and operands of bounding-box diagonal
 /// `diagonal`: far below any feature of a real model, far above the few ulps by which
@@ -363,10 +405,8 @@ pub fn finish(
     // Welding is a collapse of edges of length zero: the same clean-up (among the changed
     // triangles: uncut ones of one operand do not coincide with another's).
     collapse(&mut c.soup, &mut c.origin, &mut c.changed, &HashMap::new(), false, &mut c.repair);
-    // Rounds of ulp moves, once nothing else applies (each moves at least one point).
-    let (mut nudges, mut sheets, mut longer, mut joined, mut merged, mut pieces) = (0, 0, 0, 0, 0, 0);
-    let mut merged_sheets = 0;
-    let mut doubled = 0;
+    // How often each last resort made an edit.
+    let mut tried = [0; LAST_RESORTS.len()];
     for round in 0.. {
         let found = c.defects();
         if round == 0 {
@@ -389,51 +429,13 @@ pub fn finish(
         let map = if more { c.choose_collapses(plan.edges) } else { HashMap::new() };
         if map.is_empty() {
             let err = plan.stuck.unwrap_or_else(|| c.first_error(&found));
-            // Folds no collapse removed: the closed pieces of no volume hanging on them.
-            if pieces < ROUNDS && c.drop_pieces(&found.folds) {
-                pieces += 1;
-                continue;
-            }
-            if nudges < NUDGES && nudge(&mut c.soup, &found, first_new, &mut c.unmoved, &mut c.repair) {
-                nudges += 1;
-                continue;
-            }
-            let crossings = &found.crossings;
-            // Past the ulp moves, the sheets at the crossings (each where it leaves fewer
-            // defects around it).
-            if sheets < ROUNDS && c.rebuild_sheets(crossings, false) {
-                sheets += 1;
-                continue;
-            }
-            // Past the sheets, the sheets keeping their own edges that cross none of their
-            // others ([`flatten`]), then the other short edges of the crossing triangles
-            // (and of those around a folded edge).
-            if longer < ROUNDS && (c.rebuild_sheets(crossings, true) || c.collapse_longer(&found)) {
-                longer += 1;
-                continue;
-            }
-            // Past those, the sheets again, each rebuilt together with the sheets beside it
-            // where its outline's splits leave those crossing ([`Cleanup::split_sheet`]).
-            if joined < ROUNDS && c.join_sheets(crossings) {
-                joined += 1;
-                continue;
-            }
-            // Past every other: a corner of a crossing triangle (or of one around a folded
-            // edge) merged with any point a hair away.
-            if merged < ROUNDS && c.merge_near(&found) {
-                merged += 1;
-                continue;
-            }
-            // Past those, the sheets at the crossings with the intersection points a hair
-            // from their corners merged onto them first.
-            if merged_sheets < ROUNDS && c.merged_sheets(crossings) {
-                merged_sheets += 1;
-                continue;
-            }
-            // Past every other: the closed pieces on the folded edges that lie doubled over
-            // the rest, dropped whatever their volume (the solid's points stay).
-            if doubled < ROUNDS && c.drop_doubled(&found) {
-                doubled += 1;
+            // The first last resort that makes an edit, each at most its number of times.
+            let made = LAST_RESORTS.iter().zip(&mut tried).any(|(&(resort, most), tried)| {
+                let made = *tried < most && c.last_resort(resort, &found);
+                *tried += usize::from(made);
+                made
+            });
+            if made {
                 continue;
             }
             return Err(err);
@@ -573,6 +575,23 @@ impl Cleanup {
             snap: snap_distance(max_abs),
             unmoved: Unmoved::new(),
             wide: false,
+        }
+    }
+
+    /// Makes `resort`'s edits; true when it made any (everything is checked again).
+    fn last_resort(&mut self, resort: LastResort, found: &Defects) -> bool {
+        let crossings = &found.crossings;
+        match resort {
+            LastResort::DropPieces => self.drop_pieces(&found.folds),
+            LastResort::Nudge => {
+                nudge(&mut self.soup, found, self.first_new, &mut self.unmoved, &mut self.repair)
+            }
+            LastResort::Sheets => self.rebuild_sheets(crossings, false),
+            LastResort::Longer => self.rebuild_sheets(crossings, true) || self.collapse_longer(found),
+            LastResort::Joined => self.join_sheets(crossings),
+            LastResort::Merged => self.merge_near(found),
+            LastResort::MergedSheets => self.merged_sheets(crossings),
+            LastResort::Doubled => self.drop_doubled(found),
         }
     }
 
