@@ -1124,11 +1124,22 @@ impl Cleanup {
             }
         }
         pieces.sort_by(|x, y| x.0.total_cmp(&y.0).then_with(|| x.1.cmp(&y.1)));
+        let dropped = self.drop_where_fewer(pieces.into_iter().map(|(_, piece)| piece));
+        self.repair.dropped_pieces += dropped.len();
+        !dropped.is_empty()
+    }
+
+    /// Drops each of `sets` of triangles (closed pieces), in order, where that leaves fewer
+    /// defects around it ([`local_defects`]) and it shares no point with one dropped before
+    /// (so each is judged on the triangles around it as they stay); the places in `sets` of
+    /// those dropped.
+    fn drop_where_fewer(&mut self, sets: impl IntoIterator<Item = Vec<usize>>) -> Vec<usize> {
         let boxes = BoxIndex::new(self.soup.boxes());
         let mut busy = HashSet::new();
         let mut gone = vec![false; self.soup.triangles.len()];
-        for (_, piece) in pieces {
-            let mut at: Vec<u32> = piece.iter().flat_map(|&t| self.soup.triangles[t]).collect();
+        let mut dropped = Vec::new();
+        for (k, set) in sets.into_iter().enumerate() {
+            let mut at: Vec<u32> = set.iter().flat_map(|&t| self.soup.triangles[t]).collect();
             at.sort_unstable();
             at.dedup();
             if at.iter().any(|v| busy.contains(v)) {
@@ -1136,9 +1147,9 @@ impl Cleanup {
             }
             let (before, after) =
                 local_defects(&self.soup, &boxes, &at, None, |sub, origin, changed, local| {
-                    // The piece's triangles in the sub-soup, by their corners.
+                    // The set's triangles in the sub-soup, by their corners.
                     let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
-                    let marked = copies_in(&sub.triangles, piece.iter().map(|&t| self.soup.triangles[t]), id);
+                    let marked = copies_in(&sub.triangles, set.iter().map(|&t| self.soup.triangles[t]), id);
                     replace_marked(sub, origin, changed, &marked, Vec::new());
                     local.to_vec()
                 });
@@ -1146,12 +1157,13 @@ impl Cleanup {
                 continue;
             }
             busy.extend(at);
-            for &t in &piece {
+            for &t in &set {
                 gone[t] = true;
             }
-            self.repair.dropped_pieces += 1;
+            dropped.push(k);
         }
-        self.replace(&gone, Vec::new())
+        self.replace(&gone, Vec::new());
+        dropped
     }
 
     /// Folded edges that nothing else removed: the closed pieces on them ([`hanging_piece`])
@@ -1261,35 +1273,11 @@ impl Cleanup {
         }
         let mut groups: Vec<Vec<usize>> = by_root.into_values().collect();
         groups.sort_unstable();
-        let boxes = BoxIndex::new(self.soup.boxes());
-        let mut busy = HashSet::new();
-        let mut gone = vec![false; self.soup.triangles.len()];
-        for group in groups {
-            let triangles: Vec<usize> = group.iter().flat_map(|&k| pieces[k].0.iter().copied()).collect();
-            let mut at: Vec<u32> = triangles.iter().flat_map(|&t| self.soup.triangles[t]).collect();
-            at.sort_unstable();
-            at.dedup();
-            if at.iter().any(|v| busy.contains(v)) {
-                continue;
-            }
-            let (before, after) =
-                local_defects(&self.soup, &boxes, &at, None, |sub, origin, changed, local| {
-                    let id = |v: u32| at.binary_search(&v).ok().map(|k| local[k]);
-                    let marked =
-                        copies_in(&sub.triangles, triangles.iter().map(|&t| self.soup.triangles[t]), id);
-                    replace_marked(sub, origin, changed, &marked, Vec::new());
-                    local.to_vec()
-                });
-            if after >= before {
-                continue;
-            }
-            busy.extend(at);
-            for &t in &triangles {
-                gone[t] = true;
-            }
-            self.repair.doubled_pieces += group.len();
-        }
-        self.replace(&gone, Vec::new())
+        let sets =
+            groups.iter().map(|group| group.iter().flat_map(|&k| pieces[k].0.iter().copied()).collect());
+        let dropped = self.drop_where_fewer(sets);
+        self.repair.doubled_pieces += dropped.iter().map(|&g| groups[g].len()).sum::<usize>();
+        !dropped.is_empty()
     }
 
     /// Replaces the triangles marked in `gone` by `added`; false when none is marked.
