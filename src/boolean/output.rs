@@ -501,10 +501,17 @@ struct Cleanup {
     /// The points for which [`nudge`] found no position, with the triangles around them
     /// then: with the same triangles it finds none again.
     unmoved: Unmoved,
-    /// In [`Cleanup::merged_sheets`]: a sheet's corners take the intersection points within
-    /// `limit` of them before it is rebuilt, not the points within `snap`
-    /// ([`Cleanup::sheet_snaps`]).
-    wide: bool,
+}
+
+/// Which points [`Cleanup::sheet_edit`] joins to a sheet's corners before it rebuilds it
+/// ([`Cleanup::sheet_snaps`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Corners {
+    /// The points within a few ulps, counted as snaps.
+    Snapped,
+    /// The intersection points within the collapse limit ([`Cleanup::merged_sheets`]),
+    /// counted as merges.
+    Merged,
 }
 
 /// Per point, the triangles around it (as [`sub_soup`] gives them) where [`nudge`] found no
@@ -574,7 +581,6 @@ impl Cleanup {
             thickness: flat_thickness(max_abs, diagonal),
             snap: snap_distance(max_abs),
             unmoved: Unmoved::new(),
-            wide: false,
         }
     }
 
@@ -588,7 +594,7 @@ impl Cleanup {
             }
             LastResort::Sheets => self.rebuild_sheets(crossings, false),
             LastResort::Longer => self.rebuild_sheets(crossings, true) || self.collapse_longer(found),
-            LastResort::Joined => self.join_sheets(crossings),
+            LastResort::Joined => self.join_sheets(crossings, Corners::Snapped),
             LastResort::Merged => self.merge_near(found),
             LastResort::MergedSheets => self.merged_sheets(crossings),
             LastResort::Doubled => self.drop_doubled(found),
@@ -809,23 +815,23 @@ impl Cleanup {
         // None could be rebuilt as it is: its outline's corners in line within an ulp cross
         // each other's edges in the plane. The first whose outline, split at those corners
         // (in every triangle on the edge), can be rebuilt, where that leaves fewer defects.
-        crossings
-            .iter()
-            .any(|&(a, b)| [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, 0)))
+        crossings.iter().any(|&(a, b)| {
+            [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, 0, Corners::Snapped))
+        })
     }
 
     /// The last resort past every other: the sheets at the crossings with their outlines
     /// split ([`Cleanup::split_sheet`]), each together with up to three sheets beside it that
     /// the splits leave crossing, without and then with their own edges kept. True when one
     /// was rebuilt.
-    fn join_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
+    fn join_sheets(&mut self, crossings: &[(usize, usize)], corners: Corners) -> bool {
         /// Sheets rebuilt after the first where the one before left crossings beside it.
         const JOINED: usize = 3;
         let by_edge = edge_faces(&self.soup);
         let boxes = BoxIndex::new(self.soup.boxes());
         [false, true].into_iter().any(|keep| {
             crossings.iter().any(|&(a, b)| {
-                [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, JOINED))
+                [a, b].into_iter().any(|seed| self.split_sheet(&by_edge, &boxes, seed, keep, JOINED, corners))
             })
         })
     }
@@ -846,9 +852,10 @@ impl Cleanup {
         seed: usize,
         keep: bool,
         most: usize,
+        corners: Corners,
     ) -> bool {
         let start = (self.soup.clone(), self.origin.clone(), self.changed.clone());
-        let Some(mut edit) = self.sheet_edit(start, Some(by_edge), seed, keep, false) else {
+        let Some(mut edit) = self.sheet_edit(start, Some(by_edge), seed, keep, false, corners) else {
             return false;
         };
         let same = |_: &mut TriangleSoup, _: &mut Vec<u32>, _: &mut Vec<bool>, local: &[u32]| local.to_vec();
@@ -865,7 +872,13 @@ impl Cleanup {
                     let d = self.soup.positions[gone as usize].distance(self.soup.positions[keep as usize]);
                     self.repair.moved = self.repair.moved.max(d);
                 }
-                self.repair.snapped += edit.snaps.len();
+                match corners {
+                    Corners::Snapped => self.repair.snapped += edit.snaps.len(),
+                    Corners::Merged => {
+                        self.repair.merged += edit.snaps.len();
+                        self.repair.merged_sheets += 1 + joined;
+                    }
+                }
                 self.repair.split_edges += edit.splits;
                 self.repair.removed_triangles += edit.removed;
                 self.repair.sheets += 1 + joined;
@@ -894,7 +907,7 @@ impl Cleanup {
             crossing.dedup();
             let Some(next) = crossing.into_iter().find_map(|t| {
                 let state = (edit.soup.clone(), edit.origin.clone(), edit.changed.clone());
-                self.sheet_edit(state, None, t, keep, true)
+                self.sheet_edit(state, None, t, keep, true, corners)
             }) else {
                 break;
             };
@@ -914,6 +927,7 @@ impl Cleanup {
         seed: usize,
         keep: bool,
         plain: bool,
+        corners: Corners,
     ) -> Option<SheetEdit> {
         let (mut soup, mut origin, mut changed) = state;
         let region = match by_edge {
@@ -924,7 +938,7 @@ impl Cleanup {
         let mut scratch = Repair::default();
         // Corners a few ulps apart first (two that differ only across the plane are one
         // point in its projection): snapped together, as at a defect.
-        let snaps = self.sheet_snaps(&soup, &region);
+        let snaps = self.sheet_snaps(&soup, &region, corners);
         collapse(&mut soup, &mut origin, &mut changed, &snaps, true, &mut scratch);
         let find = |soup: &TriangleSoup, tris: Vec<[u32; 3]>| {
             let index: HashMap<[u32; 3], usize> =
@@ -970,11 +984,11 @@ impl Cleanup {
 
     /// The snaps [`Cleanup::sheet_edit`] makes at a sheet's corners before it is rebuilt:
     /// every point within `snap` (per coordinate) of one of them onto the lowest id of its
-    /// cluster ([`snap_map`]); in [`Cleanup::merged_sheets`], every intersection point within
+    /// cluster ([`snap_map`]); for [`Corners::Merged`], every intersection point within
     /// `limit` of one of them, the same way, where that moves it at most `limit` (input
     /// vertices stay).
-    fn sheet_snaps(&self, soup: &TriangleSoup, region: &[usize]) -> HashMap<u32, u32> {
-        if !self.wide {
+    fn sheet_snaps(&self, soup: &TriangleSoup, region: &[usize], corners: Corners) -> HashMap<u32, u32> {
+        if corners == Corners::Snapped {
             return snap_map(soup, region.iter().copied(), self.snap);
         }
         let mut map = snap_map(soup, region.iter().copied(), self.limit);
@@ -1005,15 +1019,7 @@ impl Cleanup {
     /// where it leaves fewer defects at the sheet's corners than before, as every edit past
     /// the collapses. True when one was made.
     fn merged_sheets(&mut self, crossings: &[(usize, usize)]) -> bool {
-        let before = self.repair;
-        self.wide = true;
-        let done = self.join_sheets(crossings);
-        self.wide = false;
-        // The edit's snaps are merges of points a hair apart, not of points a few ulps apart.
-        self.repair.merged += self.repair.snapped - before.snapped;
-        self.repair.snapped = before.snapped;
-        self.repair.merged_sheets += self.repair.sheets - before.sheets;
-        done
+        self.join_sheets(crossings, Corners::Merged)
     }
 
     /// The last resort for crossings (and folded edges) past the sheets: any edge of their
